@@ -1,0 +1,49 @@
+#include "gnc/allocation/allocator.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+namespace rocksteady::gnc {
+
+double torque_matrix_rcond(const Mat38& b) {
+  const Mat3 bbt = b * b.transpose();
+  if (!bbt.allFinite()) {
+    return 0.0;
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> es;
+  es.computeDirect(bbt, Eigen::EigenvaluesOnly);
+  const double hi = es.eigenvalues().maxCoeff();
+  const double lo = es.eigenvalues().minCoeff();
+  return hi > 0.0 && lo > 0.0 ? lo / hi : 0.0;
+}
+
+bool Allocator::configure(const Mat38& b_hat, double u_max) {
+  if (torque_matrix_rcond(b_hat) < 1e-12 || !(u_max > 0.0)) {
+    return false;
+  }
+  b_hat_ = b_hat;
+  u_max_ = u_max;
+  const Mat3 bbt = b_hat * b_hat.transpose();
+  // Eq. (53): B' (B B')^-1, through a Cholesky solve of the SPD 3x3 rather than an explicit inverse.
+  pinv_ = bbt.llt().solve(b_hat).transpose();
+  return true;
+}
+
+void Allocator::allocate(const Vec3& u_c, Vec8& u, AllocatorStatus& status) const {
+  u = pinv_ * u_c;  // Eq. (53)
+  status.torque_requested = u_c;
+  const double peak = u.lpNorm<Eigen::Infinity>();
+  if (peak > u_max_) {
+    status.scale = u_max_ / peak;  // keeps the torque direction (SPEC §4)
+    u *= status.scale;
+    status.saturated = true;
+  } else {
+    status.scale = 1.0;
+    status.saturated = false;
+  }
+  status.torque_achieved = b_hat_ * u;
+}
+
+}  // namespace rocksteady::gnc

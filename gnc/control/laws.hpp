@@ -1,0 +1,74 @@
+// Control laws (SPEC §2). Each returns the commanded body torque u_c. Free functions for the
+// stateless math; ControlLaws holds the state of the integral and adaptive laws.
+#pragma once
+
+#include "gnc/guidance/references.hpp"
+#include "gnc/params.hpp"
+#include "gnc/types.hpp"
+
+namespace rocksteady::gnc {
+
+// omega_r and its analytic time derivative.
+struct RateReference {
+  Vec3 omega_r{Vec3::Zero()};
+  Vec3 omega_r_dot{Vec3::Zero()};
+};
+
+// Eq. (9): omega_r = Z(q)^-1 qdot_d + Z(q)^-1 Lambda (q_d - q); omega_r_dot from qdot = Z(q) omega,
+// qdot_d, qddot_d and d/dt Z^-1 = -Z^-1 Zdot Z^-1. In the damping phase omega_r = 0 (Eq. 51).
+RateReference mrp_rate_reference(const Vec3& q, const Vec3& omega, const ReferenceSample& ref,
+                                 const Mat3& lambda);
+
+// Eq. (37): omega_r = R' R_d omega_d - Lambda_e E' e_R, with analytic omega_r_dot.
+// R_d, omega_d, omega_d_dot are derived from the MRP reference.
+RateReference so3_rate_reference(const Vec3& q, const Vec3& omega, const ReferenceSample& ref,
+                                 const Mat3& lambda);
+
+// Eq. (9): u_c = J w_r_dot - S(J w) w_r - K (w - w_r).
+Vec3 ntcl_torque(const Mat3& j_hat, const Mat3& k, const Vec3& omega, const RateReference& r);
+// Eq. (17): u_c = J w_r_dot - S(J w) w_r - Z(q)' K Z(q) (w - w_r).
+Vec3 el_torque(const Mat3& j_hat, const Mat3& k, const Vec3& q, const Vec3& omega,
+               const RateReference& r);
+// Feed-forward cancellation (comparison): u_c = J w_r_dot - S(J w) w - K (w - w_r).
+Vec3 feedforward_torque(const Mat3& j_hat, const Mat3& k, const Vec3& omega,
+                        const RateReference& r);
+// Eqs. (49)-(50): -K_d w while damping; -k_p beta_err,v - K_d w when holding an attitude.
+Vec3 dpd_torque(const DpdGains& g, const Vec3& omega, const Vec3& q, const ReferenceSample& ref);
+
+// Regressor of Eq. (34): Y(w, w_r, w_r_dot) a = J w_r_dot - S(J w) w_r, with
+// a = [Jxx, Jyy, Jzz, Jxy, Jxz, Jyz].
+Mat36 regressor(const Vec3& omega, const Vec3& omega_r, const Vec3& omega_r_dot);
+Vec6 inertia_to_params(const Mat3& j);
+Mat3 params_to_inertia(const Vec6& a);
+// The adaptive law's projection: the nearest (Frobenius) symmetric matrix whose eigenvalues lie in
+// [lo, hi]. The set is convex and bounded, and every member is positive definite.
+Mat3 project_inertia(const Mat3& j, double lo, double hi);
+
+struct LawInput {
+  Vec3 omega{Vec3::Zero()};
+  Vec3 q{Vec3::Zero()};
+  ReferenceSample ref{};
+  bool saturated_last{false};  // allocator saturated on the previous tick (anti-windup)
+};
+
+class ControlLaws {
+ public:
+  void configure(const GncParams& p, const Mat3& j_hat);
+  void reset_state();  // integral to zero, a_hat to J_hat
+  // One tick of law `law`. Writes omega_r for telemetry.
+  Vec3 compute(LawId law, const LawInput& in, RateReference& rr);
+
+  const Vec3& integral() const { return integral_; }
+  const Vec6& a_hat() const { return a_hat_; }
+
+ private:
+  GncParams p_{};
+  Mat3 j_hat_{Mat3::Identity()};
+  double dt_{0.1};
+  double eig_lo_{0.0};
+  double eig_hi_{0.0};
+  Vec3 integral_{Vec3::Zero()};
+  Vec6 a_hat_{Vec6::Zero()};
+};
+
+}  // namespace rocksteady::gnc

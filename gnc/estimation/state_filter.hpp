@@ -1,0 +1,45 @@
+// The study's state filter (SPEC §6): predict through the model (J_hat, MRP kinematics, last
+// commanded torque), then add K times the innovation, K = 1 - exp(-omega_c T_s). With perfect sensors
+// the estimate is the measurement (pass-through).
+#pragma once
+
+#include "gnc/params.hpp"
+#include "gnc/types.hpp"
+
+namespace rocksteady::gnc {
+
+struct Measurement {
+  Vec3 omega{Vec3::Zero()};  // gyro, rad/s
+  Vec3 q{Vec3::Zero()};      // star tracker, MRP
+  bool omega_valid{false};
+  bool q_valid{false};
+};
+
+class StateFilter {
+ public:
+  void configure(const EstimatorParams& p, const Mat3& j_hat, double dt);
+  // Forget the estimate: the next valid measurement initialises it.
+  void reset() { initialised_ = false; }
+  // One tick: torque = body torque commanded on the previous tick (B_hat u).
+  void update(const Measurement& m, const Vec3& torque);
+
+  bool initialised() const { return initialised_; }
+  const Vec3& omega() const { return omega_; }
+  const Vec3& q() const { return q_; }
+  double gain() const { return gain_; }
+
+  // Model propagation used by the prediction (RK4 of Eq. 2 with J_hat and Eq. 4), exposed for tests.
+  void predict(Vec3& q, Vec3& omega, const Vec3& torque) const;
+
+ private:
+  EstimatorParams p_{};
+  Mat3 j_hat_{Mat3::Identity()};
+  Mat3 j_hat_inv_{Mat3::Identity()};
+  double dt_{0.1};
+  double gain_{1.0};
+  bool initialised_{false};
+  Vec3 omega_{Vec3::Zero()};
+  Vec3 q_{Vec3::Zero()};
+};
+
+}  // namespace rocksteady::gnc

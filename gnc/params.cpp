@@ -1,0 +1,177 @@
+#include "gnc/params.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "gnc/allocation/allocator.hpp"
+
+namespace rocksteady::gnc {
+
+const char* to_string(Mode m) {
+  switch (m) {
+    case Mode::kIdle: return "IDLE";
+    case Mode::kDetumble: return "DETUMBLE";
+    case Mode::kHold: return "HOLD";
+    case Mode::kTrack: return "TRACK";
+    case Mode::kSafe: return "SAFE";
+  }
+  return "?";
+}
+
+const char* to_string(LawId l) {
+  switch (l) {
+    case LawId::kNtcl: return "ntcl";
+    case LawId::kNtclEl: return "el";
+    case LawId::kIntegral: return "integral";
+    case LawId::kAdaptive: return "adaptive";
+    case LawId::kSo3: return "so3";
+    case LawId::kDpd: return "dpd";
+    case LawId::kFeedforward: return "feedforward";
+  }
+  return "?";
+}
+
+GncParams study_gnc_params(double u_max) {
+  GncParams p;
+  p.mass_hat = study_true_mass_properties();
+  p.rcs = study_rcs_layout(u_max);
+  return p;
+}
+
+bool all_finite(const Mat3& m) { return m.allFinite(); }
+
+bool is_symmetric_positive_definite(const Mat3& m) {
+  if (!m.allFinite()) return false;
+  if ((m - m.transpose()).norm() > 1e-9 * (1.0 + m.norm())) return false;
+  const Eigen::LLT<Mat3> llt(0.5 * (m + m.transpose()));
+  return llt.info() == Eigen::Success;
+}
+
+namespace {
+
+ParamCheck bad(const char* field, const char* reason) { return ParamCheck{false, field, reason}; }
+
+bool positive_finite(double v) { return std::isfinite(v) && v > 0.0; }
+
+// Returns a failed check for `field` if m is not SPD.
+bool check_spd(const Mat3& m, const char* field, ParamCheck& out) {
+  if (!m.allFinite()) {
+    out = bad(field, "non-finite value");
+    return false;
+  }
+  if (!is_symmetric_positive_definite(m)) {
+    out = bad(field, "not symmetric positive definite");
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+ParamCheck validate(const GncParams& p) {
+  ParamCheck r;
+  if (!positive_finite(p.dt)) return bad("dt", "GNC period must be positive and finite");
+  if (p.dt > 10.0) return bad("dt", "GNC period above 10 s");
+
+  const MassProperties& m = p.mass_hat;
+  if (!positive_finite(m.m_sc)) return bad("mass_hat.m_sc", "mass must be positive and finite");
+  if (!m.r_scm_so.allFinite()) return bad("mass_hat.r_scm_so", "non-finite value");
+  if (!m.r_so_bcm.allFinite()) return bad("mass_hat.r_so_bcm", "non-finite value");
+  if (!check_spd(m.j_sc, "mass_hat.j_sc", r)) return r;
+  if (!check_spd(m.j_ast, "mass_hat.j_ast", r)) return r;
+  if (!check_spd(total_inertia(m), "mass_hat (J_tot, Eq. 1)", r)) return r;
+
+  if (!positive_finite(p.rcs.u_max)) return bad("rcs.u_max", "must be positive and finite");
+  for (int k = 0; k < kPods; ++k) {
+    if (!p.rcs.pod_position[k].allFinite()) return bad("rcs.pod_position", "non-finite value");
+  }
+  for (int i = 0; i < kChannels; ++i) {
+    const Vec3& d = p.rcs.channel_direction[i];
+    if (!d.allFinite() || std::fabs(d.norm() - 1.0) > 1e-6) {
+      return bad("rcs.channel_direction", "not a unit vector");
+    }
+    if (p.rcs.channel_pod[i] < 0 || p.rcs.channel_pod[i] >= kPods) {
+      return bad("rcs.channel_pod", "pod index out of range");
+    }
+  }
+  if (torque_matrix_rcond(torque_matrix(p.rcs, m.r_so_bcm)) < 1e-9) {
+    return bad("rcs", "B_hat is rank-deficient (cannot produce torque about every axis)");
+  }
+
+  if (static_cast<int>(p.law) >= kLawCount) {
+    return bad("law", "unknown control law");
+  }
+  if (!check_spd(p.ntcl.k, "ntcl.K", r) || !check_spd(p.ntcl.lambda, "ntcl.Lambda", r)) return r;
+  if (!check_spd(p.el.k, "el.K", r) || !check_spd(p.el.lambda, "el.Lambda", r)) return r;
+  if (!check_spd(p.feedforward.k, "feedforward.K", r) ||
+      !check_spd(p.feedforward.lambda, "feedforward.Lambda", r)) {
+    return r;
+  }
+  if (!check_spd(p.integral.k, "integral.K", r) ||
+      !check_spd(p.integral.lambda, "integral.Lambda", r) ||
+      !check_spd(p.integral.k_i, "integral.K_I", r)) {
+    return r;
+  }
+  if (!positive_finite(p.integral.integral_limit_nm)) {
+    return bad("integral.integral_limit", "must be positive and finite");
+  }
+  if (!check_spd(p.adaptive.k, "adaptive.K", r) ||
+      !check_spd(p.adaptive.lambda, "adaptive.Lambda", r)) {
+    return r;
+  }
+  if (!positive_finite(p.adaptive.gamma)) return bad("adaptive.Gamma", "must be positive");
+  if (!positive_finite(p.adaptive.eig_floor_ratio) || p.adaptive.eig_floor_ratio >= 1.0) {
+    return bad("adaptive.eig_floor_ratio", "must be in (0, 1)");
+  }
+  if (!std::isfinite(p.adaptive.eig_ceiling_ratio) || p.adaptive.eig_ceiling_ratio <= 1.0) {
+    return bad("adaptive.eig_ceiling_ratio", "must be greater than 1");
+  }
+  if (!check_spd(p.so3.k, "so3.K", r) || !check_spd(p.so3.lambda, "so3.Lambda", r)) return r;
+  if (!check_spd(p.dpd.k_d, "dpd.K_d", r)) return r;
+  if (!positive_finite(p.dpd.k_p)) return bad("dpd.k_p", "must be positive and finite");
+
+  const GuidanceParams& g = p.guidance;
+  if (!positive_finite(g.omega_switch)) return bad("guidance.omega_switch", "must be positive");
+  if (!positive_finite(g.eps_trans)) return bad("guidance.eps_trans", "must be positive");
+  if (g.omega_switch >= g.eps_trans) {
+    return bad("guidance.omega_switch", "must be below eps_trans");
+  }
+  if (!positive_finite(g.k_qd)) return bad("guidance.k_qd", "must be positive");
+  if (!g.q_final.allFinite() || g.q_final.norm() > 1.0) {
+    return bad("guidance.q_final", "must be a finite MRP with |q| <= 1");
+  }
+  if (!std::isfinite(g.track_reset_period_s) || g.track_reset_period_s < 0.0) {
+    return bad("guidance.track_reset_period", "must be >= 0");
+  }
+
+  const EstimatorParams& e = p.estimator;
+  if (e.kind != EstimatorKind::kPassThrough && e.kind != EstimatorKind::kFilter) {
+    return bad("estimator.kind", "unknown estimator");
+  }
+  if (!positive_finite(e.omega_c)) return bad("estimator.omega_c", "must be positive");
+  if (e.omega_c * p.dt > 3.14159265358979323846) {
+    return bad("estimator.omega_c", "cutoff above the Nyquist rate of the GNC period");
+  }
+  if (e.predict_substeps < 1 || e.predict_substeps > 100) {
+    return bad("estimator.predict_substeps", "must be in [1, 100]");
+  }
+
+  if (!positive_finite(e.gyro_max_rate)) return bad("estimator.gyro_max_rate", "must be positive");
+  if (!positive_finite(e.quat_norm_tolerance) || e.quat_norm_tolerance >= 1.0) {
+    return bad("estimator.quat_norm_tolerance", "must be in (0, 1)");
+  }
+
+  if (static_cast<int>(p.mode.initial) >= kModeCount) {
+    return bad("mode.initial", "unknown mode");
+  }
+  if (p.mode.initial == Mode::kTrack) return bad("mode.initial", "cannot boot into TRACK");
+  if (!positive_finite(p.mode.sensor_timeout_s) || p.mode.sensor_timeout_s < p.dt) {
+    return bad("mode.sensor_timeout", "must be at least one GNC period");
+  }
+  if (!positive_finite(p.isp_s)) return bad("isp", "must be positive");
+  if (!positive_finite(p.g0)) return bad("g0", "must be positive");
+  return r;
+}
+
+}  // namespace rocksteady::gnc

@@ -1,0 +1,20 @@
+// Fixed-size linear-algebra types of the flight core. No dynamic sizes anywhere in gnc/.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace rocksteady::gnc {
+
+using Vec3 = Eigen::Vector3d;
+using Vec4 = Eigen::Vector4d;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Vec8 = Eigen::Matrix<double, 8, 1>;
+using Mat3 = Eigen::Matrix3d;
+using Mat38 = Eigen::Matrix<double, 3, 8>;
+using Mat83 = Eigen::Matrix<double, 8, 3>;
+using Mat36 = Eigen::Matrix<double, 3, 6>;
+
+inline constexpr int kChannels = 8;  // SPEC §4: eight signed thruster channels
+inline constexpr int kPods = 4;      // SPEC §4: four RCS pods
+
+}  // namespace rocksteady::gnc
