@@ -1,0 +1,193 @@
+#include "ground/plant/plant.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+namespace rocksteady::plant {
+
+namespace {
+
+constexpr std::uint64_t kGyroStream = 1;
+constexpr std::uint64_t kStarStream = 2;
+constexpr std::uint64_t kDisturbanceStream = 3;
+
+[[noreturn]] void fail(const std::string& field, const std::string& reason) {
+  throw std::invalid_argument("plant parameter " + field + ": " + reason);
+}
+
+bool spd(const Mat3& m) {
+  if (!m.allFinite()) return false;
+  if ((m - m.transpose()).norm() > 1e-9 * (1.0 + m.norm())) return false;
+  return Eigen::LLT<Mat3>(m).info() == Eigen::Success;
+}
+
+bool positive(double v) { return std::isfinite(v) && v > 0.0; }
+
+}  // namespace
+
+std::uint64_t stream_seed(std::uint64_t run_seed, std::uint64_t stream_id) {
+  // splitmix64 (Steele, Lea, Flood 2014) of the seed mixed with the stream id.
+  std::uint64_t z = run_seed + 0x9E3779B97F4A7C15ULL * (stream_id + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+void validate(const PlantParams& p) {
+  const gnc::MassProperties& m = p.mass;
+  if (!positive(m.m_sc)) fail("mass.m_sc", "must be positive");
+  if (!spd(m.j_sc)) fail("mass.j_sc", "not symmetric positive definite");
+  if (!spd(m.j_ast)) fail("mass.j_ast", "not symmetric positive definite");
+  if (!m.r_scm_so.allFinite() || !m.r_so_bcm.allFinite()) fail("mass", "non-finite offset");
+  if (!spd(gnc::total_inertia(m))) fail("mass (J_tot, Eq. 1)", "not symmetric positive definite");
+  if (!positive(p.rcs.u_max)) fail("rcs.u_max", "must be positive");
+  for (int i = 0; i < gnc::kChannels; ++i) {
+    if (!p.rcs.channel_direction[i].allFinite() ||
+        std::fabs(p.rcs.channel_direction[i].norm() - 1.0) > 1e-6) {
+      fail("rcs.channel_direction", "not a unit vector");
+    }
+    if (p.rcs.channel_pod[i] < 0 || p.rcs.channel_pod[i] >= gnc::kPods) {
+      fail("rcs.channel_pod", "pod index out of range");
+    }
+  }
+  if (!positive(p.isp_s)) fail("isp_s", "must be positive");
+  if (!positive(p.g0)) fail("g0", "must be positive");
+  if (!positive(p.control_period_s)) fail("control_period_s", "must be positive");
+  if (p.substeps < 1 || p.substeps > 10000) fail("substeps", "must be in [1, 10000]");
+  if (!std::isfinite(p.disturbance.sigma_nm) || p.disturbance.sigma_nm < 0.0) {
+    fail("disturbance.sigma_nm", "must be >= 0");
+  }
+  if (!positive(p.disturbance.hold_s)) fail("disturbance.hold_s", "must be positive");
+  if (!p.disturbance.bias_nm.allFinite()) fail("disturbance.bias_nm", "non-finite value");
+  if (!positive(p.sensors.period_s)) fail("sensors.period_s", "must be positive");
+  const double ratio = p.sensors.period_s / p.control_period_s;
+  if (ratio < 0.999999 || std::fabs(ratio - std::round(ratio)) > 1e-6) {
+    fail("sensors.period_s", "must be an integer multiple of the control period");
+  }
+  if (!std::isfinite(p.sensors.gyro_psd) || p.sensors.gyro_psd < 0.0) {
+    fail("sensors.gyro_psd", "noise power must be >= 0");
+  }
+  if (!std::isfinite(p.sensors.star_psd) || p.sensors.star_psd < 0.0) {
+    fail("sensors.star_psd", "noise power must be >= 0");
+  }
+  if (!p.beta0.allFinite() || std::fabs(p.beta0.norm() - 1.0) > 1e-6) {
+    fail("beta0", "not a unit quaternion");
+  }
+  if (!p.omega0.allFinite()) fail("omega0", "non-finite value");
+}
+
+Plant::Plant(const PlantParams& p) : p_(p) {
+  validate(p_);
+  j_ = gnc::total_inertia(p_.mass);                   // Eq. (1), true values
+  j_inv_ = j_.inverse();
+  b_ = gnc::torque_matrix(p_.rcs, p_.mass.r_so_bcm);  // SPEC §4, true r_SO/BCM
+  sensor_every_ = static_cast<std::uint64_t>(std::llround(p_.sensors.period_s / p_.control_period_s));
+  reset();
+}
+
+void Plant::reset() {
+  ticks_ = 0;
+  beta_ = p_.beta0.normalized();
+  omega_ = p_.omega0;
+  fuel_kg_ = 0.0;
+  applied_.setZero();
+  clipped_ = false;
+  clipped_periods_ = 0;
+  disturbance_.setZero();
+  disturbance_index_ = -1;
+  have_sample_ = false;
+  sample_tick_ = 0;
+  held_ = gnc::SensorSample{};
+  gyro_rng_.seed(stream_seed(p_.seed, kGyroStream));
+  star_rng_.seed(stream_seed(p_.seed, kStarStream));
+  dist_rng_.seed(stream_seed(p_.seed, kDisturbanceStream));
+  gyro_normal_.reset();
+  star_normal_.reset();
+  dist_normal_.reset();
+}
+
+void Plant::set_state(const Vec4& beta, const Vec3& omega) {
+  beta_ = beta.normalized();
+  omega_ = omega;
+}
+
+void Plant::derivative(const Vec4& beta, const Vec3& omega, const Vec3& torque, Vec4& beta_dot,
+                       Vec3& omega_dot) const {
+  beta_dot = att::quat_rate(beta, omega);                  // Eq. (3)
+  omega_dot = j_inv_ * ((j_ * omega).cross(omega) + torque);  // Eq. (2)
+}
+
+void Plant::advance(const Vec8& force, bool enabled) {
+  // Per-channel saturation at the true u_max; zero-order hold over the period.
+  clipped_ = false;
+  for (int i = 0; i < gnc::kChannels; ++i) {
+    double f = enabled && std::isfinite(force(i)) ? force(i) : 0.0;
+    if (f > p_.rcs.u_max) {
+      f = p_.rcs.u_max;
+      clipped_ = true;
+    } else if (f < -p_.rcs.u_max) {
+      f = -p_.rcs.u_max;
+      clipped_ = true;
+    }
+    applied_(i) = f;
+  }
+  if (clipped_) ++clipped_periods_;
+
+  // Disturbance: a new draw at the start of each hold interval (SPEC §5).
+  const double t0 = t();
+  const auto index = static_cast<std::int64_t>(std::floor(t0 / p_.disturbance.hold_s + 1e-9));
+  while (disturbance_index_ < index) {
+    for (int a = 0; a < 3; ++a) disturbance_(a) = p_.disturbance.sigma_nm * dist_normal_(dist_rng_);
+    ++disturbance_index_;
+  }
+
+  const Vec3 torque = b_ * applied_ + disturbance_ + p_.disturbance.bias_nm;  // Eq. (2): B u + d
+  const double h = p_.control_period_s / p_.substeps;
+  for (int s = 0; s < p_.substeps; ++s) {
+    Vec4 k1b, k2b, k3b, k4b;
+    Vec3 k1w, k2w, k3w, k4w;
+    derivative(beta_, omega_, torque, k1b, k1w);
+    derivative(beta_ + 0.5 * h * k1b, omega_ + 0.5 * h * k1w, torque, k2b, k2w);
+    derivative(beta_ + 0.5 * h * k2b, omega_ + 0.5 * h * k2w, torque, k3b, k3w);
+    derivative(beta_ + h * k3b, omega_ + h * k3w, torque, k4b, k4w);
+    beta_ += (h / 6.0) * (k1b + 2.0 * k2b + 2.0 * k3b + k4b);
+    omega_ += (h / 6.0) * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+    beta_.normalize();
+  }
+  // Eq. (54): exact for forces held over the period.
+  fuel_kg_ += applied_.lpNorm<1>() / (p_.isp_s * p_.g0) * p_.control_period_s;
+  ++ticks_;
+}
+
+gnc::SensorSample Plant::sample() {
+  if (have_sample_ && ticks_ - sample_tick_ < sensor_every_) return held_;
+  have_sample_ = true;
+  sample_tick_ = ticks_;
+  const double ts = p_.sensors.period_s;
+  const double sigma_w = std::sqrt(p_.sensors.gyro_psd / ts);  // band-limited white noise
+  const double sigma_q = std::sqrt(p_.sensors.star_psd / ts);
+
+  gnc::SensorSample s;
+  s.t = t();
+  s.gyro_rate = omega_;
+  if (sigma_w > 0.0) {
+    for (int a = 0; a < 3; ++a) s.gyro_rate(a) += sigma_w * gyro_normal_(gyro_rng_);
+  }
+  s.gyro_valid = true;
+  Vec3 q = mrp();
+  if (sigma_q > 0.0) {
+    for (int a = 0; a < 3; ++a) q(a) += sigma_q * star_normal_(star_rng_);
+    s.star_quat = att::mrp_to_quat(q);
+  } else {
+    s.star_quat = beta_(3) < 0.0 ? Vec4(-beta_) : beta_;
+  }
+  s.star_valid = true;
+  held_ = s;
+  return s;
+}
+
+}  // namespace rocksteady::plant

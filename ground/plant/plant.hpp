@@ -1,0 +1,128 @@
+// The plant: Rocksteady's truth model of the spacecraft + captured asteroid (ground equipment).
+//
+// - rigid-body attitude dynamics, SPEC Eq. (2), with the TRUE mass properties (Eq. 1) and the TRUE
+//   torque matrix B (SPEC §4, built from the true r_SO/BCM); state: quaternion (Eq. 3) + body rate;
+//   fixed-step RK4 with `substeps` steps per control period;
+// - thruster channel forces held constant over each control period (zero-order hold), clipped per
+//   channel at the true u_max; fuel integrated per Eq. (54);
+// - external disturbance (SPEC §5): body-frame zero-mean Gaussian, per-axis sigma, a new draw every
+//   `hold_s`, plus an optional constant bias;
+// - sensors (SPEC §5, Table 3): gyro with per-axis noise sigma = sqrt(P(dw)/T_s), star tracker with
+//   per-axis MRP noise sigma = sqrt(P(dq)/T_s) added to the true (shadow-normalised) MRP and delivered
+//   as a unit quaternion; a new sample every sensor period T_s, held in between;
+// - every random stream (gyro, star tracker, disturbance) seeded from the run's seed: a run is
+//   bit-for-bit repeatable.
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include "gnc/gnc.hpp"
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
+#include "ground/plant/attitude.hpp"
+
+namespace rocksteady::plant {
+
+using Vec8 = Eigen::Matrix<double, 8, 1>;
+using Mat38 = Eigen::Matrix<double, 3, 8>;
+
+struct DisturbanceParams {
+  double sigma_nm{0.57735026918962576};  // per axis, N m (1/sqrt(3): |d| ~ 1 N m)
+  double hold_s{10.0};                   // a new draw every hold_s
+  Vec3 bias_nm{Vec3::Zero()};            // constant body-frame bias torque, N m
+};
+
+struct SensorParams {
+  double period_s{0.1};    // T_s; an integer multiple of the control period
+  double gyro_psd{0.0};    // P(dw), rad^2/s^2 (per axis)
+  double star_psd{0.0};    // P(dq), MRP^2 (per axis)
+};
+
+struct PlantParams {
+  gnc::MassProperties mass{gnc::study_true_mass_properties()};  // true mass properties
+  gnc::RcsLayout rcs{gnc::study_rcs_layout(200.0)};              // true geometry and u_max
+  double isp_s{287.0};  // Eq. (54)
+  double g0{9.8};
+  double control_period_s{0.1};  // forces are held for one period
+  int substeps{1};               // RK4 steps per control period
+  DisturbanceParams disturbance{};
+  SensorParams sensors{};
+  Vec4 beta0{0.0, 0.0, 0.0, 1.0};  // initial attitude, unit quaternion of F_B in F_I
+  Vec3 omega0{Vec3::Zero()};        // initial body rate, rad/s
+  std::uint64_t seed{1};
+};
+
+// Throws std::invalid_argument naming the first bad field.
+void validate(const PlantParams& p);
+
+class Plant {
+ public:
+  explicit Plant(const PlantParams& p);  // validates, then reset()
+  void reset();                          // initial state, time 0, streams re-seeded
+  const PlantParams& params() const { return p_; }
+
+  // One control period: clip each channel at u_max (zeros when !enabled), hold the forces
+  // (and the disturbance) for the period, RK4 with `substeps` steps, integrate fuel (Eq. 54).
+  void advance(const Vec8& force, bool enabled);
+
+  // The sensor sample the flight software receives now: a fresh one at each sensor period, the
+  // held one in between. Its `t` is the time the sample was taken.
+  gnc::SensorSample sample();
+
+  // Truth.
+  double t() const { return static_cast<double>(ticks_) * p_.control_period_s; }
+  std::uint64_t ticks() const { return ticks_; }
+  const Vec4& beta() const { return beta_; }
+  const Vec3& omega() const { return omega_; }
+  Vec3 mrp() const { return att::quat_to_mrp(beta_); }  // shadow-normalised, |q| <= 1
+  double fuel_kg() const { return fuel_kg_; }
+  const Vec8& applied_force() const { return applied_; }   // after clipping, last period
+  bool clipped() const { return clipped_; }                  // a channel was clipped last period
+  std::uint64_t clipped_periods() const { return clipped_periods_; }
+  const Vec3& disturbance() const { return disturbance_; }  // random part held last period
+  const Mat3& inertia() const { return j_; }
+  const Mat38& torque_matrix() const { return b_; }
+  Vec3 angular_momentum_inertial() const { return att::quat_to_matrix(beta_) * (j_ * omega_); }
+  double kinetic_energy() const { return 0.5 * omega_.dot(j_ * omega_); }
+
+  // Test hook: overwrite the state (beta is normalised).
+  void set_state(const Vec4& beta, const Vec3& omega);
+
+ private:
+  void derivative(const Vec4& beta, const Vec3& omega, const Vec3& torque, Vec4& beta_dot,
+                  Vec3& omega_dot) const;
+
+  PlantParams p_;
+  Mat3 j_{Mat3::Identity()};
+  Mat3 j_inv_{Mat3::Identity()};
+  Mat38 b_{Mat38::Zero()};
+  std::uint64_t sensor_every_{1};  // control periods per sensor period
+
+  std::uint64_t ticks_{0};
+  Vec4 beta_{0.0, 0.0, 0.0, 1.0};
+  Vec3 omega_{Vec3::Zero()};
+  double fuel_kg_{0.0};
+  Vec8 applied_{Vec8::Zero()};
+  bool clipped_{false};
+  std::uint64_t clipped_periods_{0};
+
+  Vec3 disturbance_{Vec3::Zero()};
+  std::int64_t disturbance_index_{-1};  // which hold interval the current draw belongs to
+
+  bool have_sample_{false};
+  std::uint64_t sample_tick_{0};
+  gnc::SensorSample held_{};
+
+  std::mt19937_64 gyro_rng_;
+  std::mt19937_64 star_rng_;
+  std::mt19937_64 dist_rng_;
+  std::normal_distribution<double> gyro_normal_{0.0, 1.0};
+  std::normal_distribution<double> star_normal_{0.0, 1.0};
+  std::normal_distribution<double> dist_normal_{0.0, 1.0};
+};
+
+// A 64-bit seed for one named random stream of a run (splitmix64 of the run seed and stream id).
+std::uint64_t stream_seed(std::uint64_t run_seed, std::uint64_t stream_id);
+
+}  // namespace rocksteady::plant

@@ -1,0 +1,308 @@
+// The plant's truth dynamics, actuators and sensors against independent closed forms and statistics.
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "ground/plant/plant.hpp"
+
+namespace rocksteady::plant {
+namespace {
+
+PlantParams quiet_params() {
+  PlantParams p;
+  p.disturbance.sigma_nm = 0.0;
+  p.omega0 = Vec3(0.01, 0.02, 0.03);  // SPEC §5 initial rate
+  p.beta0 = att::mrp_to_quat(Vec3(0.05, 0.04, 0.03));
+  return p;
+}
+
+TEST(PlantTruth, TorqueFreeConservesInertialMomentumAndEnergy) {
+  PlantParams p = quiet_params();
+  Plant plant(p);
+  const Vec3 h0 = plant.angular_momentum_inertial();
+  const double e0 = plant.kinetic_energy();
+  const Vec8 zero = Vec8::Zero();
+  double worst_h = 0.0, worst_e = 0.0;
+  while (plant.t() < 1e4 - 1e-9) {  // 10^4 s
+    plant.advance(zero, true);
+    worst_h = std::max(worst_h, (plant.angular_momentum_inertial() - h0).norm() / h0.norm());
+    worst_e = std::max(worst_e, std::fabs(plant.kinetic_energy() - e0) / e0);
+  }
+  EXPECT_LE(worst_h, 1e-9);
+  EXPECT_LE(worst_e, 1e-9);
+  // It really tumbled: the body rate changed direction.
+  EXPECT_GT((plant.omega() - p.omega0).norm(), 1e-3);
+}
+
+TEST(PlantTruth, AxisymmetricBodyMatchesClosedFormPrecession) {
+  PlantParams p = quiet_params();
+  // Axisymmetric about z: every inertia term and the offset r are symmetric about z.
+  p.mass.j_sc = Vec3(5e4, 5e4, 2e4).asDiagonal();
+  p.mass.j_ast = Vec3(2e7, 2e7, 3.5e7).asDiagonal();
+  p.mass.r_so_bcm = Vec3(0.0, 0.0, 3.5);
+  p.omega0 = Vec3(0.02, -0.01, 0.05);
+  p.beta0 = att::matrix_to_quat(att::rotation_exp(Vec3(0.3, -0.6, 0.2)));
+  p.substeps = 2;
+  Plant plant(p);
+  const Mat3 j = plant.inertia();
+  ASSERT_NEAR(j(0, 0), j(1, 1), 1e-6);
+  ASSERT_NEAR(j(0, 1), 0.0, 1e-9);
+  const double i1 = j(0, 0), i3 = j(2, 2);
+  const Vec3 w0 = p.omega0;
+  const double lambda = (i3 - i1) / i1 * w0.z();  // body-frame precession rate
+  const Mat3 r0 = att::quat_to_matrix(p.beta0);
+  const Vec3 h_inertial = r0 * (j * w0);
+  const Vec3 n = h_inertial.normalized();
+  const double a = h_inertial.norm() / i1;  // inertial precession rate about H
+
+  const double t_end = 2000.0;
+  const Vec8 zero = Vec8::Zero();
+  while (plant.t() < t_end - 1e-9) plant.advance(zero, true);
+  const double t = plant.t();
+  // Euler's equations: (w1 + i w2)(t) = (w1 + i w2)(0) e^{i lambda t}, w3 constant.
+  const Vec3 w_expected(w0.x() * std::cos(lambda * t) - w0.y() * std::sin(lambda * t),
+                        w0.x() * std::sin(lambda * t) + w0.y() * std::cos(lambda * t), w0.z());
+  EXPECT_LT((plant.omega() - w_expected).norm(), 1e-10);
+  // Attitude: R(t) = exp(S(n) a t) R0 exp(-S(e3) lambda t).
+  const Mat3 r_expected = att::rotation_exp(n * a * t) * r0 * att::rotation_exp(Vec3(0, 0, -lambda * t));
+  EXPECT_LT((att::quat_to_matrix(plant.beta()) - r_expected).norm(), 1e-9);
+}
+
+// Error after `periods` periods of `dt` with n substeps, against a much finer solution.
+double rk4_error(int substeps, const Plant& reference) {
+  PlantParams p = reference.params();
+  p.substeps = substeps;
+  Plant plant(p);
+  const Vec8 u = (Vec8() << 150, -80, 40, 0, -120, 60, 0, 90).finished();
+  for (int k = 0; k < 10; ++k) plant.advance(u, true);
+  return (plant.omega() - reference.omega()).norm() + (plant.beta() - reference.beta()).norm();
+}
+
+TEST(PlantTruth, Rk4ConvergesAtFourthOrder) {
+  PlantParams p = quiet_params();
+  p.omega0 = Vec3(0.2, 0.1, -0.3);  // fast enough that the step error dominates roundoff
+  p.control_period_s = 2.0;
+  p.sensors.period_s = 2.0;
+  p.substeps = 512;
+  Plant reference(p);
+  const Vec8 u = (Vec8() << 150, -80, 40, 0, -120, 60, 0, 90).finished();
+  for (int k = 0; k < 10; ++k) reference.advance(u, true);
+  const double e1 = rk4_error(2, reference);
+  const double e2 = rk4_error(4, reference);
+  const double e3 = rk4_error(8, reference);
+  ASSERT_GT(e3, 1e-12);  // well above roundoff
+  EXPECT_NEAR(std::log2(e1 / e2), 4.0, 0.3);
+  EXPECT_NEAR(std::log2(e2 / e3), 4.0, 0.3);
+}
+
+TEST(PlantTruth, ConstantForcesFromRestGiveJInverseBuTimesT) {
+  PlantParams p = quiet_params();
+  p.omega0.setZero();
+  Plant plant(p);
+  const Vec8 u = (Vec8() << 100, 0, -50, 20, 0, 0, 180, -10).finished();
+  plant.advance(u, true);
+  const Vec3 expected = plant.inertia().inverse() * (plant.torque_matrix() * u) * 0.1;
+  // The gyroscopic term is O(w^2): relative effect ~ |w| t ~ 1e-6 here.
+  EXPECT_LT((plant.omega() - expected).norm(), 1e-5 * expected.norm());
+  // B is built from the true r_SO/BCM, SPEC §4.
+  EXPECT_LT((plant.torque_matrix() - gnc::torque_matrix(p.rcs, p.mass.r_so_bcm)).norm(), 1e-12);
+}
+
+TEST(PlantActuators, ClipsEachChannelAtUmaxAndIntegratesFuel) {
+  PlantParams p = quiet_params();
+  p.rcs.u_max = 200.0;
+  Plant plant(p);
+  const Vec8 u = (Vec8() << 1000, -1000, 50, -20, 199, -250, 0, 10).finished();
+  plant.advance(u, true);
+  const Vec8 expected = (Vec8() << 200, -200, 50, -20, 199, -200, 0, 10).finished();
+  EXPECT_EQ(plant.applied_force(), expected);
+  EXPECT_TRUE(plant.clipped());
+  // Eq. (54): sum |u| dt / (Isp g0).
+  const double fuel = expected.cwiseAbs().sum() * 0.1 / (287.0 * 9.8);
+  EXPECT_NEAR(plant.fuel_kg(), fuel, 1e-15);
+  plant.advance(u, false);  // inhibited: no force, no fuel
+  EXPECT_EQ(plant.applied_force(), Vec8::Zero());
+  EXPECT_NEAR(plant.fuel_kg(), fuel, 1e-15);
+  EXPECT_EQ(plant.clipped_periods(), 1u);
+}
+
+TEST(PlantDisturbance, HeldPerIntervalWithSigmaPerAxis) {
+  PlantParams p = quiet_params();
+  p.disturbance.sigma_nm = 1.0 / std::sqrt(3.0);
+  p.disturbance.hold_s = 10.0;
+  p.control_period_s = 2.0;
+  p.sensors.period_s = 2.0;
+  Plant plant(p);
+  std::vector<Vec3> draws;
+  Vec3 previous = Vec3::Zero();
+  const int n_draws = 6000;
+  for (int k = 0; k < 5 * n_draws; ++k) {
+    plant.advance(Vec8::Zero(), false);
+    if (k % 5 == 0) {
+      draws.push_back(plant.disturbance());
+      EXPECT_NE(plant.disturbance(), previous);
+    } else {
+      EXPECT_EQ(plant.disturbance(), previous);  // held for 10 s
+    }
+    previous = plant.disturbance();
+  }
+  for (int a = 0; a < 3; ++a) {
+    double s = 0, s2 = 0;
+    for (const Vec3& d : draws) {
+      s += d(a);
+      s2 += d(a) * d(a);
+    }
+    const double mean = s / n_draws;
+    const double sd = std::sqrt(s2 / n_draws - mean * mean);
+    EXPECT_NEAR(mean, 0.0, 5.0 * p.disturbance.sigma_nm / std::sqrt(n_draws));
+    EXPECT_NEAR(sd / p.disturbance.sigma_nm, 1.0, 5.0 / std::sqrt(2.0 * n_draws));
+  }
+}
+
+struct NoiseStats {
+  Vec3 mean_w, sd_w, mean_q, sd_q;
+  int n;
+};
+
+NoiseStats measure_noise(const PlantParams& p, int n) {
+  Plant plant(p);
+  Vec3 sw = Vec3::Zero(), sw2 = Vec3::Zero(), sq = Vec3::Zero(), sq2 = Vec3::Zero();
+  const auto every = static_cast<int>(std::llround(p.sensors.period_s / p.control_period_s));
+  for (int k = 0; k < n; ++k) {
+    const gnc::SensorSample s = plant.sample();
+    const Vec3 ew = s.gyro_rate - plant.omega();
+    Vec3 eq = att::quat_to_mrp(s.star_quat) - plant.mrp();
+    sw += ew;
+    sw2 += ew.cwiseProduct(ew);
+    sq += eq;
+    sq2 += eq.cwiseProduct(eq);
+    for (int i = 0; i < every; ++i) plant.advance(Vec8::Zero(), false);
+  }
+  NoiseStats st;
+  st.n = n;
+  st.mean_w = sw / n;
+  st.mean_q = sq / n;
+  st.sd_w = (sw2 / n - st.mean_w.cwiseProduct(st.mean_w)).cwiseSqrt();
+  st.sd_q = (sq2 / n - st.mean_q.cwiseProduct(st.mean_q)).cwiseSqrt();
+  return st;
+}
+
+TEST(PlantSensors, NoiseStandardDeviationIsSqrtPowerOverPeriod) {
+  for (double ts : {0.1, 0.5}) {
+    PlantParams p = quiet_params();
+    p.omega0.setZero();  // at rest: the true MRP stays far from the shadow-set switch
+    p.sensors.period_s = ts;
+    p.sensors.gyro_psd = 1e-10;  // case 6/7 values
+    p.sensors.star_psd = 1e-6;
+    p.seed = 77;
+    const int n = 20000;
+    const NoiseStats st = measure_noise(p, n);
+    const double sigma_w = std::sqrt(p.sensors.gyro_psd / ts);
+    const double sigma_q = std::sqrt(p.sensors.star_psd / ts);
+    const double tol = 5.0 / std::sqrt(2.0 * n);  // 5 sigma of the sample s.d.
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(st.sd_w(a) / sigma_w, 1.0, tol) << "ts " << ts << " axis " << a;
+      EXPECT_NEAR(st.sd_q(a) / sigma_q, 1.0, tol) << "ts " << ts << " axis " << a;
+      EXPECT_NEAR(st.mean_w(a), 0.0, 5.0 * sigma_w / std::sqrt(n));
+      EXPECT_NEAR(st.mean_q(a), 0.0, 5.0 * sigma_q / std::sqrt(n));
+    }
+  }
+}
+
+TEST(PlantSensors, PerfectSensorsDeliverTheTruth) {
+  PlantParams p = quiet_params();
+  Plant plant(p);
+  const gnc::SensorSample s = plant.sample();
+  EXPECT_TRUE(s.gyro_valid);
+  EXPECT_TRUE(s.star_valid);
+  EXPECT_EQ(s.gyro_rate, p.omega0);
+  EXPECT_NEAR(std::fabs(s.star_quat.dot(p.beta0)), 1.0, 1e-15);
+  EXPECT_NEAR(s.star_quat.norm(), 1.0, 1e-15);
+}
+
+TEST(PlantSensors, SampleIsHeldBetweenSensorPeriods) {
+  PlantParams p = quiet_params();
+  p.sensors.period_s = 0.3;  // three control periods
+  p.sensors.gyro_psd = 1e-10;
+  Plant plant(p);
+  const gnc::SensorSample s0 = plant.sample();
+  plant.advance(Vec8::Zero(), false);
+  const gnc::SensorSample s1 = plant.sample();
+  EXPECT_EQ(s1.t, s0.t);
+  EXPECT_EQ(s1.gyro_rate, s0.gyro_rate);
+  plant.advance(Vec8::Zero(), false);
+  plant.advance(Vec8::Zero(), false);
+  const gnc::SensorSample s3 = plant.sample();
+  EXPECT_NEAR(s3.t, 0.3, 1e-12);
+  EXPECT_NE(s3.gyro_rate, s0.gyro_rate);
+}
+
+// A noisy, disturbed, actuated run; returns every sample and state as raw doubles.
+std::vector<double> noisy_run(std::uint64_t seed) {
+  PlantParams p = quiet_params();
+  p.disturbance.sigma_nm = 1.0 / std::sqrt(3.0);
+  p.disturbance.bias_nm = Vec3(0.1, -0.2, 0.05);
+  p.sensors.gyro_psd = 1e-10;
+  p.sensors.star_psd = 1e-6;
+  p.seed = seed;
+  Plant plant(p);
+  std::vector<double> out;
+  for (int k = 0; k < 2000; ++k) {
+    const gnc::SensorSample s = plant.sample();
+    out.insert(out.end(), s.gyro_rate.data(), s.gyro_rate.data() + 3);
+    out.insert(out.end(), s.star_quat.data(), s.star_quat.data() + 4);
+    Vec8 u = Vec8::Zero();
+    u(k % 8) = -1e4 * s.gyro_rate(k % 3);
+    plant.advance(u, true);
+    out.insert(out.end(), plant.beta().data(), plant.beta().data() + 4);
+    out.insert(out.end(), plant.omega().data(), plant.omega().data() + 3);
+    out.push_back(plant.fuel_kg());
+  }
+  return out;
+}
+
+TEST(PlantSensors, SameSeedSameBitsOtherSeedOtherBits) {
+  const std::vector<double> a = noisy_run(2024);
+  const std::vector<double> b = noisy_run(2024);
+  const std::vector<double> c = noisy_run(2025);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+  EXPECT_NE(std::memcmp(a.data(), c.data(), a.size() * sizeof(double)), 0);
+  // reset() replays the same streams.
+  PlantParams p = quiet_params();
+  p.sensors.gyro_psd = 1e-10;
+  Plant plant(p);
+  const Vec3 first = plant.sample().gyro_rate;
+  plant.advance(Vec8::Zero(), false);
+  plant.reset();
+  EXPECT_EQ(plant.sample().gyro_rate, first);
+}
+
+TEST(PlantParams, RejectsBadValuesNamingTheField) {
+  auto rejects = [](PlantParams p, const char* field) {
+    try {
+      Plant plant(p);
+      ADD_FAILURE() << "accepted bad " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  PlantParams p = quiet_params();
+  p.sensors.gyro_psd = -1e-10;
+  rejects(p, "sensors.gyro_psd");
+  p = quiet_params();
+  p.mass.j_ast(0, 0) = -1e7;
+  rejects(p, "mass.j_ast");
+  p = quiet_params();
+  p.sensors.period_s = 0.15;
+  rejects(p, "sensors.period_s");
+  p = quiet_params();
+  p.substeps = 0;
+  rejects(p, "substeps");
+}
+
+}  // namespace
+}  // namespace rocksteady::plant
