@@ -1,0 +1,103 @@
+#include "hal/lcm/convert.hpp"
+
+#include "hal/lcm/codec.hpp"
+
+namespace rocksteady::hal::wire {
+
+namespace {
+
+template <int N, class Vec> void put(const Vec& v, double (&a)[N]) {
+  for (int i = 0; i < N; ++i) a[i] = v(i);
+}
+template <int N, class Vec> void get(const double (&a)[N], Vec& v) {
+  for (int i = 0; i < N; ++i) v(i) = a[i];
+}
+
+}  // namespace
+
+RawSensors to_raw(const rocksteady::sensor_frame_t& m) {
+  RawSensors s{};
+  s.seq = m.seq;
+  s.t = m.t;
+  s.gyro.t = m.gyro_t;
+  get(m.gyro_rate, s.gyro.rate);
+  s.gyro.valid = m.gyro_valid != 0;
+  s.star.t = m.star_t;
+  get(m.star_quat, s.star.quat);
+  s.star.valid = m.star_valid != 0;
+  return s;
+}
+
+rocksteady::sensor_frame_t to_message(const RawSensors& s) {
+  auto m = make<rocksteady::sensor_frame_t>();
+  m.seq = s.seq;
+  m.t = s.t;
+  m.gyro_t = s.gyro.t;
+  put(s.gyro.rate, m.gyro_rate);
+  m.gyro_valid = s.gyro.valid ? 1 : 0;
+  m.star_t = s.star.t;
+  put(s.star.quat, m.star_quat);
+  m.star_valid = s.star.valid ? 1 : 0;
+  return m;
+}
+
+rocksteady::thruster_cmd_t to_message(const ThrusterOutputs& outputs, const gnc::Vec8& channel_force,
+                                      std::int64_t seq, double t) {
+  auto m = make<rocksteady::thruster_cmd_t>();
+  m.seq = seq;
+  m.t = t;
+  m.enabled = outputs.enabled ? 1 : 0;
+  put(channel_force, m.channel_force);
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    m.thruster_on[i] = outputs.on[k] ? 1 : 0;
+    m.thruster_force[i] = outputs.on[k] ? outputs.force[k] : 0.0;
+  }
+  return m;
+}
+
+ThrusterOutputs to_outputs(const rocksteady::thruster_cmd_t& m) {
+  ThrusterOutputs o{};
+  o.enabled = m.enabled != 0;
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    o.on[k] = o.enabled && m.thruster_on[i] != 0;
+    o.force[k] = o.on[k] ? m.thruster_force[i] : 0.0;
+  }
+  return o;
+}
+
+gnc::Vec8 channel_forces(const rocksteady::thruster_cmd_t& m) {
+  gnc::Vec8 u;
+  get(m.channel_force, u);
+  return u;
+}
+
+void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
+  const gnc::GncTelemetry& g = out.telemetry;
+  m.kind = rocksteady::gnc_telemetry_t::KIND;
+  m.version = rocksteady::gnc_telemetry_t::VERSION;
+  m.t = g.t;
+  m.tick = g.tick;
+  m.mode = static_cast<std::int8_t>(g.mode);
+  m.law = static_cast<std::int8_t>(g.law);
+  m.phase = static_cast<std::int8_t>(g.phase);
+  m.trajectory_loaded = g.trajectory_loaded ? 1 : 0;
+  put(g.omega_hat, m.omega_hat);
+  put(g.q_hat, m.q_hat);
+  put(g.q_d, m.q_d);
+  put(g.omega_r, m.omega_r);
+  put(g.attitude_error, m.attitude_error);
+  put(g.a_hat, m.a_hat);
+  put(g.integral, m.integral);
+  put(g.alloc.torque_requested, m.torque_requested);
+  put(g.alloc.torque_achieved, m.torque_achieved);
+  m.saturated = g.alloc.saturated ? 1 : 0;
+  m.alloc_scale = g.alloc.scale;
+  m.thrusters_enabled = out.command.enabled ? 1 : 0;
+  put(out.command.force, m.channel_force);
+  m.fuel_kg = g.fuel_kg;
+  m.sensor_rejects = g.sensor_rejects;
+}
+
+}  // namespace rocksteady::hal::wire

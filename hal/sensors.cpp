@@ -1,0 +1,110 @@
+#include "hal/sensors.hpp"
+
+#include <cmath>
+
+#include "gnc/math/rotation.hpp"
+
+namespace rocksteady::hal {
+
+namespace {
+
+bool is_rotation(const gnc::Mat3& r) {
+  if (!r.allFinite()) return false;
+  const double orth = (r.transpose() * r - gnc::Mat3::Identity()).cwiseAbs().maxCoeff();
+  return orth <= 1e-9 && std::fabs(r.determinant() - 1.0) <= 1e-9;
+}
+
+// Common timestamp / validity rules; updates the "last usable" time on success.
+ReadingStatus check_reading(bool configured, bool device_valid, bool finite, double t, double t_tick,
+                            double max_age, bool& have_last, double& last_t) {
+  if (!configured) return ReadingStatus::kNotConfigured;
+  if (!device_valid) return ReadingStatus::kDeviceInvalid;
+  if (!finite || !std::isfinite(t) || !std::isfinite(t_tick)) return ReadingStatus::kNonFinite;
+  const double age = t_tick - t;
+  if (age > max_age || age < -max_age) return ReadingStatus::kStale;
+  if (have_last && t <= last_t) return ReadingStatus::kNotAdvancing;
+  have_last = true;
+  last_t = t;
+  return ReadingStatus::kOk;
+}
+
+}  // namespace
+
+const char* to_string(SensorConfigError e) {
+  switch (e) {
+    case SensorConfigError::kOk: return "ok";
+    case SensorConfigError::kNotARotation: return "body_from_sensor is not a rotation matrix";
+    case SensorConfigError::kBadMaxAge: return "max_age_s must be finite and positive";
+  }
+  return "unknown";
+}
+
+SensorConfigError validate(const SensorConfig& config) {
+  if (!is_rotation(config.body_from_sensor)) return SensorConfigError::kNotARotation;
+  if (!std::isfinite(config.max_age_s) || config.max_age_s <= 0.0) {
+    return SensorConfigError::kBadMaxAge;
+  }
+  return SensorConfigError::kOk;
+}
+
+SensorConfigError Gyro::configure(const SensorConfig& config) {
+  const SensorConfigError e = validate(config);
+  if (e == SensorConfigError::kOk) {
+    config_ = config;
+    configured_ = true;
+    have_last_ = false;
+  }
+  return e;
+}
+
+BodyRate Gyro::read(const GyroReading& r, double t_tick) {
+  BodyRate out{};
+  out.t = r.t;
+  out.status = check_reading(configured_, r.valid, r.rate.allFinite(), r.t, t_tick,
+                             config_.max_age_s, have_last_, last_t_);
+  out.valid = out.status == ReadingStatus::kOk;
+  if (out.valid) {
+    out.rate = config_.body_from_sensor * r.rate;
+  } else {
+    ++rejects_;
+  }
+  return out;
+}
+
+SensorConfigError StarTracker::configure(const SensorConfig& config) {
+  const SensorConfigError e = validate(config);
+  if (e == SensorConfigError::kOk) {
+    config_ = config;
+    // quat::from_dcm(C_BS) is beta_BS; its conjugate is beta_SB.
+    beta_sb_ = gnc::quat::conjugate(gnc::quat::from_dcm(config.body_from_sensor));
+    configured_ = true;
+    have_last_ = false;
+  }
+  return e;
+}
+
+BodyAttitude StarTracker::read(const StarTrackerReading& r, double t_tick) {
+  BodyAttitude out{};
+  out.t = r.t;
+  out.status = check_reading(configured_, r.valid, r.quat.allFinite(), r.t, t_tick,
+                             config_.max_age_s, have_last_, last_t_);
+  out.valid = out.status == ReadingStatus::kOk;
+  if (out.valid) {
+    out.quat = gnc::quat::multiply(r.quat, beta_sb_);
+  } else {
+    ++rejects_;
+  }
+  return out;
+}
+
+gnc::SensorSample make_sample(double t_tick, const BodyRate& gyro, const BodyAttitude& star) {
+  gnc::SensorSample s{};
+  s.t = t_tick;
+  s.gyro_valid = gyro.valid;
+  if (gyro.valid) s.gyro_rate = gyro.rate;
+  s.star_valid = star.valid;
+  if (star.valid) s.star_quat = star.quat;
+  return s;
+}
+
+}  // namespace rocksteady::hal
