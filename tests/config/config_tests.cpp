@@ -1,0 +1,216 @@
+// Configuration files: the shipped ones load into the SPEC's values; each class of bad file gives a
+// ConfigError naming the file, the key and the reason.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "ground/config/config.hpp"
+
+namespace rocksteady::config {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kConfigs = std::string(ROCKSTEADY_SOURCE_DIR) + "/configs";
+const std::string kMission = kConfigs + "/mission.yaml";
+const std::string kGnc = kConfigs + "/gnc.yaml";
+std::string case_file(int n) { return kConfigs + "/cases/case" + std::to_string(n) + ".yaml"; }
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A temporary copy of a shipped file with one edit applied.
+class TempFile {
+ public:
+  TempFile(const std::string& name, const std::string& text) {
+    dir_ = fs::temp_directory_path() /
+           ("rocksteady_config_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+            "_" + std::to_string(counter_++));
+    fs::create_directories(dir_);
+    path_ = (dir_ / name).string();
+    std::ofstream(path_) << text;
+  }
+  ~TempFile() { fs::remove_all(dir_); }
+  const std::string& path() const { return path_; }
+
+ private:
+  static inline int counter_ = 0;
+  fs::path dir_;
+  std::string path_;
+};
+
+std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test setup: '" << from << "' not in the shipped file";
+  std::string out = text;
+  if (at != std::string::npos) out.replace(at, from.size(), to);
+  return out;
+}
+
+// Runs `load` and checks the error names file, key and reason.
+template <typename F>
+void expect_error(F load, const std::string& file, const std::string& key,
+                  const std::string& reason_part) {
+  try {
+    load();
+    ADD_FAILURE() << "no error for " << key;
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), file) << e.what();
+    EXPECT_EQ(e.key(), key) << e.what();
+    EXPECT_NE(e.reason().find(reason_part), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file), std::string::npos);
+    EXPECT_NE(what.find(key), std::string::npos);
+  }
+}
+
+TEST(ConfigShipped, MissionIsTheStudysTrueSpacecraftAndAsteroid) {
+  const MissionConfig m = load_mission(kMission);
+  const gnc::MassProperties truth = gnc::study_true_mass_properties();
+  EXPECT_LT((m.mass.j_ast - truth.j_ast).norm(), 1e-6);
+  EXPECT_LT((m.mass.j_sc - truth.j_sc).norm(), 1e-9);
+  EXPECT_LT((m.mass.r_so_bcm - truth.r_so_bcm).norm(), 1e-15);
+  EXPECT_LT((m.mass.r_scm_so - truth.r_scm_so).norm(), 1e-15);
+  EXPECT_EQ(m.mass.m_sc, truth.m_sc);
+  // The RCS layout matches the SPEC §4 layout built by the flight core's model.
+  const gnc::RcsLayout ours = rcs_layout(m, 200.0);
+  const gnc::RcsLayout study = gnc::study_rcs_layout(200.0);
+  EXPECT_LT((gnc::torque_matrix(ours, truth.r_so_bcm) - gnc::torque_matrix(study, truth.r_so_bcm))
+                .norm(),
+            1e-12);
+}
+
+TEST(ConfigShipped, EveryCaseAssemblesWithTable3ErrorsAlongSpecDirections) {
+  const double table_dj[] = {0, 1e5, 1e6, 1e7, 0, 0, 1e7};
+  const double table_dr[] = {0, 1e-2, 1e-1, 1, 0, 0, 1};
+  const double table_pw[] = {0, 0, 0, 0, 1e-12, 1e-10, 1e-10};
+  const double table_pq[] = {0, 0, 0, 0, 1e-8, 1e-6, 1e-6};
+  const double table_umax[] = {200, 200, 200, 1000, 200, 200, 200};
+  for (int n = 1; n <= 7; ++n) {
+    SCOPED_TRACE(n);
+    const RunSetup s = load_run(kMission, kGnc, case_file(n));
+    const int i = n - 1;
+    EXPECT_EQ(s.case_number, n);
+    EXPECT_EQ(s.duration_s, 1e5);
+    // dJ = J_true - J_hat, spectral norm and direction diag(-1, 1, 0.5).
+    const Mat3 dj = s.truth.mass.j_ast - s.flight.mass_hat.j_ast;
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(dj);
+    EXPECT_NEAR(eig.eigenvalues().cwiseAbs().maxCoeff(), table_dj[i], 1e-6 * (1 + table_dj[i]));
+    EXPECT_NEAR(dj(0, 0), -table_dj[i], 1e-6 * (1 + table_dj[i]));
+    EXPECT_NEAR(dj(1, 1), table_dj[i], 1e-6 * (1 + table_dj[i]));
+    EXPECT_NEAR(dj(2, 2), 0.5 * table_dj[i], 1e-6 * (1 + table_dj[i]));
+    const Vec3 dr = s.truth.mass.r_so_bcm - s.flight.mass_hat.r_so_bcm;
+    EXPECT_NEAR(dr.norm(), table_dr[i], 1e-12);
+    if (table_dr[i] > 0) {
+      EXPECT_LT((dr.normalized() - Vec3::Ones().normalized()).norm(), 1e-12);
+    }
+    EXPECT_EQ(s.truth.sensors.gyro_psd, table_pw[i]);
+    EXPECT_EQ(s.truth.sensors.star_psd, table_pq[i]);
+    EXPECT_EQ(s.truth.rcs.u_max, table_umax[i]);
+    EXPECT_EQ(s.flight.rcs.u_max, table_umax[i]);
+    // estimator: auto = filter exactly where the sensors are noisy (SPEC §6).
+    EXPECT_EQ(s.flight.estimator.kind, table_pw[i] > 0 ? gnc::EstimatorKind::kFilter
+                                                       : gnc::EstimatorKind::kPassThrough);
+    EXPECT_TRUE(gnc::validate(s.flight).ok);
+    EXPECT_NEAR(s.flight.dt, 0.1, 1e-15);
+  }
+}
+
+TEST(ConfigShipped, GncIsTable4) {
+  const GncConfig g = load_gnc(kGnc);
+  const gnc::GncParams d;  // the flight core's defaults are Table 4
+  EXPECT_EQ(g.params.ntcl.k, d.ntcl.k);
+  EXPECT_EQ(g.params.ntcl.lambda, d.ntcl.lambda);
+  EXPECT_EQ(g.params.adaptive.gamma, 1e12);
+  EXPECT_EQ(g.params.dpd.k_p, 10.0);
+  EXPECT_EQ(g.params.guidance.omega_switch, 5e-4);
+  EXPECT_EQ(g.params.guidance.k_qd, 1e-4);
+  EXPECT_NEAR(g.params.guidance.eps_trans, d.guidance.eps_trans, 1e-15);
+  EXPECT_NEAR(g.params.estimator.omega_c, d.estimator.omega_c, 1e-15);
+  EXPECT_EQ(g.estimator, EstimatorChoice::kAuto);
+}
+
+TEST(ConfigErrors, UnreadableFile) {
+  const std::string missing = kConfigs + "/cases/no_such_case.yaml";
+  expect_error([&] { load_case(missing); }, missing, "", "cannot read file");
+}
+
+TEST(ConfigErrors, YamlSyntaxError) {
+  TempFile f("case.yaml", read(case_file(1)) + "\nseed: [1, 2\n");
+  expect_error([&] { load_case(f.path()); }, f.path(), "", "YAML syntax error");
+}
+
+TEST(ConfigErrors, MissingKey) {
+  TempFile f("case.yaml", replaced(read(case_file(2)), "u_max_n: 200", ""));
+  expect_error([&] { load_case(f.path()); }, f.path(), "u_max_n", "missing required key");
+  TempFile g("gnc.yaml", replaced(read(kGnc), "k_p: 10.0", "k_pp: 10.0"));
+  expect_error([&] { load_gnc(g.path()); }, g.path(), "laws.dpd.k_p", "missing required key");
+}
+
+TEST(ConfigErrors, UnknownKey) {
+  TempFile f("mission.yaml", replaced(read(kMission), "  hold_s: 10.0", "  hold_s: 10.0\n  hold_ss: 3"));
+  expect_error([&] { load_mission(f.path()); }, f.path(), "disturbance.hold_ss", "unknown key");
+  TempFile g("case.yaml", read(case_file(1)) + "u_maxx: 3\n");
+  expect_error([&] { load_case(g.path()); }, g.path(), "u_maxx", "unknown key");
+}
+
+TEST(ConfigErrors, WrongShape) {
+  TempFile f("mission.yaml",
+             replaced(read(kMission), "r_so_bcm_m: [-0.0495, -0.0004, 3.5456]", "r_so_bcm_m: [1, 2]"));
+  expect_error([&] { load_mission(f.path()); }, f.path(), "asteroid.r_so_bcm_m", "list of 3");
+  TempFile g("gnc.yaml", replaced(read(kGnc), "ntcl:        {K: 1.0e4,", "ntcl:        {K: [1, 2],"));
+  expect_error([&] { load_gnc(g.path()); }, g.path(), "laws.ntcl.K", "3x3 matrix");
+  TempFile h("case.yaml", replaced(read(case_file(1)), "u_max_n: 200", "u_max_n: lots"));
+  expect_error([&] { load_case(h.path()); }, h.path(), "u_max_n", "expected a number");
+  TempFile k("gnc.yaml", replaced(read(kGnc), "laws:\n", "laws: 3\nold_laws:\n"));
+  expect_error([&] { load_gnc(k.path()); }, k.path(), "laws", "expected a mapping");
+}
+
+TEST(ConfigErrors, NonPositiveDefiniteInertia) {
+  TempFile f("mission.yaml", replaced(read(kMission), "- [ 0.8658e7,", "- [ -0.8658e7,"));
+  expect_error([&] { load_mission(f.path()); }, f.path(), "asteroid.inertia_kg_m2",
+               "not positive definite");
+  TempFile g("mission.yaml", replaced(read(kMission), "[5.584e4, 5.584e4, 1.568e4]",
+                                      "[5.584e4, 0.0, 1.568e4]"));
+  expect_error([&] { load_mission(g.path()); }, g.path(), "spacecraft.inertia_kg_m2",
+               "not positive definite");
+  // An error so large that the flight software's estimate J_ast - dJ is not positive definite.
+  TempFile h("case.yaml", replaced(read(case_file(4)), "delta_j_ast_norm_kg_m2: 1.0e7",
+                                   "delta_j_ast_norm_kg_m2: 1.0e8"));
+  expect_error([&] { load_run(kMission, kGnc, h.path()); }, h.path(), "delta_j_ast_norm_kg_m2",
+               "not positive definite");
+}
+
+TEST(ConfigErrors, NegativeNoisePower) {
+  TempFile f("case.yaml", replaced(read(case_file(6)), "gyro_noise_psd_rad2_s2: 1.0e-10",
+                                   "gyro_noise_psd_rad2_s2: -1.0e-10"));
+  expect_error([&] { load_case(f.path()); }, f.path(), "gyro_noise_psd_rad2_s2", "negative");
+  TempFile g("case.yaml", replaced(read(case_file(6)), "star_noise_psd: 1.0e-6",
+                                   "star_noise_psd: -1.0e-6"));
+  expect_error([&] { load_case(g.path()); }, g.path(), "star_noise_psd", "negative");
+}
+
+TEST(ConfigErrors, BadValues) {
+  TempFile f("gnc.yaml", replaced(read(kGnc), "estimator: auto", "estimator: kalman"));
+  expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough or filter");
+  TempFile g("gnc.yaml", replaced(read(kGnc), "{K_d: 1.0e4, k_p: 10.0}", "{K_d: -1.0e4, k_p: 10.0}"));
+  expect_error([&] { load_gnc(g.path()); }, g.path(), "laws.dpd.K_d", "not positive definite");
+  TempFile h("case.yaml", replaced(read(case_file(1)), "seed: 1001", "seed: -4"));
+  expect_error([&] { load_case(h.path()); }, h.path(), "seed", "non-negative integer");
+  // Caught by the flight core's own validation, reported against gnc.yaml.
+  TempFile k("gnc.yaml", replaced(read(kGnc), "omega_switch_rad_s: 5.0e-4", "omega_switch_rad_s: 1.0"));
+  expect_error([&] { load_run(kMission, k.path(), case_file(1)); }, k.path(),
+               "guidance.omega_switch", "below eps_trans");
+}
+
+}  // namespace
+}  // namespace rocksteady::config
