@@ -1,0 +1,194 @@
+// rocksteady-campaign: closed-loop runs of the study's cases in one process.
+//   rocksteady-campaign run --case 1 --strategy ntcl+dpd_ref
+//   rocksteady-campaign campaign [--cases 1-7] [--strategies study|all|a,b,...] [--jobs 2]
+// Exit status: 0 done (NC is a result, not a failure); 1 a run failed; 2 bad configuration or
+// command line.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "ground/campaign/campaign.hpp"
+#include "ground/config/config_error.hpp"
+
+namespace {
+
+using namespace rocksteady;
+using campaign::Strategy;
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+// "1-7", "1,4,7", or file paths (anything ending in .yaml).
+std::vector<std::string> case_files(const std::string& spec, const std::string& config_dir) {
+  std::vector<std::string> files;
+  for (const std::string& item : split(spec, ',')) {
+    if (item.size() > 5 && item.substr(item.size() - 5) == ".yaml") {
+      files.push_back(item);
+      continue;
+    }
+    const std::size_t dash = item.find('-');
+    int lo = 0, hi = 0;
+    try {
+      lo = std::stoi(item.substr(0, dash));
+      hi = dash == std::string::npos ? lo : std::stoi(item.substr(dash + 1));
+    } catch (const std::exception&) {
+      throw CLI::ValidationError("--cases", "'" + item + "' is not a case number, range or file");
+    }
+    if (lo < 1 || hi < lo) throw CLI::ValidationError("--cases", "bad range '" + item + "'");
+    for (int n = lo; n <= hi; ++n) {
+      files.push_back(config_dir + "/cases/case" + std::to_string(n) + ".yaml");
+    }
+  }
+  return files;
+}
+
+std::vector<Strategy> strategies(const std::string& spec) {
+  std::vector<std::string> names;
+  if (spec == "study") {
+    names = campaign::study_strategy_names();
+  } else if (spec == "all") {
+    names = campaign::all_strategy_names();
+  } else {
+    names = split(spec, ',');
+  }
+  std::vector<Strategy> out;
+  for (const std::string& n : names) {
+    const auto s = campaign::parse_strategy(n);
+    if (!s) {
+      std::string known;
+      for (const std::string& k : campaign::all_strategy_names()) known += " " + k;
+      throw CLI::ValidationError("--strategy", "unknown strategy '" + n + "' (known:" + known +
+                                                   ", or <law>+dpd_ref|fuel_optimal)");
+    }
+    out.push_back(*s);
+  }
+  return out;
+}
+
+std::string opt_s(const std::optional<double>& v, const char* unit, int d) {
+  if (!v) return "NC";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f %s", d, *v, unit);
+  return buf;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Rocksteady closed-loop runs and campaigns (plant + flight core in one process)"};
+  app.require_subcommand(1);
+  std::string config_dir = "configs";
+  std::string mission, gnc_file;
+  app.add_option("--config-dir", config_dir, "folder with mission.yaml, gnc.yaml, cases/")
+      ->capture_default_str();
+  app.add_option("--mission", mission, "mission file (default <config-dir>/mission.yaml)");
+  app.add_option("--gnc", gnc_file, "GNC file (default <config-dir>/gnc.yaml)");
+
+  campaign::CampaignSpec spec;
+  std::string cases_arg = "1-7";
+  std::string strategies_arg = "study";
+  std::string case_arg = "1";
+  std::string strategy_arg = "ntcl+dpd_ref";
+  bool no_plots = false, no_series = false, quiet = false, progress = false;
+
+  CLI::App* run = app.add_subcommand("run", "one case with one strategy");
+  run->add_option("--case", case_arg, "case number or case file")->capture_default_str();
+  run->add_option("--strategy", strategy_arg, "e.g. ntcl+dpd_ref, dpd, ntcl+fuel_optimal")
+      ->capture_default_str();
+  CLI::App* camp = app.add_subcommand("campaign", "cases x strategies, in parallel");
+  camp->add_option("--cases", cases_arg, "case numbers, ranges or files: 1-7, 1,4, x.yaml")
+      ->capture_default_str();
+  camp->add_option("--strategies", strategies_arg, "study (the six), all, or a comma list")
+      ->capture_default_str();
+  camp->add_option("--jobs,-j", spec.jobs, "worker threads (0: one per core)")->capture_default_str();
+  for (CLI::App* sub : {run, camp}) {
+    sub->add_option("--out,-o", spec.out_dir, "output folder");
+    sub->add_option("--duration", spec.duration_s, "simulated seconds (default: the case's)");
+    sub->add_option("--log-interval", spec.log_interval_s,
+                    "time-series interval, s (default: duration / 2000)");
+    sub->add_flag("--no-plots", no_plots, "skip the PNG plots");
+    sub->add_flag("--no-timeseries", no_series, "skip the time series (and the plots)");
+    sub->add_flag("--quiet,-q", quiet, "no progress display");
+    sub->add_flag("--progress", progress, "progress display even when not on a terminal");
+  }
+  CLI11_PARSE(app, argc, argv);
+
+  if (mission.empty()) mission = config_dir + "/mission.yaml";
+  if (gnc_file.empty()) gnc_file = config_dir + "/gnc.yaml";
+  spec.mission_file = mission;
+  spec.gnc_file = gnc_file;
+  spec.write_plots = !no_plots && !no_series;
+  spec.write_timeseries = !no_series;
+  spec.progress = quiet ? campaign::ProgressMode::kOff
+                        : (progress ? campaign::ProgressMode::kOn : campaign::ProgressMode::kAuto);
+  const bool single = run->parsed();
+  try {
+    if (single) {
+      spec.case_files = case_files(case_arg, config_dir);
+      spec.strategies = strategies(strategy_arg);
+      if (spec.out_dir == "out/campaign") spec.out_dir = "out/run";
+      spec.jobs = 1;
+    } else {
+      spec.case_files = case_files(cases_arg, config_dir);
+      spec.strategies = strategies(strategies_arg);
+    }
+  } catch (const CLI::Error& e) {
+    return app.exit(e);
+  }
+
+  const auto source = campaign::make_default_trajectory_source();
+  campaign::CampaignReport rep;
+  try {
+    rep = campaign::run_campaign(spec, *source, std::cerr);
+  } catch (const config::ConfigError& e) {
+    std::cerr << "rocksteady-campaign: configuration error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "rocksteady-campaign: " << e.what() << "\n";
+    return 1;
+  }
+
+  int failed = 0;
+  for (const campaign::RunResult& r : rep.results) {
+    if (r.status == campaign::RunStatus::kError) {
+      ++failed;
+      std::cerr << "run failed: " << r.case_name << " " << r.strategy << ": " << r.note << "\n";
+    }
+  }
+  if (single) {
+    const campaign::RunResult& r = rep.results.front();
+    std::cout << r.case_name << "  " << r.strategy << "  (" << campaign::to_string(r.status)
+              << ")\n";
+    if (r.status == campaign::RunStatus::kOk) {
+      std::cout << "  t_omega,conv        " << opt_s(r.t_omega_conv_s, "s", 1) << "\n"
+                << "  fuel at t_omega     " << opt_s(r.fuel_at_t_omega_kg, "kg", 3) << "\n"
+                << "  t_q,conv            " << opt_s(r.t_q_conv_s, "s", 1) << "\n"
+                << "  fuel at t_q         " << opt_s(r.fuel_at_t_q_kg, "kg", 3) << "\n"
+                << "  total fuel          " << opt_s(r.total_fuel_kg, "kg", 3) << "\n"
+                << "  max |omega|         " << opt_s(r.max_rate_rad_s, "rad/s", 5) << "\n"
+                << "  final mode          " << r.final_mode << "\n"
+                << "  simulated " << r.sim_s << " s in " << opt_s(r.wall_s, "s wall", 2) << "\n";
+      if (!r.plot_path.empty()) std::cout << "  plot                " << r.plot_path << "\n";
+      if (!r.timeseries_path.empty()) std::cout << "  time series         " << r.timeseries_path << "\n";
+    }
+    if (!r.note.empty()) std::cout << "  note: " << r.note << "\n";
+  } else {
+    std::cout << "results: " << rep.results_csv << "\n"
+              << "table:   " << rep.results_md << "\n"
+              << "runs:    " << rep.runs_csv << "\n";
+  }
+  std::cout << campaign::benchmark_line(rep) << "\n";
+  return failed > 0 ? 1 : 0;
+}

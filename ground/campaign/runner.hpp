@@ -1,0 +1,97 @@
+// The in-process closed loop: plant and flight software in lockstep at the GNC rate, one process,
+// as fast as the machine allows. Each tick: the plant's sensor sample -> FlightSide::step -> the
+// plant advances one control period with the commanded channel forces (zero-order hold).
+// Figures of merit (SPEC §7) are taken on the TRUE state after every tick.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ground/campaign/flight_side.hpp"
+#include "ground/campaign/strategy.hpp"
+#include "ground/config/config.hpp"
+
+namespace rocksteady::campaign {
+
+// SPEC §7: the least time after which value(t) <= tol for all later t, and the fuel used by then.
+class ConvergenceTracker {
+ public:
+  explicit ConvergenceTracker(double tol) : tol_(tol) {}
+  void add(double t, double value, double fuel_kg);
+  bool converged() const { return have_ && last_ok_; }  // NC otherwise
+  std::optional<double> time() const;
+  std::optional<double> fuel_kg() const;
+
+ private:
+  double tol_;
+  bool have_{false};
+  bool last_ok_{false};
+  double t_{0.0};
+  double fuel_{0.0};
+};
+
+struct TimeRow {
+  double t{0.0};
+  Eigen::Vector3d omega{Eigen::Vector3d::Zero()};      // true
+  Eigen::Vector3d omega_hat{Eigen::Vector3d::Zero()};  // flight estimate
+  Eigen::Vector3d q{Eigen::Vector3d::Zero()};          // true, shadow-normalised MRP
+  Eigen::Vector3d q_hat{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d torque_cmd{Eigen::Vector3d::Zero()};  // u_c
+  gnc::Vec8 force{gnc::Vec8::Zero()};                   // channel forces commanded at t
+  double fuel_kg{0.0};                                  // true, cumulative
+  double fuel_hat_kg{0.0};                              // flight software's estimate
+  gnc::Mode mode{gnc::Mode::kIdle};
+};
+
+enum class RunStatus { kOk, kNoReference, kError };
+const char* to_string(RunStatus s);
+
+struct RunResult {
+  std::string case_name;
+  int case_number{0};
+  std::string strategy;
+  RunStatus status{RunStatus::kOk};
+  std::string note;
+  std::optional<double> t_omega_conv_s;
+  std::optional<double> fuel_at_t_omega_kg;
+  std::optional<double> t_q_conv_s;
+  std::optional<double> fuel_at_t_q_kg;
+  double total_fuel_kg{0.0};
+  double fuel_hat_kg{0.0};     // the flight software's own estimate at the end
+  double max_rate_rad_s{0.0};  // max |omega| (true)
+  double final_rate_rad_s{0.0};
+  double final_q_error{0.0};
+  std::string final_mode;
+  std::uint64_t ticks{0};
+  std::uint64_t clipped_ticks{0};    // plant clipped a channel at u_max
+  std::uint64_t saturated_ticks{0};  // flight allocator rescaled (Eq. 53)
+  double sim_s{0.0};
+  double wall_s{0.0};
+  double plan_wall_s{0.0};
+  std::vector<TimeRow> series;  // decimated
+  std::string timeseries_path;
+  std::string plot_path;
+};
+
+struct RunOptions {
+  double duration_s{-1.0};       // < 0: the case's duration
+  double log_interval_s{50.0};   // time-series decimation (0: no series)
+  std::atomic<std::uint64_t>* progress_ticks{nullptr};  // advanced as the run proceeds
+};
+
+// Runs one case with one strategy. `trajectory` is required for fuel_optimal strategies; pass null
+// to get a kNoReference result (with `no_reference_note`) without simulating.
+RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strategy, FlightSide& flight,
+                          const gnc::TrajectoryTable* trajectory, const RunOptions& options,
+                          const std::string& no_reference_note = "no reference");
+
+// The flight parameters of a strategy: the case's GncParams with the strategy's law.
+gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& strategy);
+
+// |q - q_final| with q_final expressed in the set nearest q (both MRPs), SPEC §1 and §7.
+double attitude_error(const Eigen::Vector3d& q, const Eigen::Vector3d& q_final);
+
+}  // namespace rocksteady::campaign

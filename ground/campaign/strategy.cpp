@@ -1,0 +1,47 @@
+#include "ground/campaign/strategy.hpp"
+
+namespace rocksteady::campaign {
+
+std::optional<Strategy> parse_strategy(const std::string& name) {
+  if (name == "dpd") return Strategy{name, gnc::LawId::kDpd, ReferenceKind::kDpdRef};
+  const std::size_t plus = name.find('+');
+  if (plus == std::string::npos) return std::nullopt;
+  const std::string law = name.substr(0, plus);
+  const std::string ref = name.substr(plus + 1);
+  Strategy s;
+  s.name = name;
+  if (ref == "dpd_ref") {
+    s.reference = ReferenceKind::kDpdRef;
+  } else if (ref == "fuel_optimal") {
+    s.reference = ReferenceKind::kFuelOptimal;
+  } else {
+    return std::nullopt;
+  }
+  for (int i = 0; i < gnc::kLawCount; ++i) {
+    const auto id = static_cast<gnc::LawId>(i);
+    if (id != gnc::LawId::kDpd && law == gnc::to_string(id)) {
+      s.law = id;
+      return s;
+    }
+  }
+  return std::nullopt;
+}
+
+const std::vector<std::string>& study_strategy_names() {
+  static const std::vector<std::string> names = {"ntcl+fuel_optimal", "adaptive+fuel_optimal",
+                                                 "el+fuel_optimal",   "ntcl+dpd_ref",
+                                                 "adaptive+dpd_ref",  "dpd"};
+  return names;
+}
+
+const std::vector<std::string>& all_strategy_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = study_strategy_names();
+    n.push_back("feedforward+dpd_ref");
+    n.push_back("feedforward+fuel_optimal");
+    return n;
+  }();
+  return names;
+}
+
+}  // namespace rocksteady::campaign

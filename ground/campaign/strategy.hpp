@@ -1,0 +1,29 @@
+// A strategy = a control law + a desired-trajectory choice, named as the study's results table:
+// "<law>+fuel_optimal", "<law>+dpd_ref", and plain "dpd" (the D+PD law, Eqs. 49-50).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gnc/params.hpp"
+
+namespace rocksteady::campaign {
+
+enum class ReferenceKind { kDpdRef, kFuelOptimal };
+
+struct Strategy {
+  std::string name;
+  gnc::LawId law{gnc::LawId::kNtcl};
+  ReferenceKind reference{ReferenceKind::kDpdRef};
+  bool needs_trajectory() const { return reference == ReferenceKind::kFuelOptimal; }
+};
+
+// Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal.
+std::optional<Strategy> parse_strategy(const std::string& name);
+// The six columns of the study's results table, in its order.
+const std::vector<std::string>& study_strategy_names();
+// The study's six plus the feed-forward comparison law with both references.
+const std::vector<std::string>& all_strategy_names();
+
+}  // namespace rocksteady::campaign
