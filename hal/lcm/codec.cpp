@@ -39,6 +39,12 @@ template <class T> DecodeStatus header(const T& m) {
   return DecodeStatus::kOk;
 }
 
+// Bounded, and no embedded '\0': the text must survive a re-encode (LCM encodes up to the first
+// '\0').
+bool text_ok(const std::string& text, int max_len) {
+  return text.size() <= static_cast<std::size_t>(max_len) && text.find('\0') == std::string::npos;
+}
+
 DecodeStatus range(bool ok) { return ok ? DecodeStatus::kOk : DecodeStatus::kOutOfRange; }
 
 }  // namespace
@@ -96,30 +102,29 @@ DecodeStatus check(const rocksteady::gnc_telemetry_t& m) {
   return range(std::isfinite(m.t) && m.tick >= 0 && m.rate_group_count >= 0 &&
                m.rate_group_count <= rocksteady::gnc_telemetry_t::RATE_GROUPS &&
                is_bool(m.trajectory_loaded) && is_bool(m.saturated) &&
-               is_bool(m.thrusters_enabled) && non_negative(m.rg_cycles) &&
+               is_bool(m.thrusters_enabled) && is_bool(m.table_loaded) && non_negative(m.rg_cycles) &&
                non_negative(m.rg_slips) && non_negative(m.rg_missed));
 }
 
 DecodeStatus check(const rocksteady::event_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
-  // No embedded '\0': the text must survive a re-encode (LCM encodes it up to the first '\0').
   return range(std::isfinite(m.t) && m.severity >= rocksteady::event_t::SEV_DEBUG &&
                m.severity <= rocksteady::event_t::SEV_FATAL &&
-               m.text.size() <= static_cast<std::size_t>(rocksteady::event_t::MAX_TEXT) &&
-               m.text.find('\0') == std::string::npos);
+               text_ok(m.text, rocksteady::event_t::MAX_TEXT));
 }
 
 DecodeStatus check(const rocksteady::ground_cmd_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
-  // Structure only: the opcode and its arguments are judged by check_command(), which answers with
-  // a rejection reason instead of dropping the command.
+  // Structure only: the opcode and its arguments are judged by the flight application's command
+  // table, which answers with a rejection reason instead of dropping the command.
   return range(m.nargs >= 0 && m.nargs <= rocksteady::ground_cmd_t::MAX_ARGS);
 }
 
 DecodeStatus check(const rocksteady::cmd_ack_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
   return range(std::isfinite(m.t) && is_bool(m.accepted) &&
-               (m.accepted == 0) == (m.reason != rocksteady::cmd_ack_t::REASON_OK));
+               (m.accepted == 0) == (m.reason != rocksteady::cmd_ack_t::REASON_OK) &&
+               text_ok(m.text, rocksteady::cmd_ack_t::MAX_TEXT));
 }
 
 DecodeStatus check(const rocksteady::plant_truth_t& m) {

@@ -3,7 +3,8 @@
 // fingerprint ignores the type's name. safe_decode() therefore
 //   1. bounds the length and checks the fingerprint itself,
 //   2. checks the exact encoded size before decode() runs: every type is fixed-size, except event_t
-//      whose only variable part is its last field (a string), whose length prefix is checked first,
+//      and cmd_ack_t whose only variable part is their last field (a string), whose length prefix is
+//      checked first,
 //   3. calls decode() inside a catch-all (the only try/catch of the HAL),
 //   4. checks the decoded fields: kind and version, counts, booleans, finiteness.
 // A rejected message is counted and left unused; nothing here aborts. Decoding a fixed-size type
@@ -85,6 +86,7 @@ template <> inline const char* channel_of<rocksteady::trajectory_chunk_t>() { re
 // Types whose only variable-length field is a trailing string.
 template <class T> struct HasTrailingString { static constexpr bool value = false; };
 template <> struct HasTrailingString<rocksteady::event_t> { static constexpr bool value = true; };
+template <> struct HasTrailingString<rocksteady::cmd_ack_t> { static constexpr bool value = true; };
 
 // A fresh message with kind and version set (everything else zero).
 template <class T> T make() {

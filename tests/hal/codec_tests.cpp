@@ -201,6 +201,26 @@ TEST(SafeDecodeEvent, TooLongOrEmbeddedNulTextIsOutOfRange) {
   EXPECT_EQ(decode(b.data(), static_cast<int>(b.size()), out), DecodeStatus::kOutOfRange);
 }
 
+TEST(SafeDecodeAck, CarriesItsTextAndChecksTheVerdict) {
+  auto a = make<rocksteady::cmd_ack_t>();
+  a.seq = 5;
+  a.accepted = 0;
+  a.reason = rocksteady::cmd_ack_t::REASON_ARG_OUT_OF_RANGE;
+  a.detail = 1;
+  a.text = "mode out of range";
+  Bytes b = encode_bytes(a);
+  rocksteady::cmd_ack_t out{};
+  ASSERT_EQ(decode(b.data(), static_cast<int>(b.size()), out), DecodeStatus::kOk);
+  EXPECT_EQ(out.text, a.text);
+  a.accepted = 1;  // accepted with a rejection reason
+  b = encode_bytes(a);
+  EXPECT_EQ(decode(b.data(), static_cast<int>(b.size()), out), DecodeStatus::kOutOfRange);
+  a.accepted = 0;
+  a.text = std::string(static_cast<std::size_t>(rocksteady::cmd_ack_t::MAX_TEXT) + 1, 'z');
+  b = encode_bytes(a);
+  EXPECT_EQ(decode(b.data(), static_cast<int>(b.size()), out), DecodeStatus::kOutOfRange);
+}
+
 // --- every type, random bytes behind a correct fingerprint -----------------------------------------
 
 template <class T> void random_buffers_never_escape(std::uint32_t seed) {

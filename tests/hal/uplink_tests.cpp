@@ -1,4 +1,4 @@
-// Trajectory uplink: chunking on the ground, reassembly and CRC check on board.
+// Trajectory uplink, ground side: chunking a table into trajectory_chunk_t messages.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,91 +47,70 @@ TEST(Uplink, ChunkCountCoversTheTable) {
   EXPECT_EQ(chunk_count(gnc::kMaxTrajectorySamples), gnc::kMaxTrajectorySamples / Chunk::SAMPLES);
 }
 
-TEST(Uplink, ChunksInAnyOrderWithDuplicatesReassembleTheTable) {
-  const auto table = table_of(100);  // 4 chunks, the last one partial
-  auto asm_ = std::make_unique<TrajectoryAssembler>();
-  const int n = chunk_count(table->count);
-  ASSERT_EQ(n, 4);
-  Chunk c{};
-  const int order[] = {2, 0, 0, 3, 1};
-  const UplinkResult expected[] = {UplinkResult::kAccepted, UplinkResult::kAccepted,
-                                   UplinkResult::kDuplicate, UplinkResult::kAccepted,
-                                   UplinkResult::kComplete};
-  for (int i = 0; i < 5; ++i) {
-    ASSERT_TRUE(make_chunk(*table, 9, order[i], c));
-    EXPECT_EQ(check(c), DecodeStatus::kOk);
-    EXPECT_EQ(asm_->add(c), expected[i]) << i;
+// Reassemble in the test (independently of fsw/uplink) and compare with the original table.
+TEST(Uplink, ChunksCarryTheWholeTableAndItsChecksum) {
+  for (const int n : {2, 31, 32, 33, 100, gnc::kMaxTrajectorySamples}) {
+    const auto table = table_of(n);
+    auto rebuilt = std::make_unique<gnc::TrajectoryTable>();
+    const int chunks = chunk_count(n);
+    for (int i = chunks - 1; i >= 0; --i) {
+      Chunk c{};
+      ASSERT_TRUE(make_chunk(*table, 9, i, c));
+      ASSERT_EQ(check(c), DecodeStatus::kOk) << n << ' ' << i;
+      EXPECT_EQ(c.total_chunks, chunks);
+      EXPECT_EQ(c.total_samples, n);
+      EXPECT_EQ(static_cast<std::uint32_t>(c.table_crc), table->checksum);
+      for (int k = 0; k < c.count; ++k) {
+        auto& s = rebuilt->samples[static_cast<std::size_t>(c.first_sample + k)];
+        s.t = c.t[k];
+        s.omega_d = gnc::Vec3(c.omega_d[k][0], c.omega_d[k][1], c.omega_d[k][2]);
+        s.omega_d_dot = gnc::Vec3(c.omega_d_dot[k][0], c.omega_d_dot[k][1], c.omega_d_dot[k][2]);
+      }
+      rebuilt->count += c.count;
+    }
+    rebuilt->checksum = gnc::trajectory_checksum(*rebuilt);
+    expect_same_table(*rebuilt, *table);
+    EXPECT_EQ(gnc::validate_trajectory(*rebuilt, 1.0), gnc::TrajectoryError::kOk);
   }
-  ASSERT_TRUE(asm_->complete());
-  EXPECT_EQ(asm_->upload_id(), 9);
-  expect_same_table(asm_->table(), *table);
-  EXPECT_EQ(gnc::validate_trajectory(asm_->table(), 1.0), gnc::TrajectoryError::kOk);
 }
 
-TEST(Uplink, CorruptedSampleFailsTheTableChecksum) {
-  const auto table = table_of(40);
-  auto asm_ = std::make_unique<TrajectoryAssembler>();
+TEST(Uplink, ChecksumIsRecomputedNotTrusted) {
+  auto table = table_of(40);
+  const std::uint32_t right = table->checksum;
+  table->checksum = 12345;
   Chunk c{};
   ASSERT_TRUE(make_chunk(*table, 1, 0, c));
-  EXPECT_EQ(asm_->add(c), UplinkResult::kAccepted);
-  ASSERT_TRUE(make_chunk(*table, 1, 1, c));
-  c.omega_d[3][1] += 1e-12;
-  EXPECT_EQ(asm_->add(c), UplinkResult::kBadChecksum);
-  EXPECT_FALSE(asm_->complete());
-  EXPECT_FALSE(asm_->in_progress());
+  EXPECT_EQ(static_cast<std::uint32_t>(c.table_crc), right);
 }
 
-TEST(Uplink, ChunkFromAnotherTableIsInconsistent) {
+TEST(Uplink, OutOfRangeChunksFailTheChecks) {
   const auto a = table_of(70);
-  const auto b = table_of(90);
-  auto asm_ = std::make_unique<TrajectoryAssembler>();
-  Chunk c{};
-  ASSERT_TRUE(make_chunk(*a, 4, 0, c));
-  EXPECT_EQ(asm_->add(c), UplinkResult::kAccepted);
-  ASSERT_TRUE(make_chunk(*b, 4, 1, c));  // same upload id, different header
-  EXPECT_EQ(asm_->add(c), UplinkResult::kInconsistent);
-  EXPECT_EQ(asm_->received(), 1);
-}
-
-TEST(Uplink, NewUploadIdRestartsAndAbortDiscards) {
-  const auto a = table_of(70);
-  auto asm_ = std::make_unique<TrajectoryAssembler>();
-  Chunk c{};
-  ASSERT_TRUE(make_chunk(*a, 1, 0, c));
-  asm_->add(c);
-  ASSERT_TRUE(make_chunk(*a, 2, 0, c));
-  EXPECT_EQ(asm_->add(c), UplinkResult::kAccepted);
-  EXPECT_EQ(asm_->upload_id(), 2);
-  EXPECT_EQ(asm_->received(), 1);
-  EXPECT_FALSE(asm_->abort(1));
-  EXPECT_TRUE(asm_->abort(2));
-  EXPECT_FALSE(asm_->in_progress());
-}
-
-TEST(Uplink, MalformedChunksAreRejected) {
-  const auto a = table_of(70);
-  auto asm_ = std::make_unique<TrajectoryAssembler>();
   Chunk c{};
   ASSERT_TRUE(make_chunk(*a, 1, 2, c));
   Chunk bad = c;
   bad.count = -1;
   EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
-  EXPECT_EQ(asm_->add(bad), UplinkResult::kMalformed);
   bad = c;
   bad.chunk_index = 3;  // beyond total_chunks
-  EXPECT_EQ(asm_->add(bad), UplinkResult::kMalformed);
+  EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
+  bad = c;
+  bad.first_sample = 0;
+  EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
   bad = c;
   bad.total_samples = gnc::kMaxTrajectorySamples + 1;
-  EXPECT_EQ(asm_->add(bad), UplinkResult::kMalformed);
+  EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
   bad = c;
   bad.t[5] = NAN;
-  EXPECT_EQ(asm_->add(bad), UplinkResult::kMalformed);
+  EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
   bad = c;
   bad.table_crc = -1;
-  EXPECT_EQ(asm_->add(bad), UplinkResult::kMalformed);
-  EXPECT_FALSE(asm_->in_progress());
+  EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
+  bad = c;
+  bad.upload_id = -1;
+  EXPECT_EQ(check(bad), DecodeStatus::kOutOfRange);
   EXPECT_FALSE(make_chunk(*a, 1, 3, c));
   EXPECT_FALSE(make_chunk(*a, -1, 0, c));
+  EXPECT_FALSE(make_chunk(*table_of(1), 1, 0, c));
 }
 
 }  // namespace
