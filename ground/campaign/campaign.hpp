@@ -42,6 +42,7 @@ struct CampaignReport {
   double output_wall_s{0.0};    // writing series and plots (per worker)
   double run_phase_wall_s{0.0}; // closed loop + outputs, wall
   double simulated_s{0.0};      // sum of simulated seconds
+  double cpu_s{0.0};            // process CPU time of the run phase (all threads)
   std::string results_csv;
   std::string results_md;
   std::string runs_csv;

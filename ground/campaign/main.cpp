@@ -89,6 +89,7 @@ std::string opt_s(const std::optional<double>& v, const char* unit, int d) {
 int main(int argc, char** argv) {
   CLI::App app{"Rocksteady closed-loop runs and campaigns (plant + flight core in one process)"};
   app.require_subcommand(1);
+  app.fallthrough();  // --config-dir, --mission, --gnc also after the subcommand
   std::string config_dir = "configs";
   std::string mission, gnc_file;
   app.add_option("--config-dir", config_dir, "folder with mission.yaml, gnc.yaml, cases/")

@@ -1,0 +1,112 @@
+// Campaign outputs: results.csv header and NC fields, the Markdown table layout, time series, plots.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "ground/campaign/campaign.hpp"
+
+namespace rocksteady::campaign {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kConfigs = std::string(ROCKSTEADY_SOURCE_DIR) + "/configs";
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string l;
+  while (std::getline(ss, l)) out.push_back(l);
+  return out;
+}
+
+TEST(CampaignOutputs, ResultsCsvHasTheExactHeaderAndEmptyFieldsForNc) {
+  RunResult ok;
+  ok.case_name = "case1";
+  ok.strategy = "dpd";
+  ok.t_omega_conv_s = 100.0;
+  ok.fuel_at_t_omega_kg = 2.5;
+  ok.total_fuel_kg = 3.0;
+  ok.max_rate_rad_s = 0.04;  // t_q never converged: NC
+  RunResult noref;
+  noref.case_name = "case1";
+  noref.strategy = "ntcl+fuel_optimal";
+  noref.status = RunStatus::kNoReference;
+  const fs::path dir = fs::temp_directory_path() / "rocksteady_outputs_csv";
+  write_results_csv((dir / "results.csv").string(), {ok, noref});
+  const auto l = lines(slurp((dir / "results.csv").string()));
+  ASSERT_EQ(l.size(), 3u);
+  EXPECT_EQ(l[0],
+            "case,strategy,t_omega_conv_s,fuel_at_t_omega_kg,t_q_conv_s,fuel_at_t_q_kg,"
+            "total_fuel_kg,max_rate_rad_s");
+  EXPECT_EQ(l[1], "case1,dpd,100.0,2.5000,,,3.0000,0.04");
+  EXPECT_EQ(l[2], "case1,ntcl+fuel_optimal,,,,,,");
+  fs::remove_all(dir);
+}
+
+TEST(CampaignOutputs, SmallCampaignWritesTablesSeriesAndPlots) {
+  CampaignSpec spec;
+  spec.mission_file = kConfigs + "/mission.yaml";
+  spec.gnc_file = kConfigs + "/gnc.yaml";
+  spec.case_files = {kConfigs + "/cases/case1.yaml", kConfigs + "/cases/case4.yaml"};
+  spec.strategies = {*parse_strategy("ntcl+dpd_ref"), *parse_strategy("ntcl+fuel_optimal")};
+  const fs::path dir = fs::temp_directory_path() / "rocksteady_outputs_campaign";
+  fs::remove_all(dir);
+  spec.out_dir = dir.string();
+  spec.duration_s = 300.0;  // short: this test is about the files
+  spec.log_interval_s = 1.0;
+  spec.progress = ProgressMode::kOff;
+  NoTrajectorySource none;
+  std::ostringstream log;
+  const CampaignReport rep = run_campaign(spec, none, log);
+  ASSERT_EQ(rep.results.size(), 4u);
+  EXPECT_EQ(rep.cases, (std::vector<std::string>{"case1", "case4"}));
+
+  const auto csv = lines(slurp(rep.results_csv));
+  ASSERT_EQ(csv.size(), 5u);
+  EXPECT_EQ(csv[0], kResultsHeader);
+  EXPECT_EQ(csv[1].rfind("case1,ntcl+dpd_ref,", 0), 0u);
+  EXPECT_EQ(csv[2], "case1,ntcl+fuel_optimal,,,,,,");  // no reference: no numbers
+  EXPECT_EQ(csv[4], "case4,ntcl+fuel_optimal,,,,,,");
+
+  // Markdown: strategies as columns, cases as row groups of the six figures of merit.
+  const std::string md = slurp(rep.results_md);
+  EXPECT_NE(md.find("| case | figure of merit | `ntcl+dpd_ref` | `ntcl+fuel_optimal` |"),
+            std::string::npos);
+  EXPECT_NE(md.find("| **case1** | t_ω,conv (s) |"), std::string::npos);
+  EXPECT_NE(md.find("| **case4** | t_ω,conv (s) |"), std::string::npos);
+  EXPECT_NE(md.find("no ref."), std::string::npos);
+  EXPECT_NE(md.find("NC"), std::string::npos);  // 300 s is far too short to converge
+
+  // Per-run time series: 300 s at 1 s plus the final row, every column present.
+  const RunResult& r = rep.results[0];
+  ASSERT_EQ(r.status, RunStatus::kOk);
+  const auto ts = lines(slurp(r.timeseries_path));
+  ASSERT_EQ(ts.size(), 1u + 301u);
+  EXPECT_EQ(ts[0].rfind("t_s,omega_x,omega_y,omega_z,omega_hat_x", 0), 0u);
+  EXPECT_NE(ts[0].find("u7,fuel_kg"), std::string::npos);
+  // The first row is the initial state of SPEC §5.
+  EXPECT_EQ(ts[1].rfind("0,0.01,0.02,0.03,", 0), 0u);
+
+  // The plot is a PNG made by gnuplot.
+  ASSERT_FALSE(r.plot_path.empty()) << r.note;
+  std::ifstream png(r.plot_path, std::ios::binary);
+  char magic[8] = {};
+  png.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  EXPECT_EQ(rep.results[1].status, RunStatus::kNoReference);
+  EXPECT_TRUE(rep.results[1].timeseries_path.empty());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rocksteady::campaign
