@@ -1,0 +1,207 @@
+// Parameter tables: load into the inactive copy, validate the whole copy (first bad field named),
+// activate at a tick boundary.
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <string>
+
+#include "fsw/params/param_table.hpp"
+#include "fsw_harness.hpp"
+
+namespace rocksteady::fsw {
+namespace {
+
+using test::AppFixture;
+using test::M3;
+using test::V3;
+
+double id_arg(ParamId id) { return static_cast<double>(static_cast<int>(id)); }
+
+// Written independently of the fsw's own mapping: where each parameter id must land.
+struct Field {
+  ParamId id;
+  std::function<M3*(gnc::GncParams&)> matrix;
+  std::function<double*(gnc::GncParams&)> scalar;
+};
+
+std::vector<Field> fields() {
+  using P = gnc::GncParams;
+  auto m = [](ParamId id, std::function<M3*(P&)> f) { return Field{id, std::move(f), nullptr}; };
+  auto s = [](ParamId id, std::function<double*(P&)> f) { return Field{id, nullptr, std::move(f)}; };
+  return {
+      m(ParamId::kNtclK, [](P& p) { return &p.ntcl.k; }),
+      m(ParamId::kNtclLambda, [](P& p) { return &p.ntcl.lambda; }),
+      m(ParamId::kElK, [](P& p) { return &p.el.k; }),
+      m(ParamId::kElLambda, [](P& p) { return &p.el.lambda; }),
+      m(ParamId::kFeedforwardK, [](P& p) { return &p.feedforward.k; }),
+      m(ParamId::kFeedforwardLambda, [](P& p) { return &p.feedforward.lambda; }),
+      m(ParamId::kIntegralK, [](P& p) { return &p.integral.k; }),
+      m(ParamId::kIntegralLambda, [](P& p) { return &p.integral.lambda; }),
+      m(ParamId::kIntegralKi, [](P& p) { return &p.integral.k_i; }),
+      s(ParamId::kIntegralLimit, [](P& p) { return &p.integral.integral_limit_nm; }),
+      m(ParamId::kAdaptiveK, [](P& p) { return &p.adaptive.k; }),
+      m(ParamId::kAdaptiveLambda, [](P& p) { return &p.adaptive.lambda; }),
+      s(ParamId::kAdaptiveGamma, [](P& p) { return &p.adaptive.gamma; }),
+      s(ParamId::kAdaptiveEigFloor, [](P& p) { return &p.adaptive.eig_floor_ratio; }),
+      s(ParamId::kAdaptiveEigCeiling, [](P& p) { return &p.adaptive.eig_ceiling_ratio; }),
+      m(ParamId::kSo3K, [](P& p) { return &p.so3.k; }),
+      m(ParamId::kSo3Lambda, [](P& p) { return &p.so3.lambda; }),
+      m(ParamId::kDpdKd, [](P& p) { return &p.dpd.k_d; }),
+      s(ParamId::kDpdKp, [](P& p) { return &p.dpd.k_p; }),
+      s(ParamId::kOmegaSwitch, [](P& p) { return &p.guidance.omega_switch; }),
+      s(ParamId::kKqd, [](P& p) { return &p.guidance.k_qd; }),
+      s(ParamId::kEpsTrans, [](P& p) { return &p.guidance.eps_trans; }),
+      s(ParamId::kTrackResetPeriod, [](P& p) { return &p.guidance.track_reset_period_s; }),
+      s(ParamId::kSensorTimeout, [](P& p) { return &p.mode.sensor_timeout_s; }),
+      s(ParamId::kGyroMaxRate, [](P& p) { return &p.estimator.gyro_max_rate; }),
+      s(ParamId::kQuatNormTolerance, [](P& p) { return &p.estimator.quat_norm_tolerance; }),
+      s(ParamId::kEstimatorOmegaC, [](P& p) { return &p.estimator.omega_c; }),
+  };
+}
+
+TEST(ParamTable, EveryParameterIdLandsInItsField) {
+  const gnc::GncParams base = test::small_vehicle_params();
+  const auto all = fields();
+  ASSERT_EQ(static_cast<int>(all.size()) + 1, kParamCount);  // + the auto_hold flag
+  for (const Field& f : all) {
+    ParamTable t;
+    t.reset(base);
+    gnc::GncParams expected = base;
+    if (f.matrix) {
+      const M3 cur = *f.matrix(expected);
+      const V3 d = 1.25 * cur.diagonal();
+      ASSERT_TRUE(t.load(static_cast<int>(f.id), d.data(), 3).ok()) << param_specs()[int(f.id)].name;
+      *f.matrix(expected) = d.asDiagonal();
+      gnc::GncParams got = t.inactive();
+      EXPECT_TRUE(f.matrix(got)->isApprox(*f.matrix(expected), 0.0)) << param_specs()[int(f.id)].name;
+    } else {
+      // A value that keeps the table valid: scale towards the valid interior.
+      double v = *f.scalar(expected);
+      v = f.id == ParamId::kTrackResetPeriod ? 5.0 : (f.id == ParamId::kAdaptiveEigFloor ? 0.4 : 1.1 * v);
+      if (f.id == ParamId::kQuatNormTolerance) v = 0.02;
+      ASSERT_TRUE(t.load(static_cast<int>(f.id), &v, 1).ok()) << param_specs()[int(f.id)].name;
+      *f.scalar(expected) = v;
+      gnc::GncParams got = t.inactive();
+      EXPECT_EQ(*f.scalar(got), v) << param_specs()[int(f.id)].name;
+    }
+    EXPECT_TRUE(t.loaded());
+    EXPECT_TRUE(gnc::validate(t.inactive()).ok);
+  }
+  ParamTable t;
+  t.reset(base);
+  const double off = 0.0;
+  ASSERT_TRUE(t.load(static_cast<int>(ParamId::kAutoHold), &off, 1).ok());
+  EXPECT_FALSE(t.inactive().mode.auto_hold);
+}
+
+TEST(ParamTable, SixValuesLoadASymmetricMatrix) {
+  ParamTable t;
+  t.reset(test::small_vehicle_params());
+  const double v[6] = {5.0, 6.0, 7.0, 0.5, -0.25, 0.125};  // xx yy zz xy xz yz
+  ASSERT_TRUE(t.load(static_cast<int>(ParamId::kSo3K), v, 6).ok());
+  M3 expected;
+  expected << 5.0, 0.5, -0.25, 0.5, 6.0, 0.125, -0.25, 0.125, 7.0;
+  EXPECT_TRUE(t.inactive().so3.k.isApprox(expected, 0.0));
+}
+
+TEST(ParamTable, InvalidLoadNamesTheFirstBadFieldAndKeepsTheInactiveTable) {
+  ParamTable t;
+  const gnc::GncParams base = test::small_vehicle_params();
+  t.reset(base);
+  // Symmetric but indefinite: eigenvalues of [[1,3],[3,1]] are 4 and -2.
+  const double indefinite[6] = {1.0, 1.0, 1.0, 3.0, 0.0, 0.0};
+  ParamLoadResult r = t.load(static_cast<int>(ParamId::kNtclK), indefinite, 6);
+  EXPECT_EQ(r.reason, RejectReason::kInvalidTable);
+  EXPECT_STREQ(r.text, "ntcl.K");
+  EXPECT_FALSE(t.loaded());
+  EXPECT_TRUE(t.inactive().ntcl.k.isApprox(base.ntcl.k, 0.0));
+  // omega_switch must stay below eps_trans (1.0 for this vehicle).
+  double v = 2.0;
+  r = t.load(static_cast<int>(ParamId::kOmegaSwitch), &v, 1);
+  EXPECT_STREQ(r.text, "guidance.omega_switch");
+  // The sensor timeout must cover at least one GNC period (0.05 s).
+  v = 0.01;
+  r = t.load(static_cast<int>(ParamId::kSensorTimeout), &v, 1);
+  EXPECT_STREQ(r.text, "mode.sensor_timeout");
+  v = -3.0;
+  r = t.load(static_cast<int>(ParamId::kDpdKp), &v, 1);
+  EXPECT_STREQ(r.text, "dpd.k_p");
+  EXPECT_FALSE(t.loaded());
+  EXPECT_EQ(t.inactive().dpd.k_p, base.dpd.k_p);
+}
+
+TEST(ParamTable, CoupledFieldsLoadInAValidOrder) {
+  ParamTable t;
+  t.reset(test::small_vehicle_params());
+  double eps = 3.0;
+  double sw = 2.0;
+  // omega_switch = 2 first would exceed eps_trans = 1; raising eps_trans first keeps it valid.
+  EXPECT_FALSE(t.load(static_cast<int>(ParamId::kOmegaSwitch), &sw, 1).ok());
+  EXPECT_TRUE(t.load(static_cast<int>(ParamId::kEpsTrans), &eps, 1).ok());
+  EXPECT_TRUE(t.load(static_cast<int>(ParamId::kOmegaSwitch), &sw, 1).ok());
+}
+
+TEST(ParamTableActivation, TakesEffectAtTheNextTickBoundary) {
+  AppFixture f;
+  f.ticks(2);
+  const double kp_before = f.app->active_params().dpd.k_p;
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kDpdKp), 5.0}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kNtclK), 2.0, 3.0, 4.0}).accepted);
+  EXPECT_EQ(f.app->active_params().dpd.k_p, kp_before);  // loaded, not active
+  EXPECT_EQ(f.app->param_table().inactive().dpd.k_p, 5.0);
+  EXPECT_TRUE(f.app->health().table_loaded);
+  ASSERT_TRUE(f.send(Opcode::kParamActivate).accepted);
+  EXPECT_EQ(f.send(Opcode::kParamActivate).reason, RejectReason::kBusy);  // one at a time
+  EXPECT_EQ(f.app->active_params().dpd.k_p, kp_before);  // not before the boundary
+  f.ticks(1);
+  EXPECT_EQ(f.app->active_params().dpd.k_p, 5.0);
+  EXPECT_TRUE(f.app->active_params().ntcl.k.isApprox(V3(2.0, 3.0, 4.0).asDiagonal().toDenseMatrix(), 0.0));
+  EXPECT_FALSE(f.app->param_table().loaded());
+  EXPECT_EQ(f.app->param_table().inactive().dpd.k_p, 5.0);  // inactive := active
+  const HealthTelemetry h = f.app->health();
+  EXPECT_EQ(h.table_activations, 1u);
+  EXPECT_EQ(h.table_loads, 2u);
+  const std::vector<Event> ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kTableLoaded), 2);
+  EXPECT_EQ(test::count_events(ev, EventId::kTableActivated), 1);
+}
+
+TEST(ParamTableActivation, KeepsTheCommandedLawAndTarget) {
+  AppFixture f;
+  f.ticks(2);
+  ASSERT_TRUE(f.send(Opcode::kSetLaw, {static_cast<double>(static_cast<int>(gnc::LawId::kSo3))}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kSetTarget, {0.1, 0.2, -0.1}).accepted);
+  f.ticks(1);
+  ASSERT_EQ(f.app->active_params().law, gnc::LawId::kSo3);
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kKqd), 0.3}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamActivate).accepted);
+  f.ticks(1);
+  EXPECT_EQ(f.app->active_params().guidance.k_qd, 0.3);
+  EXPECT_EQ(f.app->active_params().law, gnc::LawId::kSo3);
+  // The flight core still holds the commanded target: attitude_error = q_hat - q_final.
+  EXPECT_TRUE((f.out.telemetry.q_hat - f.out.telemetry.attitude_error).isApprox(V3(0.1, 0.2, -0.1), 1e-12));
+}
+
+TEST(ParamTableActivation, LoadsAfterTheActivateCommandStayInTheInactiveTable) {
+  AppFixture f;
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kDpdKp), 5.0}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamActivate).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kDpdKp), 7.0}).accepted);
+  f.ticks(1);
+  EXPECT_EQ(f.app->active_params().dpd.k_p, 5.0);  // the table as it was when activated
+  EXPECT_TRUE(f.app->param_table().loaded());
+  EXPECT_EQ(f.app->param_table().inactive().dpd.k_p, 7.0);
+}
+
+TEST(ParamTableActivation, DiscardRestoresTheInactiveTableFromTheActiveOne) {
+  AppFixture f;
+  const double kp = f.app->active_params().dpd.k_p;
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kDpdKp), 5.0}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamDiscard).accepted);
+  EXPECT_FALSE(f.app->param_table().loaded());
+  EXPECT_EQ(f.app->param_table().inactive().dpd.k_p, kp);
+  EXPECT_EQ(f.send(Opcode::kParamActivate).reason, RejectReason::kNothingToActivate);
+}
+
+}  // namespace
+}  // namespace rocksteady::fsw

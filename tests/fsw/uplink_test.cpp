@@ -1,0 +1,186 @@
+// Trajectory uplink: reassembly from out-of-order chunks, a missing chunk, a CRC mismatch, bad
+// headers, and the hand-over to the flight core at the tick boundary.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "fsw/uplink/trajectory_uplink.hpp"
+#include "fsw_harness.hpp"
+
+namespace rocksteady::fsw {
+namespace {
+
+using test::AppFixture;
+using test::V3;
+
+struct Plan {
+  std::unique_ptr<gnc::TrajectoryTable> table = std::make_unique<gnc::TrajectoryTable>();
+  explicit Plan(int n = 70, double duration = 20.0) {
+    test::linear_despin_table(V3(0.05, -0.02, 0.01), duration, n, *table);
+  }
+};
+
+TEST(TrajectoryUplink, OutOfOrderChunksReassembleTheTable) {
+  Plan plan(70);  // 3 chunks: 32, 32, 6 samples
+  auto chunks = test::chunks_of(*plan.table, 4);
+  ASSERT_EQ(chunks.size(), 3u);
+  auto up = std::make_unique<TrajectoryUplink>();
+  ChunkResult r = up->receive(chunks[2]);
+  EXPECT_EQ(r.status, ChunkStatus::kStored);
+  EXPECT_TRUE(r.started);
+  EXPECT_EQ(up->receive(chunks[0]).status, ChunkStatus::kStored);
+  EXPECT_EQ(up->receive(chunks[0]).status, ChunkStatus::kStored);  // a repeat is harmless
+  EXPECT_FALSE(up->complete());
+  EXPECT_EQ(up->chunks_received(), 2);
+  r = up->receive(chunks[1]);
+  EXPECT_TRUE(r.completed);
+  ASSERT_TRUE(up->complete());
+  ASSERT_EQ(up->finalize(plan.table->samples[0].omega_d.norm() + 1.0), gnc::TrajectoryError::kOk);
+  const gnc::TrajectoryTable& got = up->table();
+  ASSERT_EQ(got.count, 70);
+  for (int i = 0; i < 70; ++i) {
+    EXPECT_EQ(got.samples[i].t, plan.table->samples[i].t) << i;
+    EXPECT_EQ(got.samples[i].omega_d, plan.table->samples[i].omega_d) << i;
+    EXPECT_EQ(got.samples[i].omega_d_dot, plan.table->samples[i].omega_d_dot) << i;
+  }
+}
+
+TEST(TrajectoryUplink, BadChunkHeadersAreRejected) {
+  Plan plan(70);
+  const auto chunks = test::chunks_of(*plan.table, 1);
+  auto up = std::make_unique<TrajectoryUplink>();
+  TrajectoryChunk c = chunks[0];
+  c.chunk_count = 2;  // 70 samples need 3 chunks
+  EXPECT_EQ(up->receive(c).status, ChunkStatus::kBadHeader);
+  c = chunks[0];
+  c.total_samples = gnc::kMaxTrajectorySamples + 1;
+  EXPECT_EQ(up->receive(c).status, ChunkStatus::kBadHeader);
+  c = chunks[0];
+  c.upload_id = -2;
+  EXPECT_EQ(up->receive(c).status, ChunkStatus::kBadHeader);
+  c = chunks[0];
+  c.chunk_index = 3;
+  EXPECT_EQ(up->receive(c).status, ChunkStatus::kBadIndex);
+  c = chunks[2];
+  c.n = 32;  // the last chunk carries the remaining 6
+  EXPECT_EQ(up->receive(c).status, ChunkStatus::kBadCount);
+  EXPECT_FALSE(up->active());
+  ASSERT_EQ(up->receive(chunks[0]).status, ChunkStatus::kStored);
+  c = chunks[1];
+  c.crc32 ^= 1u;  // same upload id, different table
+  EXPECT_EQ(up->receive(c).status, ChunkStatus::kHeaderMismatch);
+}
+
+TEST(TrajectoryUplinkApp, LoadHandsTheTableToTheCoreAtTheTickBoundary) {
+  AppFixture f;
+  f.ticks(2);
+  Plan plan(70);
+  const auto chunks = test::chunks_of(*plan.table, 9);
+  for (int i : {1, 2, 0}) ASSERT_EQ(f.app->receive_chunk(chunks[i]), ChunkStatus::kStored);
+  HealthTelemetry h = f.app->health();
+  EXPECT_EQ(h.uplink_id, 9);
+  EXPECT_EQ(h.uplink_chunks_received, 3);
+  const CommandAck a = f.send(Opcode::kLoadTrajectory, {9.0});
+  ASSERT_TRUE(a.accepted) << a.text;
+  EXPECT_FALSE(f.app->trajectory_loaded());
+  // While the validated table waits for the boundary, chunks are refused.
+  EXPECT_EQ(f.app->receive_chunk(chunks[0]), ChunkStatus::kBusy);
+  EXPECT_EQ(f.send(Opcode::kLoadTrajectory, {9.0}).reason, RejectReason::kBusy);
+  // TRACK is already allowed: the trajectory will be there when the request is applied.
+  EXPECT_TRUE(f.send(Opcode::kSetLaw, {0.0, 2.0}).accepted);
+  f.ticks(1);
+  EXPECT_TRUE(f.app->trajectory_loaded());
+  EXPECT_TRUE(f.out.telemetry.trajectory_loaded);
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  h = f.app->health();
+  EXPECT_EQ(h.trajectories_loaded, 1u);
+  EXPECT_EQ(h.uplink_id, -1);
+  const auto ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kUplinkStarted), 1);
+  EXPECT_EQ(test::count_events(ev, EventId::kUplinkComplete), 1);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryLoaded), 1);
+  EXPECT_EQ(test::count_events(ev, EventId::kChunkRejected), 1);
+}
+
+TEST(TrajectoryUplinkApp, MissingChunkBlocksTheLoadAndTrack) {
+  AppFixture f;
+  f.ticks(2);
+  Plan plan(70);
+  const auto chunks = test::chunks_of(*plan.table, 3);
+  f.app->receive_chunk(chunks[0]);
+  f.app->receive_chunk(chunks[2]);
+  const CommandAck a = f.send(Opcode::kLoadTrajectory, {3.0});
+  EXPECT_EQ(a.reason, RejectReason::kUploadIncomplete);
+  EXPECT_EQ(a.detail, 2);  // chunks received
+  EXPECT_EQ(f.send(Opcode::kSetMode, {3.0}).detail,
+            static_cast<std::int32_t>(gnc::TransitionCheck::kNoTrajectory));
+  // The missing chunk arrives: now it loads.
+  f.app->receive_chunk(chunks[1]);
+  EXPECT_TRUE(f.send(Opcode::kLoadTrajectory, {3.0}).accepted);
+}
+
+TEST(TrajectoryUplinkApp, CrcMismatchRejectsTheTable) {
+  AppFixture f;
+  f.ticks(2);
+  Plan plan(70);
+  auto chunks = test::chunks_of(*plan.table, 5);
+  chunks[1].samples[7].omega_d.x() += 1e-9;  // one corrupted value; the CRC is of the original
+  for (const auto& c : chunks) f.app->receive_chunk(c);
+  const CommandAck a = f.send(Opcode::kLoadTrajectory, {5.0});
+  EXPECT_EQ(a.reason, RejectReason::kTrajectoryRejected);
+  EXPECT_EQ(a.detail, static_cast<std::int32_t>(gnc::TrajectoryError::kBadChecksum));
+  EXPECT_FALSE(f.app->uplink().active());  // discarded: the ground sends it again
+  f.ticks(1);
+  EXPECT_FALSE(f.app->trajectory_loaded());
+  const auto ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryRejected), 1);
+}
+
+TEST(TrajectoryUplinkApp, ANewUploadAbandonsAnUnfinishedOneAndAbortDiscards) {
+  AppFixture f;
+  Plan a(70);
+  Plan b(40);
+  const auto ca = test::chunks_of(*a.table, 1);
+  const auto cb = test::chunks_of(*b.table, 2);
+  f.app->receive_chunk(ca[0]);
+  f.app->receive_chunk(cb[1]);
+  EXPECT_EQ(f.app->uplink().upload_id(), 2);
+  EXPECT_EQ(f.app->uplink().chunks_received(), 1);
+  EXPECT_EQ(f.send(Opcode::kAbortUplink, {1.0}).reason, RejectReason::kOutOfRange);
+  EXPECT_TRUE(f.send(Opcode::kAbortUplink, {2.0}).accepted);
+  EXPECT_FALSE(f.app->uplink().active());
+  const auto ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kUplinkAbandoned), 2);  // replaced, then aborted
+}
+
+TEST(TrajectoryUplinkApp, TrackCannotHaveItsTableReplaced) {
+  AppFixture f;
+  f.ticks(2);
+  Plan plan(70);
+  for (const auto& c : test::chunks_of(*plan.table, 1)) f.app->receive_chunk(c);
+  ASSERT_TRUE(f.send(Opcode::kLoadTrajectory, {1.0}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kSetMode, {3.0}).accepted);
+  f.ticks(1);
+  ASSERT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  // A second plan can be uplinked while tracking, but not loaded.
+  for (const auto& c : test::chunks_of(*plan.table, 2)) {
+    EXPECT_EQ(f.app->receive_chunk(c), ChunkStatus::kStored);
+  }
+  EXPECT_EQ(f.send(Opcode::kLoadTrajectory, {2.0}).reason, RejectReason::kNotAllowedInMode);
+  EXPECT_EQ(f.send(Opcode::kSetTarget, {0.1, 0.0, 0.0}).reason, RejectReason::kNotAllowedInMode);
+  const CommandAck dpd = f.send(Opcode::kSetLaw, {5.0});
+  EXPECT_EQ(dpd.reason, RejectReason::kNotAllowedInMode);
+  EXPECT_EQ(dpd.detail, static_cast<std::int32_t>(gnc::TransitionCheck::kLawCannotTrack));
+  // D+PD with its own reference: leave TRACK for DETUMBLE first, the law follows a tick later.
+  ASSERT_TRUE(f.send(Opcode::kSetLaw, {5.0, 1.0}).accepted);
+  f.ticks(1);
+  // At rest, DETUMBLE hands over to HOLD in the same tick (auto-hold at omega_switch).
+  EXPECT_TRUE(f.app->mode() == gnc::Mode::kDetumble || f.app->mode() == gnc::Mode::kHold);
+  EXPECT_EQ(f.app->active_params().law, gnc::LawId::kNtcl);
+  f.ticks(1);
+  EXPECT_EQ(f.app->active_params().law, gnc::LawId::kDpd);
+  EXPECT_TRUE(f.send(Opcode::kLoadTrajectory, {2.0}).accepted);
+}
+
+}  // namespace
+}  // namespace rocksteady::fsw
