@@ -1,0 +1,156 @@
+// rocksteady-plan: plans the fuel-optimal despin (SPEC Eq. 44) for a study case's estimated model and
+// writes the reference-trajectory file. Failure to converge or to verify is an error exit, never a
+// file.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "ground/planner/cache.hpp"
+#include "ground/planner/planner.hpp"
+#include "ground/planner/trajectory_file.hpp"
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
+#ifdef ROCKSTEADY_PLANNER_WITH_CONFIG
+#include "ground/config/config.hpp"
+#endif
+
+namespace planner = rocksteady::ground::planner;
+
+namespace {
+
+void report(const planner::PlanResult& r) {
+  const planner::Verification& v = r.verification;
+  std::printf("fuel            %.4f kg  (int |u|_1 dt = %.1f N s)\n", r.fuel_kg, r.cost_ns);
+  std::printf("t_final         %.2f s  (range [%.2f, %.2f] s)\n", r.t_final, r.t_final_min,
+              r.t_final_max);
+  std::printf("grid            %d nodes, %zu samples (Hermite-Simpson)\n", r.nodes,
+              r.samples.size());
+  std::printf("iterations      %d\n", r.iterations);
+  std::printf("solve time      %.3f s\n", r.solve_seconds);
+  std::printf("max defect      %.3g rad/s\n", v.max_defect);
+  std::printf("open loop       max error %.3g rad/s, final rate %.3g rad/s\n", v.propagation_error,
+              v.propagated_final_rate);
+  if (v.refinement_checked) {
+    std::printf("refined grid    %.4f kg (change %.4f %%)\n", v.refined_fuel_kg,
+                100.0 * v.refinement_change);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Plan the fuel-optimal despin (SPEC Eq. 44) for the estimated model of a study case"};
+  double u_max = 200.0;
+  double delta_j = 0.0;
+  double delta_r = 0.0;
+  std::string case_name = "custom";
+  std::string output;
+  std::string cache_dir;
+  std::string check_file;
+  std::string mission_file;
+  std::string gnc_file;
+  std::string case_file;
+  bool no_refinement = false;
+  bool verbose = false;
+  planner::PlanSettings settings;
+  app.add_option("--u-max", u_max, "per-channel force limit u_max (N), SPEC Table 3")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--delta-j", delta_j, "||dJ_ast||_2 (kg m^2): J_ast_hat = J_ast - dJ diag(-1,1,0.5)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--delta-r", delta_r, "||dr_SO/BCM||_2 (m): r_hat = r - dr [1,1,1]/sqrt(3)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--case-name", case_name, "case name recorded in the file");
+  app.add_option("--nodes", settings.nodes, "grid nodes N (2N-1 samples)")->check(CLI::Range(3, 512));
+  app.add_option("--t-final-max", settings.t_final_max,
+                 "final time (fixed) or its upper bound (free), s; default 8x the shortest despin");
+  app.add_option("--t-final-min", settings.t_final_min, "lower bound of a free final time, s");
+  app.add_flag("--free-final-time", settings.free_final_time, "let t_f float in [min, max]");
+  app.add_flag("--no-refinement", no_refinement, "skip the grid-refinement check");
+  app.add_option("-o,--output", output, "trajectory file to write");
+  app.add_option("--cache-dir", cache_dir, "plan-once cache directory (file named by problem hash)");
+  app.add_option("--check", check_file, "load and verify an existing trajectory file instead");
+  app.add_flag("-v,--verbose", verbose, "IPOPT iteration log");
+#ifdef ROCKSTEADY_PLANNER_WITH_CONFIG
+  app.add_option("--mission", mission_file, "mission YAML (with --gnc and --case)");
+  app.add_option("--gnc", gnc_file, "GNC YAML");
+  app.add_option("--case", case_file, "case YAML: takes the model from the configuration");
+#endif
+  CLI11_PARSE(app, argc, argv);
+  settings.verify_refinement = !no_refinement;
+  if (verbose) settings.print_level = 5;
+
+  planner::PlanProblem problem;
+  problem.case_name = case_name;
+  problem.settings = settings;
+  try {
+    if (!case_file.empty() || !mission_file.empty() || !gnc_file.empty()) {
+#ifdef ROCKSTEADY_PLANNER_WITH_CONFIG
+      if (case_file.empty() || mission_file.empty() || gnc_file.empty()) {
+        std::fprintf(stderr, "error: --mission, --gnc and --case go together\n");
+        return 2;
+      }
+      const auto mission = rocksteady::config::load_mission(mission_file);
+      const auto run = rocksteady::config::assemble(
+          mission, rocksteady::config::load_gnc(gnc_file), rocksteady::config::load_case(case_file));
+      problem.case_name = run.case_name;
+      problem.model.j_hat = rocksteady::gnc::total_inertia(run.flight.mass_hat);
+      problem.model.b_hat =
+          rocksteady::gnc::torque_matrix(run.flight.rcs, run.flight.mass_hat.r_so_bcm);
+      problem.model.u_max = run.flight.rcs.u_max;
+      problem.model.eps_trans = run.flight.guidance.eps_trans;
+      problem.model.omega_init = mission.initial_omega;
+#endif
+    } else {
+      problem.model = planner::study_case_model(u_max, delta_j, delta_r);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
+
+  if (!check_file.empty()) {
+    const planner::LoadResult loaded = planner::load_trajectory_file(check_file, problem.model);
+    if (!loaded.ok) {
+      std::fprintf(stderr, "rejected: %s\n", loaded.error.c_str());
+      return 1;
+    }
+    std::printf("%s: valid plan for case '%s': fuel %.4f kg, t_final %.2f s, %zu samples\n",
+                check_file.c_str(), loaded.file.case_name.c_str(), loaded.file.fuel_kg,
+                loaded.file.t_final, loaded.file.samples.size());
+    return 0;
+  }
+
+  if (!cache_dir.empty()) {
+    const planner::CachedPlan c = planner::plan_cached(problem, cache_dir);
+    if (!c.note.empty()) std::printf("note: %s\n", c.note.c_str());
+    if (!c.ok) {
+      std::fprintf(stderr, "error: %s\n", c.error.c_str());
+      return 1;
+    }
+    std::printf("%s %s: fuel %.4f kg, t_final %.2f s, %d iterations, %.3f s\n",
+                c.from_cache ? "cached" : "planned", c.path.c_str(), c.file.fuel_kg,
+                c.file.t_final, c.file.iterations, c.file.solve_seconds);
+    return 0;
+  }
+  if (output.empty()) {
+    std::fprintf(stderr, "error: give -o FILE or --cache-dir DIR\n");
+    return 2;
+  }
+  const planner::PlanResult result = planner::plan(problem);
+  if (!result.ok) {
+    std::fprintf(stderr, "error: case '%s': %s (no file written)\n", problem.case_name.c_str(),
+                 result.error.c_str());
+    return 1;
+  }
+  report(result);
+  try {
+    planner::write_trajectory_file(output, problem, result);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  std::printf("wrote %s\n", output.c_str());
+  return 0;
+}

@@ -1,0 +1,531 @@
+#include "ground/planner/planner.hpp"
+
+#include <Eigen/Dense>
+#include <IpIpoptApplication.hpp>
+#include <IpSolveStatistics.hpp>
+#include <IpTNLP.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+
+#include "ground/planner/transcription.hpp"
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
+
+namespace rocksteady::ground::planner {
+
+namespace {
+
+Vec3 dynamics(const PlanModel& model, const Mat3& j_inv, const Vec3& omega, const Vec8& u) {
+  const Vec3 j_omega = model.j_hat * omega;
+  return j_inv * (j_omega.cross(omega) + model.b_hat * u);  // Eq. (41)
+}
+
+// IPOPT adapter around the solver-independent transcription.
+class DespinTnlp : public Ipopt::TNLP {
+ public:
+  DespinTnlp(const HermiteSimpsonNlp& nlp, std::vector<double> x0)
+      : nlp_(nlp), x0_(std::move(x0)) {
+    nlp_.bounds(x_lo_, x_hi_, g_lo_, g_hi_);
+  }
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g,
+                    Ipopt::Index& nnz_h_lag, IndexStyleEnum& index_style) override {
+    n = nlp_.num_variables();
+    m = nlp_.num_constraints();
+    nnz_jac_g = static_cast<Ipopt::Index>(nlp_.jacobian_pattern().rows.size());
+    nnz_h_lag = static_cast<Ipopt::Index>(nlp_.hessian_pattern().rows.size());
+    index_style = C_STYLE;
+    return true;
+  }
+
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index m,
+                       Ipopt::Number* g_l, Ipopt::Number* g_u) override {
+    std::copy(x_lo_.begin(), x_lo_.begin() + n, x_l);
+    std::copy(x_hi_.begin(), x_hi_.begin() + n, x_u);
+    std::copy(g_lo_.begin(), g_lo_.begin() + m, g_l);
+    std::copy(g_hi_.begin(), g_hi_.begin() + m, g_u);
+    return true;
+  }
+
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z,
+                          Ipopt::Number* /*z_l*/, Ipopt::Number* /*z_u*/, Ipopt::Index /*m*/,
+                          bool init_lambda, Ipopt::Number* /*lambda*/) override {
+    if (!init_x || init_z || init_lambda) return false;
+    std::copy(x0_.begin(), x0_.begin() + n, x);
+    return true;
+  }
+
+  bool eval_f(Ipopt::Index /*n*/, const Ipopt::Number* x, bool /*new_x*/,
+              Ipopt::Number& obj) override {
+    obj = nlp_.objective(x);
+    return std::isfinite(obj);
+  }
+  bool eval_grad_f(Ipopt::Index /*n*/, const Ipopt::Number* x, bool /*new_x*/,
+                   Ipopt::Number* grad) override {
+    nlp_.objective_gradient(x, grad);
+    return true;
+  }
+  bool eval_g(Ipopt::Index /*n*/, const Ipopt::Number* x, bool /*new_x*/, Ipopt::Index /*m*/,
+              Ipopt::Number* g) override {
+    nlp_.constraints(x, g);
+    return true;
+  }
+  bool eval_jac_g(Ipopt::Index /*n*/, const Ipopt::Number* x, bool /*new_x*/, Ipopt::Index /*m*/,
+                  Ipopt::Index nele, Ipopt::Index* irow, Ipopt::Index* jcol,
+                  Ipopt::Number* values) override {
+    if (values == nullptr) {
+      const SparsityPattern& p = nlp_.jacobian_pattern();
+      std::copy(p.rows.begin(), p.rows.begin() + nele, irow);
+      std::copy(p.cols.begin(), p.cols.begin() + nele, jcol);
+    } else {
+      nlp_.jacobian_values(x, values);
+    }
+    return true;
+  }
+  bool eval_h(Ipopt::Index /*n*/, const Ipopt::Number* x, bool /*new_x*/, Ipopt::Number obj_factor,
+              Ipopt::Index /*m*/, const Ipopt::Number* lambda, bool /*new_lambda*/,
+              Ipopt::Index nele, Ipopt::Index* irow, Ipopt::Index* jcol,
+              Ipopt::Number* values) override {
+    if (values == nullptr) {
+      const SparsityPattern& p = nlp_.hessian_pattern();
+      std::copy(p.rows.begin(), p.rows.begin() + nele, irow);
+      std::copy(p.cols.begin(), p.cols.begin() + nele, jcol);
+    } else {
+      nlp_.hessian_values(x, obj_factor, lambda, values);
+    }
+    return true;
+  }
+
+  void finalize_solution(Ipopt::SolverReturn status, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number* /*z_l*/, const Ipopt::Number* /*z_u*/,
+                         Ipopt::Index /*m*/, const Ipopt::Number* /*g*/,
+                         const Ipopt::Number* /*lambda*/, Ipopt::Number obj_value,
+                         const Ipopt::IpoptData* /*ip_data*/,
+                         Ipopt::IpoptCalculatedQuantities* /*ip_cq*/) override {
+    status_ = status;
+    x_.assign(x, x + n);
+    objective_ = obj_value;
+  }
+
+  Ipopt::SolverReturn status() const { return status_; }
+  const std::vector<double>& solution() const { return x_; }
+  double objective() const { return objective_; }
+
+ private:
+  const HermiteSimpsonNlp& nlp_;
+  std::vector<double> x0_;
+  std::vector<double> x_lo_, x_hi_, g_lo_, g_hi_;
+  std::vector<double> x_;
+  double objective_{0.0};
+  Ipopt::SolverReturn status_{Ipopt::INTERNAL_ERROR};
+};
+
+const char* status_text(Ipopt::SolverReturn s) {
+  switch (s) {
+    case Ipopt::SUCCESS: return "optimal solution found";
+    case Ipopt::MAXITER_EXCEEDED: return "maximum number of iterations exceeded";
+    case Ipopt::CPUTIME_EXCEEDED: return "CPU time limit exceeded";
+    case Ipopt::STOP_AT_TINY_STEP: return "stopped at a tiny step";
+    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return "stopped at an acceptable (not optimal) point";
+    case Ipopt::LOCAL_INFEASIBILITY: return "converged to a point of local infeasibility";
+    case Ipopt::USER_REQUESTED_STOP: return "stopped by the user";
+    case Ipopt::FEASIBLE_POINT_FOUND: return "feasible point found";
+    case Ipopt::DIVERGING_ITERATES: return "iterates diverging";
+    case Ipopt::RESTORATION_FAILURE: return "restoration phase failed";
+    case Ipopt::ERROR_IN_STEP_COMPUTATION: return "error in step computation";
+    case Ipopt::INVALID_NUMBER_DETECTED: return "invalid number detected";
+    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return "too few degrees of freedom";
+    case Ipopt::INVALID_OPTION: return "invalid option";
+    case Ipopt::OUT_OF_MEMORY: return "out of memory";
+    case Ipopt::INTERNAL_ERROR: return "internal error";
+    default: return "unknown IPOPT status";
+  }
+}
+
+struct SolveOutcome {
+  bool ok{false};
+  std::string error;
+  int iterations{0};
+  double seconds{0.0};
+  double cost_ns{0.0};
+  double t_final{0.0};
+  std::vector<PlanSample> samples;
+};
+
+// Initial guess [Rocksteady choice]: a dynamically consistent despin that removes the momentum at a
+// constant rate. The torque is -(|H0|/t_f) e, with e the unit momentum direction in the body, so
+// H = |H0| (1 - t/t_f) e reaches zero exactly at t_f while e turns with the body (de/dt = e x omega,
+// from Eq. 41). u is the minimum-norm control of that torque, clipped to u_max.
+std::vector<double> momentum_ramp_guess(const HermiteSimpsonNlp& nlp, const PlanModel& model) {
+  std::vector<double> x(nlp.num_variables(), 0.0);
+  const double t_f = nlp.t_scale();
+  nlp.set_t_final(x.data(), t_f);
+  const Eigen::Matrix<double, 8, 3> b_pinv =
+      model.b_hat.transpose() * (model.b_hat * model.b_hat.transpose()).inverse();
+  const Mat3 j_inv = model.j_hat.inverse();
+  const Vec3 h0 = model.j_hat * model.omega_init;
+  const double h0_norm = h0.norm();
+  const auto e_dot = [&](double t, const Vec3& e) -> Vec3 {
+    const Vec3 omega = h0_norm * (1.0 - t / t_f) * (j_inv * e);
+    return e.cross(omega);
+  };
+  const int p = nlp.num_points();
+  const double dt_point = t_f / (p - 1);
+  constexpr int kSubsteps = 16;
+  Vec3 e = h0 / h0_norm;
+  for (int j = 0; j < p; ++j) {
+    const double t = j * dt_point;
+    const Vec3 omega = h0_norm * (1.0 - t / t_f) * (j_inv * e);
+    const Vec8 u = (b_pinv * (-h0_norm / t_f * e)).cwiseMax(-model.u_max).cwiseMin(model.u_max);
+    nlp.set_point(x.data(), j, j == 0 ? model.omega_init : omega, u);
+    const double dt = dt_point / kSubsteps;
+    for (int k = 0; k < kSubsteps; ++k) {  // RK4 on e, renormalised
+      const double tk = t + k * dt;
+      const Vec3 k1 = e_dot(tk, e);
+      const Vec3 k2 = e_dot(tk + 0.5 * dt, e + 0.5 * dt * k1);
+      const Vec3 k3 = e_dot(tk + 0.5 * dt, e + 0.5 * dt * k2);
+      const Vec3 k4 = e_dot(tk + dt, e + dt * k3);
+      e = (e + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)).normalized();
+    }
+  }
+  return x;
+}
+
+// Guess on a finer grid from a coarser plan's samples (linear interpolation in normalised time).
+std::vector<double> guess_from_samples(const HermiteSimpsonNlp& nlp,
+                                       const std::vector<PlanSample>& samples) {
+  std::vector<double> x(nlp.num_variables(), 0.0);
+  const double t_f = samples.back().t;
+  nlp.set_t_final(x.data(), t_f);
+  const int p = nlp.num_points();
+  std::size_t k = 0;
+  for (int j = 0; j < p; ++j) {
+    const double t = t_f * j / (p - 1);
+    while (k + 2 < samples.size() && samples[k + 1].t < t) ++k;
+    const PlanSample& a = samples[k];
+    const PlanSample& b = samples[k + 1];
+    const double s = std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0);
+    nlp.set_point(x.data(), j, (1 - s) * a.omega_d + s * b.omega_d, (1 - s) * a.u_d + s * b.u_d);
+  }
+  return x;
+}
+
+SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, int nodes, double t_min,
+                   double t_max, const std::vector<PlanSample>* warm) {
+  SolveOutcome out;
+  TranscriptionModel tm;
+  tm.j_hat = model.j_hat;
+  tm.b_hat = model.b_hat;
+  tm.u_max = model.u_max;
+  tm.eps_trans = model.eps_trans;
+  tm.omega_init = model.omega_init;
+  tm.nodes = nodes;
+  tm.t_final_min = t_min;
+  tm.t_final_max = t_max;
+  const HermiteSimpsonNlp nlp(tm);
+  std::vector<double> x0 =
+      warm != nullptr ? guess_from_samples(nlp, *warm) : momentum_ramp_guess(nlp, model);
+
+  Ipopt::SmartPtr<DespinTnlp> tnlp = new DespinTnlp(nlp, std::move(x0));
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->Options()->SetIntegerValue("print_level", settings.print_level);
+  if (settings.print_level >= 5) app->Options()->SetStringValue("print_timing_statistics", "yes");
+  app->Options()->SetStringValue("sb", "yes");
+  app->Options()->SetNumericValue("tol", settings.tolerance);
+  app->Options()->SetNumericValue("constr_viol_tol", 1e-10);
+  app->Options()->SetIntegerValue("max_iter", settings.max_iterations);
+  app->Options()->SetNumericValue("bound_relax_factor", 0.0);  // bounds hold exactly
+  app->Options()->SetStringValue("mu_strategy", "adaptive");
+  app->Options()->SetStringValue("hessian_approximation", "exact");
+  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+    out.error = "IPOPT failed to initialise";
+    return out;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Ipopt::SmartPtr<Ipopt::SolveStatistics> stats = app->Statistics();
+  if (Ipopt::IsValid(stats)) out.iterations = stats->IterationCount();
+  if (status != Ipopt::Solve_Succeeded || tnlp->status() != Ipopt::SUCCESS) {
+    std::ostringstream msg;
+    msg << "IPOPT did not converge (" << status_text(tnlp->status()) << ", " << out.iterations
+        << " iterations, " << nodes << " nodes)";
+    out.error = msg.str();
+    return out;
+  }
+  const std::vector<double>& x = tnlp->solution();
+  out.t_final = nlp.t_final(x.data());
+  out.cost_ns = nlp.cost_scale() * nlp.objective(x.data());
+  const Mat3 j_inv = model.j_hat.inverse();
+  const int p = nlp.num_points();
+  out.samples.resize(p);
+  for (int j = 0; j < p; ++j) {
+    PlanSample& s = out.samples[j];
+    s.t = out.t_final * j / (p - 1);
+    s.omega_d = nlp.omega(x.data(), j);
+    s.u_d = nlp.control(x.data(), j);
+  }
+  out.samples.front().omega_d = model.omega_init;  // exact boundary values, Eq. (43)
+  out.samples.back().omega_d = Vec3::Zero();
+  out.samples.back().t = out.t_final;
+  for (PlanSample& s : out.samples) s.omega_d_dot = dynamics(model, j_inv, s.omega_d, s.u_d);
+  out.ok = true;
+  return out;
+}
+
+void check_model(const PlanModel& m, int nodes) {
+  if (!m.j_hat.allFinite() || !m.b_hat.allFinite() || !m.omega_init.allFinite() ||
+      !std::isfinite(m.u_max) || !std::isfinite(m.eps_trans)) {
+    throw std::invalid_argument("model has non-finite entries");
+  }
+  if ((m.j_hat - m.j_hat.transpose()).norm() > 1e-9 * m.j_hat.norm()) {
+    throw std::invalid_argument("J_hat is not symmetric");
+  }
+  if (Eigen::SelfAdjointEigenSolver<Mat3>(m.j_hat).eigenvalues().minCoeff() <= 0.0) {
+    throw std::invalid_argument("J_hat is not positive definite");
+  }
+  const Mat3 bbt = m.b_hat * m.b_hat.transpose();
+  if (Eigen::SelfAdjointEigenSolver<Mat3>(bbt).eigenvalues().minCoeff() <= 1e-12 * bbt.norm()) {
+    throw std::invalid_argument("B_hat does not have full rank: some torque direction is missing");
+  }
+  if (!(m.u_max > 0.0) || !(m.eps_trans > 0.0)) {
+    throw std::invalid_argument("u_max and eps_trans must be positive");
+  }
+  if (m.omega_init.norm() > m.eps_trans) {
+    throw std::invalid_argument("|omega_init| exceeds eps_trans: Eq. (43) is infeasible at t = 0");
+  }
+  if (m.omega_init.norm() == 0.0) throw std::invalid_argument("omega_init is already at rest");
+  if (nodes < 3 || 2 * nodes - 1 > gnc::kMaxTrajectorySamples) {
+    std::ostringstream msg;
+    msg << "nodes must be in [3, " << (gnc::kMaxTrajectorySamples + 1) / 2
+        << "] (2N-1 samples fit the on-board table)";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+}  // namespace
+
+void resolve_final_time_bounds(const PlanModel& model, const PlanSettings& settings, double& t_min,
+                               double& t_max) {
+  double torque_bound = 0.0;
+  for (int i = 0; i < gnc::kChannels; ++i) torque_bound += model.b_hat.col(i).norm();
+  torque_bound *= model.u_max;
+  const double t_lower = (model.j_hat * model.omega_init).norm() / torque_bound;
+  t_max = settings.t_final_max > 0.0 ? settings.t_final_max : kHorizonFactor * t_lower;
+  if (!settings.free_final_time) {
+    t_min = t_max;  // fixed final time (see planner.hpp)
+  } else {
+    t_min = settings.t_final_min > 0.0 ? settings.t_final_min : t_lower;
+  }
+}
+
+Verification verify_samples(const PlanModel& model, const std::vector<PlanSample>& samples,
+                            double propagation_limit) {
+  Verification v;
+  const auto fail = [&v](const std::string& why) {
+    if (v.failure.empty()) v.failure = why;
+  };
+  if (samples.size() < 3 || samples.size() % 2 == 0) {
+    v.failure = "sample count must be odd and >= 3 (nodes and midpoints)";
+    return v;
+  }
+  const Mat3 j_inv = model.j_hat.inverse();
+  const double w0 = model.omega_init.norm();
+  const std::size_t p = samples.size();
+  std::vector<Vec3> f(p);
+  for (std::size_t j = 0; j < p; ++j) {
+    const PlanSample& s = samples[j];
+    f[j] = dynamics(model, j_inv, s.omega_d, s.u_d);
+    v.max_rate_excess = std::max(v.max_rate_excess, s.omega_d.norm() - model.eps_trans);
+    v.max_control_excess =
+        std::max(v.max_control_excess, s.u_d.cwiseAbs().maxCoeff() - model.u_max);
+  }
+  // Hermite-Simpson defects from the samples themselves (independent of the NLP's scaling).
+  for (std::size_t a = 0; a + 2 < p; a += 2) {
+    const PlanSample& sa = samples[a];
+    const PlanSample& sm = samples[a + 1];
+    const PlanSample& sb = samples[a + 2];
+    const double h = sb.t - sa.t;
+    const Vec3 d1 = sm.omega_d - 0.5 * (sa.omega_d + sb.omega_d) - h / 8.0 * (f[a] - f[a + 2]);
+    const Vec3 d2 = sb.omega_d - sa.omega_d - h / 6.0 * (f[a] + 4.0 * f[a + 1] + f[a + 2]);
+    v.max_defect = std::max({v.max_defect, d1.norm(), d2.norm()});
+  }
+  v.boundary_error = (samples.front().omega_d - model.omega_init).norm() +
+                     samples.back().omega_d.norm();
+
+  // Open-loop propagation of u_d (quadratic through the node, midpoint, node values, the control
+  // interpolant that Hermite-Simpson integrates exactly) with classical RK4, 32 steps per interval.
+  Vec3 omega = model.omega_init;
+  constexpr int kSteps = 32;
+  for (std::size_t a = 0; a + 2 < p; a += 2) {
+    const double ta = samples[a].t;
+    const double h = samples[a + 2].t - ta;
+    const Vec8& ua = samples[a].u_d;
+    const Vec8& um = samples[a + 1].u_d;
+    const Vec8& ub = samples[a + 2].u_d;
+    const auto u_at = [&](double t) -> Vec8 {
+      const double s = (t - ta) / h;  // Lagrange basis on s = 0, 1/2, 1
+      return (2 * s - 1) * (s - 1) * ua + 4 * s * (1 - s) * um + s * (2 * s - 1) * ub;
+    };
+    const double dt = h / kSteps;
+    for (int k = 0; k < kSteps; ++k) {
+      const double t = ta + k * dt;
+      const Vec3 k1 = dynamics(model, j_inv, omega, u_at(t));
+      const Vec3 k2 = dynamics(model, j_inv, omega + 0.5 * dt * k1, u_at(t + 0.5 * dt));
+      const Vec3 k3 = dynamics(model, j_inv, omega + 0.5 * dt * k2, u_at(t + 0.5 * dt));
+      const Vec3 k4 = dynamics(model, j_inv, omega + dt * k3, u_at(t + dt));
+      omega += dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+      if (k + 1 == kSteps / 2) {
+        v.propagation_error =
+            std::max(v.propagation_error, (omega - samples[a + 1].omega_d).norm());
+      }
+    }
+    v.propagation_error = std::max(v.propagation_error, (omega - samples[a + 2].omega_d).norm());
+  }
+  v.propagated_final_rate = omega.norm();
+
+  // Tolerances [Rocksteady choice]: the NLP is solved to 1e-9 (scaled), so defects, bounds and
+  // boundary values are at round-off; the propagation limit covers the transcription error.
+  if (!(v.max_defect <= 1e-7 * w0)) fail("dynamics defects above tolerance");
+  if (!(v.max_rate_excess <= 1e-9 * model.eps_trans)) fail("|omega_d| exceeds eps_trans");
+  if (!(v.max_control_excess <= 1e-9 * model.u_max)) fail("|u_d| exceeds u_max");
+  if (!(v.boundary_error == 0.0)) fail("boundary conditions not met");
+  if (!(v.propagation_error <= propagation_limit * w0)) {
+    fail("open-loop propagation of u_d does not reproduce omega_d");
+  }
+  if (!(v.propagated_final_rate <= propagation_limit * w0)) {
+    fail("open-loop propagation of u_d does not end near rest");
+  }
+  v.passed = v.failure.empty();
+  return v;
+}
+
+PlanResult plan(const PlanProblem& problem) {
+  PlanResult r;
+  const PlanModel& model = problem.model;
+  const PlanSettings& settings = problem.settings;
+  try {
+    check_model(model, settings.nodes);
+  } catch (const std::invalid_argument& e) {
+    r.error = std::string("invalid problem: ") + e.what();
+    return r;
+  }
+  resolve_final_time_bounds(model, settings, r.t_final_min, r.t_final_max);
+  if (!(r.t_final_max >= r.t_final_min)) {
+    r.error = "invalid problem: t_final_max < t_final_min";
+    return r;
+  }
+  r.nodes = settings.nodes;
+  SolveOutcome main =
+      solve(model, settings, settings.nodes, r.t_final_min, r.t_final_max, nullptr);
+  r.iterations = main.iterations;
+  r.solve_seconds = main.seconds;
+  if (!main.ok) {
+    r.error = main.error;
+    return r;
+  }
+  r.cost_ns = main.cost_ns;
+  r.fuel_kg = main.cost_ns / (kIsp * kG0);  // Eq. (54)
+  r.t_final = main.t_final;
+  r.samples = std::move(main.samples);
+  r.verification = verify_samples(model, r.samples, settings.propagation_limit);
+  if (!r.verification.passed) {
+    r.error = "verification failed: " + r.verification.failure;
+    return r;
+  }
+  if (settings.verify_refinement) {
+    const SolveOutcome fine = solve(model, settings, 2 * settings.nodes - 1, r.t_final_min,
+                                    r.t_final_max, &r.samples);
+    if (!fine.ok) {
+      r.error = "verification failed: refined grid: " + fine.error;
+      return r;
+    }
+    r.verification.refinement_checked = true;
+    r.verification.refined_fuel_kg = fine.cost_ns / (kIsp * kG0);
+    r.verification.refinement_change =
+        std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
+    if (!(r.verification.refinement_change < settings.refinement_limit)) {
+      std::ostringstream msg;
+      msg << "grid refinement (" << settings.nodes << " -> " << 2 * settings.nodes - 1
+          << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
+          << " % (limit " << 100.0 * settings.refinement_limit << " %)";
+      r.verification.passed = false;
+      r.verification.failure = msg.str();
+      r.error = "verification failed: " + msg.str();
+      return r;
+    }
+  }
+  r.ok = true;
+  return r;
+}
+
+gnc::TrajectoryTable to_table(const std::vector<PlanSample>& samples) {
+  if (samples.size() > static_cast<std::size_t>(gnc::kMaxTrajectorySamples)) {
+    throw std::length_error("plan has more samples than the on-board trajectory table holds");
+  }
+  gnc::TrajectoryTable table;
+  table.count = static_cast<int>(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    table.samples[i].t = samples[i].t;
+    table.samples[i].omega_d = samples[i].omega_d;
+    table.samples[i].omega_d_dot = samples[i].omega_d_dot;
+  }
+  if (table.count > 0) table.samples[table.count - 1].omega_d = Vec3::Zero();
+  table.checksum = gnc::trajectory_checksum(table);
+  return table;
+}
+
+PlanModel study_case_model(double u_max, double delta_j_norm, double delta_r_norm) {
+  gnc::MassProperties mp = gnc::study_true_mass_properties();
+  mp.j_ast -= delta_j_norm * Vec3(-1.0, 1.0, 0.5).asDiagonal().toDenseMatrix();  // SPEC §5
+  mp.r_so_bcm -= delta_r_norm * Vec3(1.0, 1.0, 1.0) / std::sqrt(3.0);
+  PlanModel m;
+  m.j_hat = gnc::total_inertia(mp);
+  m.b_hat = gnc::torque_matrix(gnc::study_rcs_layout(u_max), mp.r_so_bcm);
+  m.u_max = u_max;
+  m.eps_trans = 0.5 * 2.0 * 3.14159265358979323846 / 60.0;  // 0.5 rpm
+  m.omega_init = Vec3(0.01, 0.02, 0.03);
+  return m;
+}
+
+namespace {
+void hash_bytes(std::uint64_t& h, const void* data, std::size_t n) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) {
+    h ^= bytes[i];
+    h *= 1099511628211ULL;
+  }
+}
+void hash_double(std::uint64_t& h, double v) { hash_bytes(h, &v, sizeof v); }
+}  // namespace
+
+std::uint64_t problem_hash(const PlanProblem& problem) {
+  std::uint64_t h = 14695981039346656037ULL;
+  const PlanModel& m = problem.model;
+  const PlanSettings& s = problem.settings;
+  const char tag[] = "rocksteady-plan-v1";
+  hash_bytes(h, tag, sizeof tag);
+  for (int i = 0; i < 9; ++i) hash_double(h, m.j_hat(i / 3, i % 3));
+  for (int i = 0; i < 24; ++i) hash_double(h, m.b_hat(i / 8, i % 8));
+  hash_double(h, m.u_max);
+  hash_double(h, m.eps_trans);
+  for (int i = 0; i < 3; ++i) hash_double(h, m.omega_init[i]);
+  const std::int64_t nodes = s.nodes;
+  hash_bytes(h, &nodes, sizeof nodes);
+  hash_double(h, s.t_final_min);
+  hash_double(h, s.t_final_max);
+  hash_double(h, s.tolerance);
+  hash_double(h, s.refinement_limit);
+  hash_double(h, s.propagation_limit);
+  const std::int64_t flags =
+      (s.verify_refinement ? 1 : 0) + (s.free_final_time ? 2 : 0) + 4 * std::int64_t{s.max_iterations};
+  hash_bytes(h, &flags, sizeof flags);
+  return h;
+}
+
+}  // namespace rocksteady::ground::planner

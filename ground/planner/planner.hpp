@@ -1,0 +1,131 @@
+// Fuel-optimal despin planner, SPEC Eq. (44): minimise int |u_d|_1 dt subject to the estimated
+// model's dynamics (41) and the limits (43). Ground code: solves a Hermite-Simpson transcription
+// (transcription.hpp) with IPOPT, verifies its own answer, and hands the flight side a
+// gnc::TrajectoryTable (via the trajectory file, trajectory_file.hpp).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gnc/guidance/trajectory.hpp"
+#include "gnc/types.hpp"
+
+namespace rocksteady::ground::planner {
+
+using gnc::Mat3;
+using gnc::Mat38;
+using gnc::Vec3;
+using gnc::Vec8;
+
+// Fuel, Eq. (54): m = cost / (I_sp g0).
+inline constexpr double kIsp = 287.0;  // s
+inline constexpr double kG0 = 9.8;     // m/s^2
+
+// [Rocksteady choice] default grid: 101 nodes (201 collocation points = table samples). See
+// ground/planner/README.md for why this is enough (grid refinement changes the fuel by ~1e-5).
+inline constexpr int kDefaultNodes = 101;
+// [Rocksteady choice] default horizon: kHorizonFactor times the shortest possible despin time.
+inline constexpr double kHorizonFactor = 8.0;
+
+// The model the plan is for: the flight software's estimate (hatted quantities, SPEC Eq. 6).
+struct PlanModel {
+  Mat3 j_hat{Mat3::Identity()};   // estimated total inertia J_tot (kg m^2)
+  Mat38 b_hat{Mat38::Zero()};     // estimated torque matrix (m)
+  double u_max{200.0};            // per-channel force limit (N)
+  double eps_trans{0.05236};      // rate bound, 0.5 rpm (rad/s)
+  Vec3 omega_init{Vec3::Zero()};  // initial body rate (rad/s)
+};
+
+struct PlanSettings {
+  int nodes{kDefaultNodes};
+  // Final time [Rocksteady choice]: fixed by default. Without a time cost the minimum fuel is a
+  // non-increasing function of the horizon (a plan that reaches rest at T extends to any T' > T by
+  // resting), so a free final time ends at its upper bound anyway (or anywhere on a flat stretch);
+  // fixing it removes the dense t_f column from the NLP and roughly halves the iterations.
+  // free_final_time = true solves with t_f free in [t_final_min, t_final_max].
+  bool free_final_time{false};
+  // Final-time bounds [s]; values <= 0 mean automatic (see resolve_final_time_bounds). With a fixed
+  // final time, t_f = t_final_max.
+  double t_final_min{0.0};
+  double t_final_max{0.0};
+  double tolerance{1e-9};    // IPOPT tol (scaled NLP)
+  int max_iterations{1000};
+  int print_level{0};  // IPOPT print_level (0 = quiet, 5 = per-iteration log)
+  bool verify_refinement{true};      // re-solve on a grid of 2N-1 nodes and compare the fuel
+  double refinement_limit{0.01};     // allowed relative fuel change on refinement
+  double propagation_limit{1e-3};    // allowed open-loop error, relative to |omega_init|
+};
+
+struct PlanProblem {
+  std::string case_name{"custom"};
+  PlanModel model;
+  PlanSettings settings;
+};
+
+struct PlanSample {
+  double t{0.0};
+  Vec3 omega_d{Vec3::Zero()};
+  Vec3 omega_d_dot{Vec3::Zero()};  // = J^-1 ((J omega_d) x omega_d + B u_d), Eq. (41)
+  Vec8 u_d{Vec8::Zero()};
+};
+
+struct Verification {
+  bool passed{false};
+  std::string failure;            // first failed check, empty when passed
+  double max_defect{0.0};         // Hermite-Simpson defects, rad/s (recomputed from the samples)
+  double max_rate_excess{0.0};    // max(|omega_d| - eps_trans, 0), rad/s
+  double max_control_excess{0.0}; // max(|u_i| - u_max, 0), N
+  double boundary_error{0.0};     // |omega_d(0) - omega_init| + |omega_d(t_f)|, rad/s
+  double propagation_error{0.0};  // max |omega_open_loop - omega_d| at the samples, rad/s
+  double propagated_final_rate{0.0};  // |omega_open_loop(t_f)|, rad/s
+  bool refinement_checked{false};
+  double refined_fuel_kg{0.0};
+  double refinement_change{0.0};  // |fuel_refined - fuel| / fuel
+};
+
+struct PlanResult {
+  bool ok{false};
+  std::string error;  // why the plan failed (solver status or failed verification)
+  double cost_ns{0.0};    // int |u|_1 dt (N s)
+  double fuel_kg{0.0};    // Eq. (54)
+  double t_final{0.0};    // s
+  double t_final_min{0.0};  // the resolved final-time range (s)
+  double t_final_max{0.0};
+  int nodes{0};
+  int iterations{0};        // IPOPT iterations of the main solve
+  double solve_seconds{0.0};  // wall time of the main solve
+  std::vector<PlanSample> samples;  // every collocation point (nodes and midpoints)
+  Verification verification;
+};
+
+// Automatic final-time range [Rocksteady choice]:
+//   t_lower = |H0| / (u_max sum_i |B_i|): no admissible torque is larger than u_max sum_i |B_i|, and
+//             the gyroscopic term does not change |H| = |J omega|, so no plan can be shorter;
+//   t_max = kHorizonFactor t_lower (README.md: case 1, 8x -> 85.0 kg, 16x -> 83.7 kg, 32x -> 81.8 kg);
+//   t_min = t_lower when the final time is free, t_max when it is fixed.
+// Explicit positive settings override either end.
+void resolve_final_time_bounds(const PlanModel& model, const PlanSettings& settings, double& t_min,
+                               double& t_max);
+
+// Solves Eq. (44) for the model and verifies the answer. Never throws for solver failures:
+// ok = false with the reason in `error`.
+PlanResult plan(const PlanProblem& problem);
+
+// Re-checks samples against the model: defects, bounds, boundary conditions, open-loop propagation.
+// (plan() calls this; exposed so tests and the file loader can re-verify.)
+Verification verify_samples(const PlanModel& model, const std::vector<PlanSample>& samples,
+                            double propagation_limit);
+
+// The flight-side table of a plan (t, omega_d, omega_d_dot; checksum set). The last omega_d is
+// exactly zero. Throws std::length_error if there are more samples than the table holds.
+gnc::TrajectoryTable to_table(const std::vector<PlanSample>& samples);
+
+// The estimated model of a study case (SPEC §5, Table 3): J_ast_hat = J_ast - dJ diag(-1, 1, 0.5),
+// r_hat = r - dr [1 1 1]/sqrt(3); study RCS layout; omega_init of Table 2.
+PlanModel study_case_model(double u_max, double delta_j_norm, double delta_r_norm);
+
+// 64-bit FNV-1a hash of the model and the settings (the cache key; also stored in the file).
+std::uint64_t problem_hash(const PlanProblem& problem);
+
+}  // namespace rocksteady::ground::planner
