@@ -76,6 +76,7 @@ const char* to_string(EventId id) {
     case EventId::kTrajectoryRejected: return "trajectory_rejected";
     case EventId::kTrajectoryLoaded: return "trajectory_loaded";
     case EventId::kCountersReset: return "counters_reset";
+    case EventId::kOverrunSafe: return "overrun_safe";
   }
   return "?";
 }

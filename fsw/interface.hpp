@@ -136,6 +136,7 @@ enum class EventId : std::int32_t {
   kTrajectoryRejected = 121,   // arg0 = upload id, arg1 = gnc::TrajectoryError
   kTrajectoryLoaded = 122,     // handed to the flight core at the tick boundary
   kCountersReset = 123,
+  kOverrunSafe = 124,          // -> SAFE: arg0 = consecutive GNC slips
 };
 const char* to_string(EventId id);
 

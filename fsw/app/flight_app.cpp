@@ -60,6 +60,8 @@ void FlightApp::reset_state() {
   have_gnc_t_ = false;
   last_gnc_t_ = 0.0;
   gnc_cycles_missed_ = 0;
+  consecutive_slips_ = 0;
+  overrun_request_ = false;
   next_index_ = 0;
   cmd_accepted_ = 0;
   cmd_rejected_ = 0;
@@ -203,10 +205,23 @@ bool FlightApp::accept_frame_time(double t) {
 
 void FlightApp::run_gnc(const Tick& tick, const double* t_frameless, Outputs& out) {
   RateGroup& group = exec_.group(GroupId::kGnc);
-  report_slip(GroupId::kGnc, group.begin(tick.start_ns, clock_->now_ns()));
+  const SlipReport slip = group.begin(tick.start_ns, clock_->now_ns());
+  report_slip(GroupId::kGnc, slip);
+  consecutive_slips_ = slip.slipped ? consecutive_slips_ + 1 : 0;
 
   // 1. Accepted commands take effect at the tick boundary.
   apply_pending(cmds_);
+
+  // Repeated overruns: the loop cannot keep its rate, stop actuating (DESIGN.md, SAFE).
+  overrun_request_ = false;
+  if (config_.overrun_safe_slips > 0 && consecutive_slips_ >= config_.overrun_safe_slips &&
+      gnc_.mode() != gnc::Mode::kSafe) {
+    cmds_.has_mode_request = true;
+    cmds_.mode_request = gnc::Mode::kSafe;
+    overrun_request_ = true;
+    emit(Severity::kError, EventId::kOverrunSafe, static_cast<std::int32_t>(consecutive_slips_), 0,
+         "%" PRIu32 " consecutive GNC overruns: -> SAFE, thrusters off", consecutive_slips_);
+  }
 
   // 2. The sample: the fresh frame if its time is sane, otherwise an invalid sample at the
   //    scheduled time (the flight core counts the sensor age and goes to SAFE on timeout).
@@ -249,8 +264,9 @@ void FlightApp::translate_core_events() {
     const auto to = static_cast<std::int32_t>(e.to);
     switch (e.id) {
       case gnc::EventId::kModeChanged:
-        emit(Severity::kInfo, EventId::kModeChanged, from, to, "mode %s -> %s (ground request)",
-             gnc::to_string(e.from), gnc::to_string(e.to));
+        emit(Severity::kInfo, EventId::kModeChanged, from, to, "mode %s -> %s (%s)",
+             gnc::to_string(e.from), gnc::to_string(e.to),
+             overrun_request_ ? "overrun protection" : "ground request");
         break;
       case gnc::EventId::kAutoHold:
         emit(Severity::kInfo, EventId::kAutoHold, from, to,

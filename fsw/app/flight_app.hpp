@@ -34,6 +34,8 @@ struct FlightConfig {
   // After this many consecutive rejected frames, the next frame with a finite time re-anchors the
   // time base (e.g. the sensor front end restarted its clock).
   std::uint32_t frame_resync_count{50};
+  // This many consecutive GNC cycles that slipped -> SAFE (thrusters off) with an event; 0: never.
+  std::uint32_t overrun_safe_slips{10};
 };
 
 struct InitResult {
@@ -163,6 +165,8 @@ class FlightApp {
   bool have_gnc_t_{false};
   double last_gnc_t_{0.0};
   std::uint32_t gnc_cycles_missed_{0};  // GNC cycles skipped since the last one ran
+  std::uint32_t consecutive_slips_{0};
+  bool overrun_request_{false};         // this tick's SAFE request is the overrun protection's
   std::uint64_t next_index_{0};         // for the lockstep conveniences
 
   // Counters (telemetry).

@@ -215,3 +215,55 @@ TEST(FlightApp, EventQueueDropsAndCountsWhenFull) {
 
 }  // namespace
 }  // namespace rocksteady::fsw
+
+namespace rocksteady::fsw {
+namespace {
+
+TEST(FlightApp, RepeatedOverrunsGoSafe) {
+  FlightConfig cfg = test::small_config();
+  cfg.overrun_safe_slips = 4;
+  test::AppFixture f(cfg);
+  f.loop.truth.omega = test::V3(0.08, 0.0, 0.0);
+  f.ticks(3);
+  ASSERT_TRUE(f.send(Opcode::kSetMode, {1.0}).accepted);
+  f.ticks(1);
+  ASSERT_EQ(f.app->mode(), gnc::Mode::kDetumble);
+  test::drain(*f.app);
+  // Every tick claims to have been due before the previous cycle ended: an overrun each time.
+  std::uint64_t index = f.app->executive().base_ticks();
+  int n = 0;
+  while (f.app->mode() != gnc::Mode::kSafe && n < 20) {
+    const std::int64_t end_of_previous = f.clock.now_ns();
+    f.clock.advance(50000000);
+    gnc::SensorSample s = f.loop.truth.sample();
+    f.app->tick(Tick{index++, end_of_previous - 1, 0}, &s, f.out);
+    f.loop.truth.step(0.05, test::V3::Zero());
+    ++n;
+  }
+  EXPECT_EQ(n, 4);
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kSafe);
+  EXPECT_FALSE(f.out.command.enabled);
+  EXPECT_EQ(f.app->health().gnc.slips, 4u);
+  const auto ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kOverrunSafe), 1);
+}
+
+TEST(FlightApp, OccasionalSlipsDoNotGoSafe) {
+  FlightConfig cfg = test::small_config();
+  cfg.overrun_safe_slips = 4;
+  test::AppFixture f(cfg);
+  std::uint64_t index = 0;
+  for (int k = 0; k < 40; ++k) {
+    const std::int64_t end_of_previous = f.clock.now_ns();
+    f.clock.advance(50000000);
+    gnc::SensorSample s = f.loop.truth.sample();
+    const bool slip = k % 4 != 0;  // three in a row at most
+    f.app->tick(Tick{index++, slip ? end_of_previous - 1 : f.clock.now_ns(), 0}, &s, f.out);
+    f.loop.truth.step(0.05, test::V3::Zero());
+  }
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kIdle);
+  EXPECT_EQ(f.app->health().gnc.slips, 30u);  // k = 1..39 except multiples of 4
+}
+
+}  // namespace
+}  // namespace rocksteady::fsw
