@@ -142,19 +142,26 @@ TEST(SpyJar, HasAClassForEveryLcmStructAndNothingElse) {
   EXPECT_EQ(classes, expected);
 }
 
-TEST(SpyJar, JavaFingerprintsEqualTheCppOnes) {
+TEST(SpyJar, JavaFingerprintsEqualTheCppOnesAndLcmSpyResolvesThem) {
   std::string command = std::string("\"") + ROCKSTEADY_JAVA_EXE + "\" -cp \"" + ROCKSTEADY_TYPES_JAR +
                         ":" + ROCKSTEADY_LCM_JAR + ":" + ROCKSTEADY_DUMP_DIR + "\" FingerprintDump";
   const auto types = cpp_types();
   for (const auto& entry : types) command += " " + entry.first;
   const std::string out = run(command);
-  std::istringstream in(out);
-  std::string name;
-  std::string hex;
+  std::istringstream lines(out);
+  std::string line;
   std::size_t seen = 0;
-  while (in >> name >> hex) {
+  while (std::getline(lines, line)) {
+    std::istringstream in(line);
+    std::string name;
+    std::string hex;
+    std::string resolved;
+    // lcm-spy's type database prints its own progress lines; ours start with the package name.
+    if (line.rfind("rocksteady.", 0) != 0 || !(in >> name >> hex >> resolved)) continue;
     ASSERT_EQ(types.count(name), 1u) << name;
     EXPECT_EQ(std::stoull(hex, nullptr, 16), static_cast<std::uint64_t>(types.at(name).hash)) << name;
+    // What lcm-spy does with a packet: fingerprint -> class, found by scanning the class path.
+    EXPECT_EQ(resolved, name);
     ++seen;
   }
   EXPECT_EQ(seen, types.size());
