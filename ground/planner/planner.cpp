@@ -391,15 +391,28 @@ Verification verify_samples(const PlanModel& model, const std::vector<PlanSample
 
   // Tolerances [Rocksteady choice]: the NLP is solved to 1e-9 (scaled), so defects, bounds and
   // boundary values are at round-off; the propagation limit covers the transcription error.
-  if (!(v.max_defect <= 1e-7 * w0)) fail("dynamics defects above tolerance");
-  if (!(v.max_rate_excess <= 1e-9 * model.eps_trans)) fail("|omega_d| exceeds eps_trans");
-  if (!(v.max_control_excess <= 1e-9 * model.u_max)) fail("|u_d| exceeds u_max");
-  if (!(v.boundary_error == 0.0)) fail("boundary conditions not met");
+  const auto limit = [](const char* what, double value, double bound, const char* unit) {
+    std::ostringstream msg;
+    msg << what << " (" << value << " " << unit << " > " << bound << " " << unit << ")";
+    return msg.str();
+  };
+  if (!(v.max_defect <= 1e-7 * w0)) {
+    fail(limit("dynamics defects above tolerance", v.max_defect, 1e-7 * w0, "rad/s"));
+  }
+  if (!(v.max_rate_excess <= 1e-9 * model.eps_trans)) {
+    fail(limit("|omega_d| exceeds eps_trans", v.max_rate_excess, 1e-9 * model.eps_trans, "rad/s"));
+  }
+  if (!(v.max_control_excess <= 1e-9 * model.u_max)) {
+    fail(limit("|u_d| exceeds u_max", v.max_control_excess, 1e-9 * model.u_max, "N"));
+  }
+  if (!(v.boundary_error == 0.0)) fail(limit("boundary conditions not met", v.boundary_error, 0.0, "rad/s"));
   if (!(v.propagation_error <= propagation_limit * w0)) {
-    fail("open-loop propagation of u_d does not reproduce omega_d");
+    fail(limit("open-loop propagation of u_d does not reproduce omega_d; refine the grid",
+               v.propagation_error, propagation_limit * w0, "rad/s"));
   }
   if (!(v.propagated_final_rate <= propagation_limit * w0)) {
-    fail("open-loop propagation of u_d does not end near rest");
+    fail(limit("open-loop propagation of u_d does not end near rest", v.propagated_final_rate,
+               propagation_limit * w0, "rad/s"));
   }
   v.passed = v.failure.empty();
   return v;
