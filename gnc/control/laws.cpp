@@ -107,8 +107,9 @@ Mat3 params_to_inertia(const Vec6& a) {
 
 Mat3 project_inertia(const Mat3& j, double lo, double hi) {
   const Mat3 sym = 0.5 * (j + j.transpose());
+  // Iterative (QR) solver: accurate eigenvectors even for repeated eigenvalues; fixed-size, no heap.
   Eigen::SelfAdjointEigenSolver<Mat3> es;
-  es.computeDirect(sym, Eigen::ComputeEigenvectors);
+  es.compute(sym, Eigen::ComputeEigenvectors);
   Vec3 lam = es.eigenvalues();
   bool inside = true;
   for (int i = 0; i < 3; ++i) {
