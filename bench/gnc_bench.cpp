@@ -1,0 +1,97 @@
+// GNC tick benchmark: one full Gnc::step (filter + NTCL + D+PD-based reference + pseudoinverse),
+// and each control law alone. Measures and prints; never asserts a time.
+#include <benchmark/benchmark.h>
+
+#include "gnc/control/laws.hpp"
+#include "gnc/gnc.hpp"
+#include "gnc/math/rotation.hpp"
+
+namespace {
+
+using namespace rocksteady::gnc;
+
+SensorSample study_sample(double t) {
+  SensorSample s;
+  s.t = t;
+  s.gyro_rate = Vec3(0.01, 0.02, 0.03);  // SPEC §5 initial rate
+  s.gyro_valid = true;
+  s.star_quat = mrp::to_quaternion(Vec3(0.05, 0.04, 0.03));
+  s.star_valid = true;
+  return s;
+}
+
+void BM_GncTick(benchmark::State& state, LawId law, Mode mode) {
+  GncParams p = study_gnc_params(200.0);
+  p.law = law;
+  p.estimator.kind = EstimatorKind::kFilter;
+  p.mode.auto_hold = false;
+  Gnc gnc;
+  if (!gnc.init(p).ok) {
+    state.SkipWithError("parameters rejected");
+    return;
+  }
+  GncOutput out;
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = mode;
+  double t = 0.0;
+  gnc.step(study_sample(t), c, out);
+  c = GncCommands{};
+  for (auto _ : state) {
+    t += p.dt;
+    gnc.step(study_sample(t), c, out);
+    benchmark::DoNotOptimize(out);
+  }
+  state.SetLabel(to_string(gnc.mode()));
+}
+
+// The reference tick: filter + NTCL + D+PD-based reference (both phases) + pseudoinverse.
+BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_damping, LawId::kNtcl, Mode::kDetumble);
+BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_hold, LawId::kNtcl, Mode::kHold);
+BENCHMARK_CAPTURE(BM_GncTick, so3_hold, LawId::kSo3, Mode::kHold);
+BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
+
+void BM_LawAlone(benchmark::State& state, LawId law) {
+  const GncParams p = study_gnc_params(200.0);
+  ControlLaws laws;
+  laws.configure(p, total_inertia(p.mass_hat));
+  laws.reset_state();
+  LawInput in;
+  in.omega = Vec3(1e-3, -2e-3, 5e-4);
+  in.q = Vec3(0.05, 0.04, 0.03);
+  in.ref.phase = ReferencePhase::kTrack;
+  in.ref.q = {Vec3(0.04, 0.05, 0.02), Vec3(1e-4, -2e-4, 1e-4), Vec3(1e-7, 2e-7, -1e-7)};
+  RateReference rr;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(in);
+    Vec3 u = laws.compute(law, in, rr);
+    benchmark::DoNotOptimize(u);
+  }
+}
+
+BENCHMARK_CAPTURE(BM_LawAlone, ntcl, LawId::kNtcl);
+BENCHMARK_CAPTURE(BM_LawAlone, el, LawId::kNtclEl);
+BENCHMARK_CAPTURE(BM_LawAlone, integral, LawId::kIntegral);
+BENCHMARK_CAPTURE(BM_LawAlone, adaptive, LawId::kAdaptive);
+BENCHMARK_CAPTURE(BM_LawAlone, so3, LawId::kSo3);
+BENCHMARK_CAPTURE(BM_LawAlone, dpd, LawId::kDpd);
+BENCHMARK_CAPTURE(BM_LawAlone, feedforward, LawId::kFeedforward);
+
+void BM_Allocate(benchmark::State& state) {
+  const GncParams p = study_gnc_params(200.0);
+  Allocator a;
+  a.configure(torque_matrix(p.rcs, p.mass_hat.r_so_bcm), p.rcs.u_max);
+  Vec3 uc(300.0, -150.0, 800.0);
+  Vec8 u;
+  AllocatorStatus st;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(uc);
+    a.allocate(uc, u, st);
+    benchmark::DoNotOptimize(u);
+  }
+}
+BENCHMARK(BM_Allocate);
+
+}  // namespace
+
+BENCHMARK_MAIN();
