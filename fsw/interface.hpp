@@ -51,7 +51,7 @@ struct GroundCommand {
 enum class RejectReason : std::int32_t {
   kNone = 0,
   kUnknownOpcode = 1,
-  kBadLength = 2,           // wrong argument count (or value count for the parameter)
+  kBadLength = 2,  // wrong argument count (or value count for the parameter)
   kArgNotFinite = 3,
   kOutOfRange = 4,          // detail = index of the first bad argument
   kStaleSequence = 5,       // seq not newer than the last accepted from that source
@@ -127,16 +127,16 @@ enum class EventId : std::int32_t {
   kTableActivated = 112,
   kTableActivationFailed = 113,
   kTableDiscarded = 114,
-  kLawChanged = 115,           // arg0 = from, arg1 = to
+  kLawChanged = 115,  // arg0 = from, arg1 = to
   kTargetSet = 116,
-  kChunkRejected = 117,        // arg0 = upload id, arg1 = ChunkStatus
-  kUplinkStarted = 118,        // arg0 = upload id, arg1 = chunk count
-  kUplinkAbandoned = 119,      // arg0 = upload id, arg1 = chunks received
-  kUplinkComplete = 120,       // all chunks received; arg0 = upload id
-  kTrajectoryRejected = 121,   // arg0 = upload id, arg1 = gnc::TrajectoryError
-  kTrajectoryLoaded = 122,     // handed to the flight core at the tick boundary
+  kChunkRejected = 117,       // arg0 = upload id, arg1 = ChunkStatus
+  kUplinkStarted = 118,       // arg0 = upload id, arg1 = chunk count
+  kUplinkAbandoned = 119,     // arg0 = upload id, arg1 = chunks received
+  kUplinkComplete = 120,      // all chunks received; arg0 = upload id
+  kTrajectoryRejected = 121,  // arg0 = upload id, arg1 = gnc::TrajectoryError
+  kTrajectoryLoaded = 122,    // handed to the flight core at the tick boundary
   kCountersReset = 123,
-  kOverrunSafe = 124,          // -> SAFE: arg0 = consecutive GNC slips
+  kOverrunSafe = 124,  // -> SAFE: arg0 = consecutive GNC slips
 };
 const char* to_string(EventId id);
 
@@ -157,17 +157,17 @@ struct Event {
 // ---------------------------------------------------------------------------------------------
 
 struct RateGroupStats {
-  std::uint32_t cycles{0};         // cycles run (never reset: it must keep moving)
-  std::uint32_t slips{0};          // a tick arrived before the previous cycle had ended
-  std::uint32_t missed_ticks{0};   // cycles of this group skipped (late wake-up, frame gap)
-  std::int64_t last_exec_ns{0};    // execution time of the last cycle
+  std::uint32_t cycles{0};        // cycles run (never reset: it must keep moving)
+  std::uint32_t slips{0};         // a tick arrived before the previous cycle had ended
+  std::uint32_t missed_ticks{0};  // cycles of this group skipped (late wake-up, frame gap)
+  std::int64_t last_exec_ns{0};   // execution time of the last cycle
   std::int64_t max_exec_ns{0};
 };
 
 struct HealthTelemetry {
-  double t{0.0};                    // s, time of the last GNC tick
-  std::uint64_t base_ticks{0};      // base ticks seen by the executive
-  std::uint32_t base_missed{0};     // base ticks missed
+  double t{0.0};                 // s, time of the last GNC tick
+  std::uint64_t base_ticks{0};   // base ticks seen by the executive
+  std::uint32_t base_missed{0};  // base ticks missed
   gnc::Mode mode{gnc::Mode::kIdle};
   gnc::LawId law{gnc::LawId::kNtcl};
   RateGroupStats gnc{};
@@ -178,7 +178,7 @@ struct HealthTelemetry {
   std::int64_t last_cmd_seq{0};
   std::int32_t last_cmd_opcode{-1};
   RejectReason last_reject{RejectReason::kNone};
-  std::uint32_t cmd_pending{0};     // accepted, waiting for the tick boundary
+  std::uint32_t cmd_pending{0};  // accepted, waiting for the tick boundary
 
   std::uint32_t events_emitted{0};
   std::uint32_t events_dropped{0};  // event queue full
@@ -190,9 +190,9 @@ struct HealthTelemetry {
 
   std::uint32_t table_loads{0};
   std::uint32_t table_activations{0};
-  bool table_loaded{false};          // the inactive table differs from the active one
+  bool table_loaded{false};  // the inactive table differs from the active one
 
-  std::int32_t uplink_id{-1};        // -1: no uplink in progress
+  std::int32_t uplink_id{-1};  // -1: no uplink in progress
   std::int32_t uplink_chunks_received{0};
   std::int32_t uplink_chunk_count{0};
   std::uint32_t uplink_chunks_rejected{0};

@@ -11,7 +11,9 @@ namespace {
 
 constexpr double kNsPerS = 1e9;
 
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * kNsPerS)); }
+std::int64_t to_ns(double s) {
+  return static_cast<std::int64_t>(std::llround(s * kNsPerS));
+}
 
 CommandCheck reject(RejectReason r, std::int32_t detail, const char* text) {
   return CommandCheck{r, detail, text};
@@ -141,8 +143,9 @@ void FlightApp::run_tick(const Tick& tick, const gnc::SensorSample* frame,
     std::uint32_t suppressed = 0;
     if (missed_throttle_.allow(clock_->now_ns(), suppressed)) {
       emit(Severity::kWarning, EventId::kMissedTicks, static_cast<std::int32_t>(plan.base_missed),
-           static_cast<std::int32_t>(suppressed), "%" PRIu32 " base tick(s) missed (%" PRIu32
-           " report(s) suppressed)", plan.base_missed, suppressed);
+           static_cast<std::int32_t>(suppressed),
+           "%" PRIu32 " base tick(s) missed (%" PRIu32 " report(s) suppressed)", plan.base_missed,
+           suppressed);
     }
   }
   gnc_cycles_missed_ += plan.missed[static_cast<int>(GroupId::kGnc)];
@@ -294,8 +297,8 @@ void FlightApp::translate_core_events() {
           const std::uint32_t total = gout_.telemetry.sensor_rejects - sensor_rejects_base_;
           emit(Severity::kWarning, EventId::kSensorRejected, static_cast<std::int32_t>(total),
                static_cast<std::int32_t>(suppressed),
-               "sensor sample rejected: invalid, non-finite or out of range (%" PRIu32
-               " so far)", total);
+               "sensor sample rejected: invalid, non-finite or out of range (%" PRIu32 " so far)",
+               total);
         }
         break;
       }
@@ -468,7 +471,8 @@ CommandCheck FlightApp::execute(const GroundCommand& cmd) {
     }
 
     case Opcode::kParamActivate: {
-      if (table_.staged()) return reject(RejectReason::kBusy, 0, "an activation is already pending");
+      if (table_.staged())
+        return reject(RejectReason::kBusy, 0, "an activation is already pending");
       if (!table_.loaded()) return reject(RejectReason::kNothingToActivate, 0, "no parameter load");
       if (!queue_has_room(1)) return reject(RejectReason::kBusy, 0, "command queue full");
       table_.stage();
@@ -690,8 +694,9 @@ void FlightApp::apply_pre_step(const Action& a) {
       if (c.ok) {
         ++table_activations_;
         table_.activated(gnc_.params());
-        emit(Severity::kInfo, EventId::kTableActivated, static_cast<std::int32_t>(table_activations_),
-             0, "parameter table activated at the tick boundary");
+        emit(Severity::kInfo, EventId::kTableActivated,
+             static_cast<std::int32_t>(table_activations_), 0,
+             "parameter table activated at the tick boundary");
       } else {
         table_.activation_failed();
         emit(Severity::kError, EventId::kTableActivationFailed, 0, 0,

@@ -26,7 +26,7 @@ namespace rocksteady::fsw {
 
 struct FlightConfig {
   gnc::GncParams gnc{};
-  ExecutiveConfig executive{};  // gnc_divider / base_rate_hz must equal gnc.dt
+  ExecutiveConfig executive{};           // gnc_divider / base_rate_hz must equal gnc.dt
   double sensor_event_interval_s{10.0};  // throttle of sensor/frame reject and missed-tick events
   // A frame whose time is more than this ahead of the on-board time is rejected (one bad time tag
   // must not poison the time base).
@@ -166,8 +166,8 @@ class FlightApp {
   double last_gnc_t_{0.0};
   std::uint32_t gnc_cycles_missed_{0};  // GNC cycles skipped since the last one ran
   std::uint32_t consecutive_slips_{0};
-  bool overrun_request_{false};         // this tick's SAFE request is the overrun protection's
-  std::uint64_t next_index_{0};         // for the lockstep conveniences
+  bool overrun_request_{false};  // this tick's SAFE request is the overrun protection's
+  std::uint64_t next_index_{0};  // for the lockstep conveniences
 
   // Counters (telemetry).
   std::uint32_t cmd_accepted_{0};

@@ -11,8 +11,12 @@ namespace {
 constexpr double kIdMax = 2147483647.0;  // upload ids are int32 >= 0
 constexpr double kValueMax = 1e30;       // parameter values: finite, sane magnitude
 
-constexpr ArgRange integer(double lo, double hi) { return ArgRange{lo, hi, true}; }
-constexpr ArgRange real(double lo, double hi) { return ArgRange{lo, hi, false}; }
+constexpr ArgRange integer(double lo, double hi) {
+  return ArgRange{lo, hi, true};
+}
+constexpr ArgRange real(double lo, double hi) {
+  return ArgRange{lo, hi, false};
+}
 
 constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
     {Opcode::kNoop, 0, 0, kAllModes, {}},
@@ -24,7 +28,10 @@ constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
     {Opcode::kLoadTrajectory, 1, 1, kAllButTrack, {integer(0, kIdMax)}},
     {Opcode::kAbortUplink, 1, 1, kAllModes, {integer(0, kIdMax)}},
     {Opcode::kResetCounters, 0, 0, kAllModes, {}},
-    {Opcode::kParamLoad, 2, 7, kAllModes,
+    {Opcode::kParamLoad,
+     2,
+     7,
+     kAllModes,
      {integer(0, kParamCount - 1), real(-kValueMax, kValueMax), real(-kValueMax, kValueMax),
       real(-kValueMax, kValueMax), real(-kValueMax, kValueMax), real(-kValueMax, kValueMax),
       real(-kValueMax, kValueMax)}},
@@ -42,7 +49,9 @@ static_assert(rows_in_opcode_order(), "opcode table rows must be indexed by opco
 
 }  // namespace
 
-const std::array<OpcodeSpec, kOpcodeCount>& opcode_table() { return kTable; }
+const std::array<OpcodeSpec, kOpcodeCount>& opcode_table() {
+  return kTable;
+}
 
 const OpcodeSpec* find_opcode(std::int32_t opcode) {
   if (opcode < 0 || opcode >= kOpcodeCount) return nullptr;
@@ -51,7 +60,8 @@ const OpcodeSpec* find_opcode(std::int32_t opcode) {
 
 CommandCheck check_command(const GroundCommand& cmd, gnc::Mode mode) {
   const OpcodeSpec* spec = find_opcode(cmd.opcode);
-  if (spec == nullptr) return CommandCheck{RejectReason::kUnknownOpcode, cmd.opcode, "unknown opcode"};
+  if (spec == nullptr)
+    return CommandCheck{RejectReason::kUnknownOpcode, cmd.opcode, "unknown opcode"};
   if (cmd.arg_count < spec->min_args || cmd.arg_count > spec->max_args) {
     return CommandCheck{RejectReason::kBadLength, cmd.arg_count, "wrong number of arguments"};
   }
@@ -63,7 +73,8 @@ CommandCheck check_command(const GroundCommand& cmd, gnc::Mode mode) {
   for (int i = 0; i < cmd.arg_count; ++i) {
     const ArgRange& r = spec->ranges[i];
     const double v = cmd.args[i];
-    if (v < r.lo || v > r.hi) return CommandCheck{RejectReason::kOutOfRange, i, "argument out of range"};
+    if (v < r.lo || v > r.hi)
+      return CommandCheck{RejectReason::kOutOfRange, i, "argument out of range"};
     if (r.integer && std::trunc(v) != v) {
       return CommandCheck{RejectReason::kOutOfRange, i, "argument must be an integer"};
     }

@@ -12,7 +12,9 @@
 namespace rocksteady::fsw {
 
 using ModeMask = std::uint8_t;
-constexpr ModeMask mode_bit(gnc::Mode m) { return static_cast<ModeMask>(1u << static_cast<int>(m)); }
+constexpr ModeMask mode_bit(gnc::Mode m) {
+  return static_cast<ModeMask>(1u << static_cast<int>(m));
+}
 inline constexpr ModeMask kAllModes = 0x1F;
 inline constexpr ModeMask kAllButTrack =
     static_cast<ModeMask>(kAllModes & ~mode_bit(gnc::Mode::kTrack));

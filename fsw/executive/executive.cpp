@@ -26,8 +26,10 @@ ConfigCheck validate(const ExecutiveConfig& c) {
 
 const char* to_string(GroupId g) {
   switch (g) {
-    case GroupId::kGnc: return "gnc";
-    case GroupId::kHousekeeping: return "housekeeping";
+    case GroupId::kGnc:
+      return "gnc";
+    case GroupId::kHousekeeping:
+      return "housekeeping";
   }
   return "?";
 }
@@ -90,7 +92,8 @@ ConfigCheck Executive::configure(const ExecutiveConfig& c) {
   if (!check.ok) return check;
   config_ = c;
   base_period_ns_ = static_cast<std::int64_t>(std::llround(kNsPerS / c.base_rate_hz));
-  const auto interval_ns = static_cast<std::int64_t>(std::llround(c.slip_event_interval_s * kNsPerS));
+  const auto interval_ns =
+      static_cast<std::int64_t>(std::llround(c.slip_event_interval_s * kNsPerS));
   group(GroupId::kGnc).configure(c.gnc_divider, interval_ns);
   group(GroupId::kHousekeeping).configure(c.housekeeping_divider, interval_ns);
   have_tick_ = false;

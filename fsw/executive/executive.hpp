@@ -53,9 +53,9 @@ class Throttle {
 
 struct SlipReport {
   bool slipped{false};
-  bool report{false};             // emit the (throttled) warning event now
-  std::uint32_t suppressed{0};    // slip reports suppressed since the previous warning
-  std::int64_t late_ns{0};        // how far the previous cycle ran past this tick's start
+  bool report{false};           // emit the (throttled) warning event now
+  std::uint32_t suppressed{0};  // slip reports suppressed since the previous warning
+  std::int64_t late_ns{0};      // how far the previous cycle ran past this tick's start
 };
 
 class RateGroup {
@@ -84,7 +84,7 @@ class RateGroup {
 };
 
 struct TickPlan {
-  bool valid{false};                                // false: tick index not after the last one
+  bool valid{false};  // false: tick index not after the last one
   std::array<bool, kGroupCount> due{};
   std::array<std::uint32_t, kGroupCount> missed{};  // cycles of each group skipped before it
   std::uint32_t base_missed{0};

@@ -13,9 +13,9 @@
 namespace rocksteady::fsw {
 
 struct Tick {
-  std::uint64_t index{0};     // base tick number; 0 is the first
-  std::int64_t start_ns{0};   // when the tick became due (deadline, or frame arrival)
-  std::uint32_t missed{0};    // ticks skipped between the previous tick and this one
+  std::uint64_t index{0};    // base tick number; 0 is the first
+  std::int64_t start_ns{0};  // when the tick became due (deadline, or frame arrival)
+  std::uint32_t missed{0};   // ticks skipped between the previous tick and this one
 };
 
 class TickSource {
@@ -28,7 +28,8 @@ class TickSource {
 
 class RealTimeClockSource final : public TickSource {
  public:
-  RealTimeClockSource(Clock& clock, std::int64_t period_ns) : clock_(clock), period_ns_(period_ns) {}
+  RealTimeClockSource(Clock& clock, std::int64_t period_ns)
+      : clock_(clock), period_ns_(period_ns) {}
   // The first call returns tick 0 at the current time; then waits for each absolute deadline.
   bool next(Tick& tick) override;
   std::uint32_t missed_total() const { return missed_total_; }
@@ -55,11 +56,11 @@ class LockstepSource final : public TickSource {
  private:
   bool have_first_{false};
   std::int64_t first_seq_{0};
-  std::int64_t latest_seq_{0};       // newest frame accepted
+  std::int64_t latest_seq_{0};  // newest frame accepted
   std::int64_t latest_arrival_ns_{0};
   bool pending_{false};
   bool have_returned_{false};
-  std::uint64_t last_index_{0};      // last tick handed out
+  std::uint64_t last_index_{0};  // last tick handed out
   std::uint32_t missed_total_{0};
   std::uint32_t stale_frames_{0};
 };

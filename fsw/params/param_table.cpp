@@ -47,46 +47,77 @@ static_assert(specs_in_id_order(), "parameter specs must be indexed by id");
 
 gnc::Mat3* matrix_field(gnc::GncParams& p, ParamId id) {
   switch (id) {
-    case ParamId::kNtclK: return &p.ntcl.k;
-    case ParamId::kNtclLambda: return &p.ntcl.lambda;
-    case ParamId::kElK: return &p.el.k;
-    case ParamId::kElLambda: return &p.el.lambda;
-    case ParamId::kFeedforwardK: return &p.feedforward.k;
-    case ParamId::kFeedforwardLambda: return &p.feedforward.lambda;
-    case ParamId::kIntegralK: return &p.integral.k;
-    case ParamId::kIntegralLambda: return &p.integral.lambda;
-    case ParamId::kIntegralKi: return &p.integral.k_i;
-    case ParamId::kAdaptiveK: return &p.adaptive.k;
-    case ParamId::kAdaptiveLambda: return &p.adaptive.lambda;
-    case ParamId::kSo3K: return &p.so3.k;
-    case ParamId::kSo3Lambda: return &p.so3.lambda;
-    case ParamId::kDpdKd: return &p.dpd.k_d;
-    default: return nullptr;
+    case ParamId::kNtclK:
+      return &p.ntcl.k;
+    case ParamId::kNtclLambda:
+      return &p.ntcl.lambda;
+    case ParamId::kElK:
+      return &p.el.k;
+    case ParamId::kElLambda:
+      return &p.el.lambda;
+    case ParamId::kFeedforwardK:
+      return &p.feedforward.k;
+    case ParamId::kFeedforwardLambda:
+      return &p.feedforward.lambda;
+    case ParamId::kIntegralK:
+      return &p.integral.k;
+    case ParamId::kIntegralLambda:
+      return &p.integral.lambda;
+    case ParamId::kIntegralKi:
+      return &p.integral.k_i;
+    case ParamId::kAdaptiveK:
+      return &p.adaptive.k;
+    case ParamId::kAdaptiveLambda:
+      return &p.adaptive.lambda;
+    case ParamId::kSo3K:
+      return &p.so3.k;
+    case ParamId::kSo3Lambda:
+      return &p.so3.lambda;
+    case ParamId::kDpdKd:
+      return &p.dpd.k_d;
+    default:
+      return nullptr;
   }
 }
 
 double* scalar_field(gnc::GncParams& p, ParamId id) {
   switch (id) {
-    case ParamId::kIntegralLimit: return &p.integral.integral_limit_nm;
-    case ParamId::kAdaptiveGamma: return &p.adaptive.gamma;
-    case ParamId::kAdaptiveEigFloor: return &p.adaptive.eig_floor_ratio;
-    case ParamId::kAdaptiveEigCeiling: return &p.adaptive.eig_ceiling_ratio;
-    case ParamId::kDpdKp: return &p.dpd.k_p;
-    case ParamId::kOmegaSwitch: return &p.guidance.omega_switch;
-    case ParamId::kKqd: return &p.guidance.k_qd;
-    case ParamId::kEpsTrans: return &p.guidance.eps_trans;
-    case ParamId::kTrackResetPeriod: return &p.guidance.track_reset_period_s;
-    case ParamId::kSensorTimeout: return &p.mode.sensor_timeout_s;
-    case ParamId::kGyroMaxRate: return &p.estimator.gyro_max_rate;
-    case ParamId::kQuatNormTolerance: return &p.estimator.quat_norm_tolerance;
-    case ParamId::kEstimatorOmegaC: return &p.estimator.omega_c;
-    default: return nullptr;
+    case ParamId::kIntegralLimit:
+      return &p.integral.integral_limit_nm;
+    case ParamId::kAdaptiveGamma:
+      return &p.adaptive.gamma;
+    case ParamId::kAdaptiveEigFloor:
+      return &p.adaptive.eig_floor_ratio;
+    case ParamId::kAdaptiveEigCeiling:
+      return &p.adaptive.eig_ceiling_ratio;
+    case ParamId::kDpdKp:
+      return &p.dpd.k_p;
+    case ParamId::kOmegaSwitch:
+      return &p.guidance.omega_switch;
+    case ParamId::kKqd:
+      return &p.guidance.k_qd;
+    case ParamId::kEpsTrans:
+      return &p.guidance.eps_trans;
+    case ParamId::kTrackResetPeriod:
+      return &p.guidance.track_reset_period_s;
+    case ParamId::kSensorTimeout:
+      return &p.mode.sensor_timeout_s;
+    case ParamId::kGyroMaxRate:
+      return &p.estimator.gyro_max_rate;
+    case ParamId::kQuatNormTolerance:
+      return &p.estimator.quat_norm_tolerance;
+    case ParamId::kEstimatorOmegaC:
+      return &p.estimator.omega_c;
+    default:
+      return nullptr;
   }
 }
 
 }  // namespace
 
-const std::array<ParamSpec, kParamCount>& param_specs() { return kSpecs; }
+const std::array<ParamSpec, kParamCount>& param_specs() {
+  return kSpecs;
+}
 
 ParamLoadResult write_param(gnc::GncParams& table, std::int32_t id, const double* values, int n) {
   if (id < 0 || id >= kParamCount) {

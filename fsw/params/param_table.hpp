@@ -79,12 +79,13 @@ class ParamTable {
   bool loaded() const { return loaded_; }
   const gnc::GncParams& inactive() const { return inactive_; }
 
-  // Snapshot of the inactive table for activation at the next tick boundary (false: nothing loaded).
+  // Snapshot of the inactive table for activation at the next tick boundary (false: nothing
+  // loaded).
   bool stage();
   bool staged() const { return staged_; }
   const gnc::GncParams& staged_table() const { return staged_table_; }
-  // The staged table is now active: later loads (made after the snapshot) stay in the inactive copy,
-  // otherwise inactive := active.
+  // The staged table is now active: later loads (made after the snapshot) stay in the inactive
+  // copy, otherwise inactive := active.
   void activated(const gnc::GncParams& active);
   // The activation failed at the boundary: nothing changes but the stage.
   void activation_failed() { staged_ = false; }

@@ -14,11 +14,11 @@ namespace rocksteady::fsw {
 
 struct ChunkResult {
   ChunkStatus status{ChunkStatus::kStored};
-  bool started{false};            // this chunk opened a new uplink
-  bool abandoned{false};          // ... and dropped an unfinished one
+  bool started{false};    // this chunk opened a new uplink
+  bool abandoned{false};  // ... and dropped an unfinished one
   std::int32_t abandoned_id{-1};
   std::int32_t abandoned_received{0};
-  bool completed{false};          // this chunk was the last missing one
+  bool completed{false};  // this chunk was the last missing one
 };
 
 class TrajectoryUplink {

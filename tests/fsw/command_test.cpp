@@ -17,9 +17,15 @@ using test::command;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double mode_arg(gnc::Mode m) { return static_cast<double>(static_cast<int>(m)); }
-double law_arg(gnc::LawId l) { return static_cast<double>(static_cast<int>(l)); }
-double ref_arg(ReferenceId r) { return static_cast<double>(static_cast<int>(r)); }
+double mode_arg(gnc::Mode m) {
+  return static_cast<double>(static_cast<int>(m));
+}
+double law_arg(gnc::LawId l) {
+  return static_cast<double>(static_cast<int>(l));
+}
+double ref_arg(ReferenceId r) {
+  return static_cast<double>(static_cast<int>(r));
+}
 
 TEST(CommandTable, RowsMatchTheirOpcodeAndRejectOneArgumentTooManyOrTooFew) {
   const auto& table = opcode_table();

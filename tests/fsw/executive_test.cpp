@@ -1,4 +1,5 @@
-// Executive: dividers, absolute deadlines, slips, missed ticks, throttled warnings; fake clock only.
+// Executive: dividers, absolute deadlines, slips, missed ticks, throttled warnings; fake clock
+// only.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -167,7 +168,7 @@ TEST(Executive, SlipWhenTheNextTickIsDueBeforeTheCycleEnded) {
   loop.run(40);
   loop.run(60);
   EXPECT_TRUE(loop.slips.empty());
-  loop.run(120);  // overruns its 100 ms period by 20 ms
+  loop.run(120);                // overruns its 100 ms period by 20 ms
   const Tick t = loop.run(10);  // this tick was due 20 ms before the previous cycle ended
   EXPECT_EQ(t.missed, 0u);
   ASSERT_EQ(loop.slips.size(), 1u);

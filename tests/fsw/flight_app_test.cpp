@@ -16,7 +16,9 @@ using test::V4;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double mode_arg(gnc::Mode m) { return static_cast<double>(static_cast<int>(m)); }
+double mode_arg(gnc::Mode m) {
+  return static_cast<double>(static_cast<int>(m));
+}
 
 TEST(FlightApp, InitRejectsAnExecutivePeriodThatDiffersFromTheGncPeriod) {
   FakeClock clock;
@@ -143,7 +145,7 @@ TEST(FlightApp, BadSensorInputIsRejectedAndNeverStopsTheSoftware) {
   s.gyro_rate = V3(kNaN, 0, 0);
   f.app->gnc_tick(s, out);
   s.t += 0.05;
-  s.gyro_rate = V3(1e6, 0, 0);  // above gyro_max_rate
+  s.gyro_rate = V3(1e6, 0, 0);           // above gyro_max_rate
   s.star_quat = V4(0.5, 0.5, 0.5, 2.0);  // not a unit quaternion
   f.app->gnc_tick(s, out);
   EXPECT_EQ(f.app->health().sensor_rejects, rejects0 + 2);

@@ -168,7 +168,8 @@ inline void linear_despin_table(const V3& omega0, double duration, int n, gnc::T
 }
 
 // Cut a table into uplink chunks of 32 samples.
-inline std::vector<TrajectoryChunk> chunks_of(const gnc::TrajectoryTable& t, std::int32_t upload_id) {
+inline std::vector<TrajectoryChunk> chunks_of(const gnc::TrajectoryTable& t,
+                                              std::int32_t upload_id) {
   std::vector<TrajectoryChunk> v;
   const int count = (t.count + kChunkSamples - 1) / kChunkSamples;
   for (int i = 0; i < count; ++i) {

@@ -15,7 +15,9 @@ using test::AppFixture;
 using test::M3;
 using test::V3;
 
-double id_arg(ParamId id) { return static_cast<double>(static_cast<int>(id)); }
+double id_arg(ParamId id) {
+  return static_cast<double>(static_cast<int>(id));
+}
 
 // Written independently of the fsw's own mapping: where each parameter id must land.
 struct Field {
@@ -27,7 +29,9 @@ struct Field {
 std::vector<Field> fields() {
   using P = gnc::GncParams;
   auto m = [](ParamId id, std::function<M3*(P&)> f) { return Field{id, std::move(f), nullptr}; };
-  auto s = [](ParamId id, std::function<double*(P&)> f) { return Field{id, nullptr, std::move(f)}; };
+  auto s = [](ParamId id, std::function<double*(P&)> f) {
+    return Field{id, nullptr, std::move(f)};
+  };
   return {
       m(ParamId::kNtclK, [](P& p) { return &p.ntcl.k; }),
       m(ParamId::kNtclLambda, [](P& p) { return &p.ntcl.lambda; }),
@@ -70,14 +74,17 @@ TEST(ParamTable, EveryParameterIdLandsInItsField) {
     if (f.matrix) {
       const M3 cur = *f.matrix(expected);
       const V3 d = 1.25 * cur.diagonal();
-      ASSERT_TRUE(t.load(static_cast<int>(f.id), d.data(), 3).ok()) << param_specs()[int(f.id)].name;
+      ASSERT_TRUE(t.load(static_cast<int>(f.id), d.data(), 3).ok())
+          << param_specs()[int(f.id)].name;
       *f.matrix(expected) = d.asDiagonal();
       gnc::GncParams got = t.inactive();
-      EXPECT_TRUE(f.matrix(got)->isApprox(*f.matrix(expected), 0.0)) << param_specs()[int(f.id)].name;
+      EXPECT_TRUE(f.matrix(got)->isApprox(*f.matrix(expected), 0.0))
+          << param_specs()[int(f.id)].name;
     } else {
       // A value that keeps the table valid: scale towards the valid interior.
       double v = *f.scalar(expected);
-      v = f.id == ParamId::kTrackResetPeriod ? 5.0 : (f.id == ParamId::kAdaptiveEigFloor ? 0.4 : 1.1 * v);
+      v = f.id == ParamId::kTrackResetPeriod ? 5.0
+                                             : (f.id == ParamId::kAdaptiveEigFloor ? 0.4 : 1.1 * v);
       if (f.id == ParamId::kQuatNormTolerance) v = 0.02;
       ASSERT_TRUE(t.load(static_cast<int>(f.id), &v, 1).ok()) << param_specs()[int(f.id)].name;
       *f.scalar(expected) = v;
@@ -152,10 +159,11 @@ TEST(ParamTableActivation, TakesEffectAtTheNextTickBoundary) {
   EXPECT_TRUE(f.app->health().table_loaded);
   ASSERT_TRUE(f.send(Opcode::kParamActivate).accepted);
   EXPECT_EQ(f.send(Opcode::kParamActivate).reason, RejectReason::kBusy);  // one at a time
-  EXPECT_EQ(f.app->active_params().dpd.k_p, kp_before);  // not before the boundary
+  EXPECT_EQ(f.app->active_params().dpd.k_p, kp_before);                   // not before the boundary
   f.ticks(1);
   EXPECT_EQ(f.app->active_params().dpd.k_p, 5.0);
-  EXPECT_TRUE(f.app->active_params().ntcl.k.isApprox(V3(2.0, 3.0, 4.0).asDiagonal().toDenseMatrix(), 0.0));
+  EXPECT_TRUE(
+      f.app->active_params().ntcl.k.isApprox(V3(2.0, 3.0, 4.0).asDiagonal().toDenseMatrix(), 0.0));
   EXPECT_FALSE(f.app->param_table().loaded());
   EXPECT_EQ(f.app->param_table().inactive().dpd.k_p, 5.0);  // inactive := active
   const HealthTelemetry h = f.app->health();
@@ -169,7 +177,8 @@ TEST(ParamTableActivation, TakesEffectAtTheNextTickBoundary) {
 TEST(ParamTableActivation, KeepsTheCommandedLawAndTarget) {
   AppFixture f;
   f.ticks(2);
-  ASSERT_TRUE(f.send(Opcode::kSetLaw, {static_cast<double>(static_cast<int>(gnc::LawId::kSo3))}).accepted);
+  ASSERT_TRUE(
+      f.send(Opcode::kSetLaw, {static_cast<double>(static_cast<int>(gnc::LawId::kSo3))}).accepted);
   ASSERT_TRUE(f.send(Opcode::kSetTarget, {0.1, 0.2, -0.1}).accepted);
   f.ticks(1);
   ASSERT_EQ(f.app->active_params().law, gnc::LawId::kSo3);
@@ -179,7 +188,8 @@ TEST(ParamTableActivation, KeepsTheCommandedLawAndTarget) {
   EXPECT_EQ(f.app->active_params().guidance.k_qd, 0.3);
   EXPECT_EQ(f.app->active_params().law, gnc::LawId::kSo3);
   // The flight core still holds the commanded target: attitude_error = q_hat - q_final.
-  EXPECT_TRUE((f.out.telemetry.q_hat - f.out.telemetry.attitude_error).isApprox(V3(0.1, 0.2, -0.1), 1e-12));
+  EXPECT_TRUE(
+      (f.out.telemetry.q_hat - f.out.telemetry.attitude_error).isApprox(V3(0.1, 0.2, -0.1), 1e-12));
 }
 
 TEST(ParamTableActivation, LoadsAfterTheActivateCommandStayInTheInactiveTable) {
