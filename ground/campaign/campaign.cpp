@@ -329,7 +329,7 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
       RunOptions opt;
       opt.duration_s = spec.duration_s;
       const double d = spec.duration_s >= 0 ? spec.duration_s : setup.duration_s;
-      opt.log_interval_s = spec.log_interval_s >= 0 ? spec.log_interval_s : d / 2000.0;
+      opt.log_interval_s = spec.log_interval_s >= 0 ? spec.log_interval_s : d / 5000.0;
       if (!spec.write_timeseries && !spec.write_plots) opt.log_interval_s = 0.0;
       opt.progress_ticks = &ticks;
       RunResult r;

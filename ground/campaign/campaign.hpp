@@ -29,7 +29,7 @@ struct CampaignSpec {
   bool write_plots{true};
   ProgressMode progress{ProgressMode::kAuto};
   double duration_s{-1.0};      // < 0: each case's own duration
-  double log_interval_s{-1.0};  // < 0: duration / 2000
+  double log_interval_s{-1.0};  // < 0: duration / 5000
 };
 
 struct CampaignReport {

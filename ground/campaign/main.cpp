@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
     sub->add_option("--out,-o", spec.out_dir, "output folder");
     sub->add_option("--duration", spec.duration_s, "simulated seconds (default: the case's)");
     sub->add_option("--log-interval", spec.log_interval_s,
-                    "time-series interval, s (default: duration / 2000)");
+                    "time-series interval, s (default: duration / 5000)");
     sub->add_flag("--no-plots", no_plots, "skip the PNG plots");
     sub->add_flag("--no-timeseries", no_series, "skip the time series (and the plots)");
     sub->add_flag("--quiet,-q", quiet, "no progress display");

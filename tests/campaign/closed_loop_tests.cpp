@@ -80,6 +80,43 @@ TEST(ClosedLoop, FuelOptimalWithoutATrajectoryReportsNoReference) {
   EXPECT_EQ(r.total_fuel_kg, 0.0);
 }
 
+// A simple uplinkable rate profile: omega_d decays linearly from the initial rate to rest.
+gnc::TrajectoryTable linear_despin(const Eigen::Vector3d& omega0, double t_final) {
+  gnc::TrajectoryTable table;
+  table.count = 201;
+  for (int i = 0; i < table.count; ++i) {
+    gnc::TrajectorySample& s = table.samples[static_cast<std::size_t>(i)];
+    s.t = t_final * i / (table.count - 1);
+    s.omega_d = omega0 * (1.0 - s.t / t_final);
+    s.omega_d_dot = -omega0 / t_final;
+  }
+  table.samples[static_cast<std::size_t>(table.count - 1)].omega_d.setZero();
+  table.checksum = gnc::trajectory_checksum(table);
+  return table;
+}
+
+TEST(ClosedLoop, FuelOptimalStrategyFollowsAnUplinkedTrajectoryInTrack) {
+  const config::RunSetup s = load(1);
+  const gnc::TrajectoryTable table = linear_despin(s.truth.omega0, 5000.0);
+  ASSERT_EQ(gnc::validate_trajectory(table, s.flight.guidance.eps_trans), gnc::TrajectoryError::kOk);
+  GncFlightSide flight;
+  RunOptions opt;
+  opt.log_interval_s = 100.0;
+  const RunResult r =
+      run_closed_loop(s, *parse_strategy("ntcl+fuel_optimal"), flight, &table, opt);
+  ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
+  EXPECT_EQ(r.final_mode, "TRACK");
+  EXPECT_EQ(r.series.front().mode, gnc::Mode::kTrack);  // entered on the first tick
+  // The body follows the decaying profile (with the law's lag): slower half-way, at rest later.
+  const TimeRow& mid = r.series[25];
+  ASSERT_NEAR(mid.t, 2500.0, 1e-9);
+  EXPECT_LT(mid.omega.norm(), 0.75 * s.truth.omega0.norm());
+  for (const TimeRow& row : r.series) EXPECT_EQ(row.mode, gnc::Mode::kTrack);
+  ASSERT_TRUE(r.t_omega_conv_s.has_value());
+  EXPECT_LE(r.final_rate_rad_s, 1e-4);
+  EXPECT_GT(r.total_fuel_kg, 0.0);
+}
+
 TEST(ClosedLoop, SameSeedSameBits) {
   const config::RunSetup s = load(7);  // noise, disturbance, model error: every stream in play
   const RunResult a = run(s, "ntcl+dpd_ref", 1.0, 600.0);
