@@ -107,19 +107,17 @@ Mat3 params_to_inertia(const Vec6& a) {
 
 Mat3 project_inertia(const Mat3& j, double lo, double hi) {
   const Mat3 sym = 0.5 * (j + j.transpose());
-  // Iterative (QR) solver: accurate eigenvectors even for repeated eigenvalues; fixed-size, no heap.
+  // Fast path: closed-form eigenvalues; most ticks the estimate is well inside the set.
   Eigen::SelfAdjointEigenSolver<Mat3> es;
-  es.compute(sym, Eigen::ComputeEigenvectors);
-  Vec3 lam = es.eigenvalues();
-  bool inside = true;
-  for (int i = 0; i < 3; ++i) {
-    const double c = std::clamp(lam[i], lo, hi);
-    inside = inside && c == lam[i];
-    lam[i] = c;
-  }
-  if (inside) {
+  es.computeDirect(sym, Eigen::EigenvaluesOnly);
+  const double margin = 1e-6 * hi;
+  if (es.eigenvalues().minCoeff() >= lo + margin && es.eigenvalues().maxCoeff() <= hi - margin) {
     return sym;
   }
+  // Iterative (QR) solver: accurate eigenvectors even for repeated eigenvalues; fixed-size, no heap.
+  es.compute(sym, Eigen::ComputeEigenvectors);
+  Vec3 lam = es.eigenvalues();
+  for (int i = 0; i < 3; ++i) lam[i] = std::clamp(lam[i], lo, hi);
   const Mat3& v = es.eigenvectors();
   return v * lam.asDiagonal() * v.transpose();
 }
