@@ -33,8 +33,9 @@ void report(const planner::PlanResult& r) {
   std::printf("open loop       max error %.3g rad/s, final rate %.3g rad/s\n", v.propagation_error,
               v.propagated_final_rate);
   if (v.refinement_checked) {
-    std::printf("refined grid    %.4f kg (change %.4f %%)\n", v.refined_fuel_kg,
-                100.0 * v.refinement_change);
+    std::printf("refined grid    %.4f kg (change %.4f %%), %d iterations, %.3f s\n",
+                v.refined_fuel_kg, 100.0 * v.refinement_change, v.refined_iterations,
+                v.refined_seconds);
   }
 }
 
@@ -67,6 +68,8 @@ int main(int argc, char** argv) {
                  "final time (fixed) or its upper bound (free), s; default 8x the shortest despin");
   app.add_option("--t-final-min", settings.t_final_min, "lower bound of a free final time, s");
   app.add_flag("--free-final-time", settings.free_final_time, "let t_f float in [min, max]");
+  app.add_option("--tolerance", settings.tolerance, "IPOPT convergence tolerance (scaled NLP)")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--no-refinement", no_refinement, "skip the grid-refinement check");
   app.add_option("-o,--output", output, "trajectory file to write");
   app.add_option("--cache-dir", cache_dir, "plan-once cache directory (file named by problem hash)");

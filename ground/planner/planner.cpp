@@ -455,10 +455,13 @@ PlanResult plan(const PlanProblem& problem) {
     const SolveOutcome fine = solve(model, settings, 2 * settings.nodes - 1, r.t_final_min,
                                     r.t_final_max, &r.samples);
     if (!fine.ok) {
+      r.verification.refined_iterations = fine.iterations;
       r.error = "verification failed: refined grid: " + fine.error;
       return r;
     }
     r.verification.refinement_checked = true;
+    r.verification.refined_iterations = fine.iterations;
+    r.verification.refined_seconds = fine.seconds;
     r.verification.refined_fuel_kg = fine.cost_ns / (kIsp * kG0);
     r.verification.refinement_change =
         std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;

@@ -82,6 +82,8 @@ struct Verification {
   bool refinement_checked{false};
   double refined_fuel_kg{0.0};
   double refinement_change{0.0};  // |fuel_refined - fuel| / fuel
+  int refined_iterations{0};
+  double refined_seconds{0.0};
 };
 
 struct PlanResult {
