@@ -6,14 +6,6 @@
 #include <cmath>
 #include <stdexcept>
 
-// gnc/model/rcs.cpp (torque_matrix) calls Vec3::cross without including <Eigen/Geometry>, so the
-// gnc library references this instance without defining it. Emit it here until gnc includes the
-// header itself.
-template Eigen::MatrixBase<rocksteady::gnc::Vec3>::cross_product_return_type<
-    rocksteady::gnc::Vec3>::type
-Eigen::MatrixBase<rocksteady::gnc::Vec3>::cross<rocksteady::gnc::Vec3>(
-    const Eigen::MatrixBase<rocksteady::gnc::Vec3>&) const;
-
 namespace rocksteady::ground::planner {
 
 namespace {
