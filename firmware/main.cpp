@@ -189,7 +189,8 @@ int firmware_main() {
     if (counted[m] == 0) continue;
     const double mean = static_cast<double>(counts_total[m]) / counted[m];
     line.str("  ").str(gnc::to_string(static_cast<gnc::Mode>(m))).str(": mean ")
-        .fix(mean * insn_per_count, 0).str(", max ").fix(counts_max[m] * insn_per_count, 0)
+        .fix(mean * insn_per_count, 0).str(", max ")
+        .fix(counts_max[m] * insn_per_count, 0)
         .str(" over ").u32(counted[m]).str(" ticks");
     line.flush();
   }
