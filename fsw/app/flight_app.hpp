@@ -90,6 +90,8 @@ class FlightApp {
   // --- Inspection -------------------------------------------------------------------------------
   gnc::Mode mode() const { return gnc_.mode(); }
   const gnc::Gnc& core() const { return gnc_; }
+  // The flight core's output of the last GNC cycle, with its raw mode events (gnc::ModeEvents).
+  const gnc::GncOutput& core_output() const { return gout_; }
   const gnc::GncParams& active_params() const { return gnc_.params(); }
   const ParamTable& param_table() const { return table_; }
   const Executive& executive() const { return exec_; }

@@ -24,6 +24,17 @@ ConfigCheck validate(const ExecutiveConfig& c) {
   return ConfigCheck{};
 }
 
+ExecutiveConfig lockstep_executive(double gnc_dt, double housekeeping_period_s) {
+  ExecutiveConfig c;
+  c.base_rate_hz = 1.0 / gnc_dt;
+  c.gnc_divider = 1;
+  const double ticks = std::round(housekeeping_period_s / gnc_dt);
+  c.housekeeping_divider = std::isfinite(ticks) && ticks >= 1.0 && ticks <= 100000.0
+                               ? static_cast<std::uint32_t>(ticks)
+                               : 1;
+  return c;
+}
+
 const char* to_string(GroupId g) {
   switch (g) {
     case GroupId::kGnc:

@@ -29,6 +29,10 @@ struct ConfigCheck {
 };
 ConfigCheck validate(const ExecutiveConfig& c);
 
+// The executive of a lockstep run: base tick = GNC tick = one sensor frame every `gnc_dt` seconds,
+// housekeeping every `housekeeping_period_s` (rounded to whole ticks, at least one).
+ExecutiveConfig lockstep_executive(double gnc_dt, double housekeeping_period_s = 1.0);
+
 enum class GroupId : std::uint8_t { kGnc = 0, kHousekeeping = 1 };
 inline constexpr int kGroupCount = 2;
 const char* to_string(GroupId g);

@@ -288,3 +288,20 @@ TEST(FlightAppExecutive, SlipsAndMissedTicksAreTelemeteredWithThrottledWarnings)
 
 }  // namespace
 }  // namespace rocksteady::fsw
+
+namespace rocksteady::fsw {
+namespace {
+
+TEST(Executive, LockstepConfigurationMatchesTheGncPeriod) {
+  for (const double dt : {0.05, 0.1, 0.25, 1.0}) {
+    const ExecutiveConfig c = lockstep_executive(dt, 1.0);
+    Executive exec;
+    ASSERT_TRUE(exec.configure(c).ok) << dt;
+    EXPECT_NEAR(exec.gnc_period_s(), dt, 1e-12 * dt);
+    EXPECT_EQ(c.housekeeping_divider, static_cast<std::uint32_t>(std::lround(1.0 / dt)));
+  }
+  EXPECT_EQ(lockstep_executive(0.1, 0.0).housekeeping_divider, 1u);  // at least every tick
+}
+
+}  // namespace
+}  // namespace rocksteady::fsw
