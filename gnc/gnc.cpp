@@ -17,7 +17,8 @@ void Gnc::configure_components() {
   refs_.configure(params_.guidance, params_.dt);
   laws_.configure(params_, j_hat);
   // B_hat from the estimated r_SO/BCM (SPEC §4); validate() has checked its rank.
-  alloc_.configure(torque_matrix(params_.rcs, params_.mass_hat.r_so_bcm), params_.rcs.u_max);
+  alloc_.configure(torque_matrix(params_.rcs, params_.mass_hat.r_so_bcm), params_.rcs.u_max,
+                   params_.allocator);
 }
 
 ParamCheck Gnc::init(const GncParams& params) {
@@ -127,7 +128,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     }
   }
 
-  // 5. Allocator, Eq. (53); fuel estimate, Eq. (54).
+  // 5. Allocator, Eq. (53) or Eq. (52) (params_.allocator); fuel estimate, Eq. (54).
   Vec8 u = Vec8::Zero();
   AllocatorStatus status;
   const bool enabled = actuating(modes_.mode());

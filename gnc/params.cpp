@@ -99,6 +99,10 @@ ParamCheck validate(const GncParams& p) {
     return bad("rcs", "B_hat is rank-deficient (cannot produce torque about every axis)");
   }
 
+  if (static_cast<int>(p.allocator) >= kAllocatorKindCount) {
+    return bad("allocator", "unknown allocator");
+  }
+
   if (static_cast<int>(p.law) >= kLawCount) {
     return bad("law", "unknown control law");
   }

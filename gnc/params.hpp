@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "gnc/allocation/allocator.hpp"
 #include "gnc/model/mass_properties.hpp"
 #include "gnc/model/rcs.hpp"
 #include "gnc/types.hpp"
@@ -109,6 +110,8 @@ struct GncParams {
   GuidanceParams guidance{};
   EstimatorParams estimator{};
   ModeParams mode{};
+  // SPEC §4: the study's pseudoinverse, Eq. (53), or the fuel-optimal allocation, Eq. (52).
+  AllocatorKind allocator{AllocatorKind::kPseudoInverse};
   double isp_s{287.0};  // Eq. (54)
   double g0{9.8};
 };

@@ -19,10 +19,20 @@ double torque_matrix_rcond(const Mat38& b) {
   return hi > 0.0 && lo > 0.0 ? lo / hi : 0.0;
 }
 
-bool Allocator::configure(const Mat38& b_hat, double u_max) {
-  if (torque_matrix_rcond(b_hat) < 1e-12 || !(u_max > 0.0)) {
+const char* to_string(AllocatorKind k) {
+  switch (k) {
+    case AllocatorKind::kPseudoInverse: return "pinv";
+    case AllocatorKind::kL1: return "l1";
+  }
+  return "?";
+}
+
+bool Allocator::configure(const Mat38& b_hat, double u_max, AllocatorKind kind) {
+  if (torque_matrix_rcond(b_hat) < 1e-12 || !(u_max > 0.0) ||
+      static_cast<int>(kind) >= kAllocatorKindCount || !l1_.configure(b_hat, u_max)) {
     return false;
   }
+  kind_ = kind;
   b_hat_ = b_hat;
   u_max_ = u_max;
   const Mat3 bbt = b_hat * b_hat.transpose();
@@ -42,6 +52,20 @@ void Allocator::allocate(const Vec3& u_c, Vec8& u, AllocatorStatus& status) cons
   } else {
     status.scale = 1.0;
     status.saturated = false;
+  }
+  status.l1_fallback = false;
+  status.l1_iterations = 0;
+  if (kind_ == AllocatorKind::kL1) {
+    // Eq. (52) for the torque the rescaled pseudoinverse achieves: attainable (that u attains it),
+    // same direction and magnitude. Keep the pseudoinverse's forces if the LP cannot certify a
+    // solution or (never expected) would spend more fuel.
+    const L1Solution s = l1_.solve(status.scale * u_c);
+    status.l1_iterations = s.iterations;
+    if (s.ok && s.u.lpNorm<1>() <= u.lpNorm<1>() * (1.0 + 1e-12) + 1e-12 * u_max_) {
+      u = s.u;
+    } else {
+      status.l1_fallback = true;
+    }
   }
   status.torque_achieved = b_hat_ * u;
 }

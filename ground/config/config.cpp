@@ -123,6 +123,18 @@ GncConfig load_gnc(const std::string& path) {
     doc.fail("estimator", "expected auto, passthrough or filter, got '" + est + "'");
   }
 
+  // SPEC §4: optional; the study's pseudoinverse, Eq. (53), unless the fuel-optimal Eq. (52).
+  if (doc.has("allocator")) {
+    const std::string alloc = doc.text("allocator");
+    if (alloc == "pinv") {
+      p.allocator = gnc::AllocatorKind::kPseudoInverse;
+    } else if (alloc == "l1") {
+      p.allocator = gnc::AllocatorKind::kL1;
+    } else {
+      doc.fail("allocator", "expected pinv or l1, got '" + alloc + "'");
+    }
+  }
+
   MapReader f = doc.map("filter");
   p.estimator.omega_c = f.positive("omega_c_rad_s");
   p.estimator.predict_substeps = f.integer("predict_substeps");

@@ -137,6 +137,15 @@ TEST(ConfigShipped, GncIsTable4) {
   EXPECT_NEAR(g.params.guidance.eps_trans, d.guidance.eps_trans, 1e-15);
   EXPECT_NEAR(g.params.estimator.omega_c, d.estimator.omega_c, 1e-15);
   EXPECT_EQ(g.estimator, EstimatorChoice::kAuto);
+  EXPECT_EQ(g.params.allocator, gnc::AllocatorKind::kPseudoInverse);  // the study's Eq. (53)
+}
+
+TEST(ConfigShipped, AllocatorKeyIsOptionalAndSelectsTheL1Allocator) {
+  TempFile l1("gnc.yaml", replaced(read(kGnc), "allocator: pinv", "allocator: l1"));
+  EXPECT_EQ(load_gnc(l1.path()).params.allocator, gnc::AllocatorKind::kL1);
+  EXPECT_EQ(load_run(kMission, l1.path(), case_file(1)).flight.allocator, gnc::AllocatorKind::kL1);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), "allocator: pinv", ""));
+  EXPECT_EQ(load_gnc(absent.path()).params.allocator, gnc::AllocatorKind::kPseudoInverse);
 }
 
 TEST(ConfigErrors, UnreadableFile) {
@@ -202,6 +211,8 @@ TEST(ConfigErrors, NegativeNoisePower) {
 TEST(ConfigErrors, BadValues) {
   TempFile f("gnc.yaml", replaced(read(kGnc), "estimator: auto", "estimator: kalman"));
   expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough or filter");
+  TempFile a("gnc.yaml", replaced(read(kGnc), "allocator: pinv", "allocator: simplex"));
+  expect_error([&] { load_gnc(a.path()); }, a.path(), "allocator", "pinv or l1");
   TempFile g("gnc.yaml", replaced(read(kGnc), "{K_d: 1.0e4, k_p: 10.0}", "{K_d: -1.0e4, k_p: 10.0}"));
   expect_error([&] { load_gnc(g.path()); }, g.path(), "laws.dpd.K_d", "not positive definite");
   TempFile h("case.yaml", replaced(read(case_file(1)), "seed: 1001", "seed: -4"));

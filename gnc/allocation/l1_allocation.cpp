@@ -1,0 +1,224 @@
+#include "gnc/allocation/l1_allocation.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/LU>
+
+namespace rocksteady::gnc {
+
+namespace {
+
+// Columns 0..7: u+ (B_hat columns), 8..15: u- (minus the columns), 16..18: phase-1 artificials.
+// The problem is scaled so that every column entry is at most 1 and every bound is 0 or 1:
+// x = u+- / u_max, torque / (u_max max|B_ij|).
+constexpr int kStructural = 2 * kChannels;
+constexpr int kVars = kStructural + 3;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kCostTol = 1e-11;  // reduced-cost optimality tolerance (costs are 0 or 1)
+constexpr double kPivotTol = 1e-9;  // smallest usable entry of B_b^-1 a_j in the ratio test
+constexpr double kTieTol = 1e-12;   // ratios this close are ties (Bland: smallest index leaves)
+constexpr double kFeasTol = 1e-9;   // bound and residual tolerance of the certified solution
+constexpr double kDetTol = 1e-12;   // |det B_b| below this: the basis is treated as singular
+constexpr int kDegenerateBeforeBland = 2;  // degenerate steps in a row before Bland's rule
+
+struct Lp {
+  const Mat38* a{nullptr};
+  Vec3 art_sign{Vec3::Ones()};
+  std::array<int, 3> basis{};
+  std::array<bool, kVars> basic{};
+  std::array<bool, kVars> upper{};  // a nonbasic variable sits at its upper bound
+  std::array<double, kVars> ub{};
+  int phase{1};
+  int iterations{0};
+  bool bland_only{false};
+
+  Vec3 column(int j) const {
+    if (j < kChannels) return a->col(j);
+    if (j < kStructural) return -a->col(j - kChannels);
+    Vec3 e = Vec3::Zero();
+    e(j - kStructural) = art_sign(j - kStructural);
+    return e;
+  }
+  // Phase 1: minimise the artificials; phase 2: Eq. (52), the sum of u+ and u-.
+  double cost(int j) const {
+    const bool artificial = j >= kStructural;
+    return (phase == 1) == artificial ? 1.0 : 0.0;
+  }
+};
+
+// Basis inverse and the basic variables' values for the current nonbasic bounds.
+bool basic_solution(const Lp& lp, const Vec3& tau, Mat3& binv, Vec3& xb) {
+  Mat3 bb;
+  for (int r = 0; r < 3; ++r) bb.col(r) = lp.column(lp.basis[static_cast<std::size_t>(r)]);
+  bool invertible = false;
+  double det = 0.0;
+  bb.computeInverseAndDetWithCheck(binv, det, invertible, kDetTol);
+  if (!invertible) return false;
+  Vec3 rhs = tau;
+  for (int j = 0; j < kStructural; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    if (!lp.basic[k] && lp.upper[k]) rhs -= lp.ub[k] * lp.column(j);
+  }
+  xb = binv * rhs;
+  return xb.allFinite();
+}
+
+// One simplex phase to optimality. False: iteration cap, singular basis or no bounded step.
+bool run_phase(Lp& lp, const Vec3& tau) {
+  int degenerate_run = 0;
+  for (;;) {
+    Mat3 binv;
+    Vec3 xb;
+    if (!basic_solution(lp, tau, binv, xb)) return false;
+    Vec3 cb;
+    for (int r = 0; r < 3; ++r) cb(r) = lp.cost(lp.basis[static_cast<std::size_t>(r)]);
+    const Vec3 y = binv.transpose() * cb;  // simplex multipliers
+
+    // Entering: Dantzig's rule (the largest reduced-cost violation, ties to the lowest index) while
+    // steps make progress; Bland's rule (the lowest-index improving nonbasic) once a run of
+    // degenerate steps starts, until a step makes progress again: the objective strictly decreases
+    // between runs and Bland's rule cannot cycle within one, so the method terminates.
+    // Artificials never re-enter.
+    const bool bland = lp.bland_only || degenerate_run >= kDegenerateBeforeBland;
+    int enter = -1;
+    double violation = 0.0;
+    for (int j = 0; j < kStructural; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      if (lp.basic[k]) continue;
+      const double d = lp.cost(j) - y.dot(lp.column(j));
+      const double v = lp.upper[k] ? d : -d;  // > 0: moving off the bound lowers the cost
+      if (v > kCostTol && v > violation) {
+        enter = j;
+        violation = v;
+        if (bland) break;
+      }
+    }
+    if (enter < 0) return true;  // optimal for this phase
+    if (lp.iterations >= L1Allocation::kMaxIterations) return false;
+    ++lp.iterations;
+
+    const auto ke = static_cast<std::size_t>(enter);
+    const double dir = lp.upper[ke] ? -1.0 : 1.0;  // the entering variable moves by dir * theta
+    const Vec3 w = binv * lp.column(enter);        // x_B(theta) = x_B - dir theta w
+
+    // Leaving: the smallest ratio; ties go to the lowest variable index (Bland).
+    int leave_row = -1;
+    bool leave_to_upper = false;
+    double best = kInf;
+    for (int r = 0; r < 3; ++r) {
+      const int v = lp.basis[static_cast<std::size_t>(r)];
+      const double g = dir * w(r);
+      double t = kInf;
+      bool to_upper = false;
+      if (g > kPivotTol) {
+        t = std::max(0.0, xb(r)) / g;
+      } else if (g < -kPivotTol && lp.ub[static_cast<std::size_t>(v)] < kInf) {
+        t = std::max(0.0, lp.ub[static_cast<std::size_t>(v)] - xb(r)) / -g;
+        to_upper = true;
+      } else {
+        continue;
+      }
+      const bool tie = std::fabs(t - best) <= kTieTol;
+      if ((!tie && t < best) ||
+          (tie && leave_row >= 0 && v < lp.basis[static_cast<std::size_t>(leave_row)])) {
+        best = tie ? std::min(t, best) : t;
+        leave_row = r;
+        leave_to_upper = to_upper;
+      }
+    }
+
+    const double flip = lp.ub[ke];  // the entering variable reaches its other bound first
+    degenerate_run = std::min(flip, best) <= kTieTol ? degenerate_run + 1 : 0;
+    if (flip <= best + kTieTol) {
+      if (!(flip < kInf)) return false;  // unbounded step (not reachable: all columns bounded)
+      lp.upper[ke] = !lp.upper[ke];
+      continue;
+    }
+    if (leave_row < 0) return false;
+    const auto kr = static_cast<std::size_t>(leave_row);
+    const auto kl = static_cast<std::size_t>(lp.basis[kr]);
+    lp.basic[kl] = false;
+    lp.upper[kl] = leave_to_upper;
+    lp.basis[kr] = enter;
+    lp.basic[ke] = true;
+    lp.upper[ke] = false;
+  }
+}
+
+}  // namespace
+
+bool L1Allocation::configure(const Mat38& b_hat, double u_max, Pricing pricing) {
+  const double s = b_hat.cwiseAbs().maxCoeff();
+  if (!b_hat.allFinite() || !(s > 0.0) || !std::isfinite(u_max) || !(u_max > 0.0)) return false;
+  b_scale_ = s;
+  b_scaled_ = b_hat / s;
+  u_max_ = u_max;
+  pricing_ = pricing;
+  return true;
+}
+
+// Eq. (52): min |u|_1 s.t. B_hat u = tau, |u|_inf <= u_max.
+L1Solution L1Allocation::solve(const Vec3& tau) const {
+  L1Solution out;
+  if (!(u_max_ > 0.0) || !tau.allFinite()) return out;
+  const Vec3 tau_s = tau / (u_max_ * b_scale_);
+
+  Lp lp;
+  lp.a = &b_scaled_;
+  lp.bland_only = pricing_ == Pricing::kBland;
+  for (int i = 0; i < 3; ++i) lp.art_sign(i) = tau_s(i) < 0.0 ? -1.0 : 1.0;
+  for (int j = 0; j < kVars; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    lp.basic[k] = j >= kStructural;
+    lp.upper[k] = false;
+    lp.ub[k] = j < kStructural ? 1.0 : kInf;
+  }
+  lp.basis = {kStructural, kStructural + 1, kStructural + 2};
+
+  // Phase 1: from u = 0 with the artificials carrying the torque, to a feasible vertex.
+  lp.phase = 1;
+  const bool phase1 = run_phase(lp, tau_s);
+  out.iterations = static_cast<std::uint16_t>(lp.iterations);
+  if (!phase1) return out;
+  Mat3 binv;
+  Vec3 xb;
+  if (!basic_solution(lp, tau_s, binv, xb)) return out;
+  for (int r = 0; r < 3; ++r) {
+    if (lp.basis[static_cast<std::size_t>(r)] >= kStructural && xb(r) > kFeasTol) return out;
+  }
+  // Artificials still basic (at zero: redundant-looking rows) are fixed at zero from now on.
+  for (int j = kStructural; j < kVars; ++j) lp.ub[static_cast<std::size_t>(j)] = 0.0;
+
+  // Phase 2: Eq. (52).
+  lp.phase = 2;
+  const bool phase2 = run_phase(lp, tau_s);
+  out.iterations = static_cast<std::uint16_t>(lp.iterations);
+  if (!phase2 || !basic_solution(lp, tau_s, binv, xb)) return out;
+
+  std::array<double, kVars> x{};
+  for (int j = 0; j < kVars; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    x[k] = lp.upper[k] ? lp.ub[k] : 0.0;
+  }
+  for (int r = 0; r < 3; ++r)
+    x[static_cast<std::size_t>(lp.basis[static_cast<std::size_t>(r)])] = xb(r);
+  for (int j = 0; j < kVars; ++j) {
+    const double hi = j < kStructural ? 1.0 : 0.0;
+    const double v = x[static_cast<std::size_t>(j)];
+    if (!(v >= -kFeasTol && v <= hi + kFeasTol)) return out;
+  }
+  Vec8 v;
+  for (int i = 0; i < kChannels; ++i) {
+    const double d = x[static_cast<std::size_t>(i)] - x[static_cast<std::size_t>(i + kChannels)];
+    v(i) = std::min(1.0, std::max(-1.0, d));
+  }
+  if ((b_scaled_ * v - tau_s).lpNorm<Eigen::Infinity>() > kFeasTol) return out;
+  out.u = u_max_ * v;
+  out.ok = true;
+  return out;
+}
+
+}  // namespace rocksteady::gnc

@@ -1,0 +1,52 @@
+// Fuel-optimal thrust allocation, Eq. (52): min |u|_1 s.t. B_hat u = tau, |u|_inf <= u_max.
+//
+// An exact solver for this fixed-size linear program: a bounded-variable (upper-bounded) primal
+// simplex over the split channels u = u+ - u-, 0 <= u+-_i <= u_max (16 columns, 3 equality rows),
+// two phases (phase 1 drives three artificials out of the basis from u = 0), and an iteration cap.
+// Pricing: Dantzig's rule while steps make progress, Bland's rule (lowest index enters, ties in the
+// ratio test to the lowest index) through any run of degenerate steps, so it cannot cycle. The 3x3
+// basis is re-inverted from its columns at every iteration (no drift of an updated inverse).
+// Everything is fixed-size: no heap, no exceptions, no I/O, deterministic.
+//
+// The caller chooses a torque that is attainable (Allocator uses the pseudoinverse's scaled torque,
+// which is); `ok == false` means the solve could not certify a solution (iteration cap, singular
+// basis, infeasible phase 1, or a residual check failed) and `u` must not be used.
+#pragma once
+
+#include <cstdint>
+
+#include "gnc/types.hpp"
+
+namespace rocksteady::gnc {
+
+struct L1Solution {
+  Vec8 u{Vec8::Zero()};         // channel forces, N
+  bool ok{false};               // u is an optimal, feasible solution of Eq. (52)
+  std::uint16_t iterations{0};  // simplex pivots and bound flips, both phases
+};
+
+class L1Allocation {
+ public:
+  // Well above what the eight-channel problem needs (tests record the observed maximum: ~10 with
+  // the default pricing, ~30 with Bland's rule alone).
+  static constexpr int kMaxIterations = 64;
+
+  enum class Pricing : std::uint8_t {
+    kDantzigThenBland = 0,  // flight default: few iterations
+    kBland = 1,             // Bland's rule throughout (slower; the anti-cycling rule, tested alone)
+  };
+
+  // Stores the scaled problem data. Returns false for a non-finite or zero B_hat or u_max <= 0
+  // (rank is the caller's check: Allocator::configure and parameter validation).
+  bool configure(const Mat38& b_hat, double u_max, Pricing pricing = Pricing::kDantzigThenBland);
+  // Eq. (52) for the torque `tau` (N m).
+  L1Solution solve(const Vec3& tau) const;
+
+ private:
+  Mat38 b_scaled_{Mat38::Zero()};  // B_hat / b_scale_
+  double b_scale_{1.0};            // max |B_hat_ij|, m
+  double u_max_{0.0};
+  Pricing pricing_{Pricing::kDantzigThenBland};
+};
+
+}  // namespace rocksteady::gnc
