@@ -92,6 +92,23 @@ void BM_Allocate(benchmark::State& state) {
 }
 BENCHMARK(BM_Allocate);
 
+// The fuel-optimal allocation, Eq. (52), of the same request (pinv first, then the simplex).
+void BM_AllocateL1(benchmark::State& state) {
+  const GncParams p = study_gnc_params(200.0);
+  Allocator a;
+  a.configure(torque_matrix(p.rcs, p.mass_hat.r_so_bcm), p.rcs.u_max, AllocatorKind::kL1);
+  Vec3 uc(300.0, -150.0, 800.0);
+  Vec8 u;
+  AllocatorStatus st;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(uc);
+    a.allocate(uc, u, st);
+    benchmark::DoNotOptimize(u);
+  }
+  state.counters["simplex_iterations"] = st.l1_iterations;
+}
+BENCHMARK(BM_AllocateL1);
+
 }  // namespace
 
 BENCHMARK_MAIN();
