@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# Cross builds of the flight side, from a fresh Debian 12 machine:
+#   1. packages: the arm64 architecture for multiarch target libraries, then scripts/setup.sh --cross;
+#   2. aarch64 Linux (preset aarch64): the flight side and its tests, built with Debian's cross
+#      compiler, tests run by ctest under qemu-aarch64; LCM comes from a private sysroot inside the
+#      build tree (cmake/toolchains/arm64-sysroot.sh);
+#   3. bare-metal Cortex-M7 (preset baremetal-m7): the gnc core + firmware image, run in
+#      qemu-system-arm (mps2-an500, semihosting): it closes the loop on a built-in plant and exits
+#      0 when DETUMBLE has despun the vehicle and handed over to HOLD.
+# Usage: scripts/cross.sh [--no-setup] [--only aarch64|baremetal] [--bench]
+#   --bench  also count instructions per Gnc::step exactly, on both targets, from emulator traces
+#            (-singlestep -d exec,nochain: one line per executed instruction; the counted steps are
+#            bracketed by marker functions, tests/cross/count_insns.awk counts inside the brackets).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+setup=1
+only=""
+bench=0
+while (($#)); do
+  case "$1" in
+    --no-setup) setup=0 ;;
+    --only) only="$2"; shift ;;
+    --bench) bench=1 ;;
+    *) echo "usage: $0 [--no-setup] [--only aarch64|baremetal] [--bench]" >&2; exit 2 ;;
+  esac
+  shift
+done
+jobs=$(nproc)
+t_start=$SECONDS
+stage() { echo "cross: [$((SECONDS - t_start)) s] $*"; }
+
+if ((setup)); then
+  SUDO=""
+  if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+  if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+    stage "adding the arm64 architecture (multiarch target libraries)"
+    $SUDO dpkg --add-architecture arm64
+    $SUDO apt-get update -qq
+  fi
+  scripts/setup.sh --cross
+fi
+
+if [[ -z "$only" || "$only" == "aarch64" ]]; then
+  stage "aarch64: sysroot, configure, build"
+  cmake/toolchains/arm64-sysroot.sh build/aarch64/sysroot
+  cmake --preset aarch64 >/dev/null
+  cmake --build --preset aarch64 -j "$jobs"
+  stage "aarch64: ctest under qemu-aarch64"
+  ctest --preset aarch64 -j "$jobs"
+  if ((bench)); then
+    stage "aarch64: instructions per Gnc::step (qemu-aarch64 -singlestep -d exec)"
+    for mode in detumble hold; do
+      printf '  aarch64 %-8s ' "$mode"
+      qemu-aarch64 -singlestep -d exec,nochain -D /dev/stderr \
+          build/aarch64/tests/cross/gnc_tick_count "$mode" 50 2>&1 >/dev/null |
+        awk -f tests/cross/count_insns.awk
+    done
+  fi
+fi
+
+if [[ -z "$only" || "$only" == "baremetal" ]]; then
+  stage "bare metal: configure, build the firmware image"
+  cmake --preset baremetal-m7 >/dev/null
+  cmake --build --preset baremetal-m7 -j "$jobs" --target rocksteady_fw
+  elf=build/baremetal-m7/firmware/rocksteady_fw.elf
+  arm-none-eabi-size -A -d "$elf" | grep -E '^(section|\.isr_vector|\.text|\.data|\.bss|\.stack|Total)'
+  arm-none-eabi-size -B -d "$elf"
+  stage "bare metal: run in qemu-system-arm (mps2-an500, semihosting, -icount shift=0)"
+  rc=0
+  timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
+      -icount shift=0 -semihosting-config enable=on,target=native,arg=rocksteady_fw \
+      -kernel "$elf" || rc=$?
+  if ((rc != 0)); then
+    echo "cross: FAIL: the firmware image exited with $rc" >&2
+    exit 1
+  fi
+  if ((bench)); then
+    stage "bare metal: instructions per Gnc::step (qemu-system-arm -singlestep -d exec)"
+    for start in detumble hold; do
+      printf '  cortex-m7 %-8s ' "$start"
+      timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
+          -singlestep -d exec,nochain -D /dev/stderr \
+          -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=5,arg=start=$start \
+          -kernel "$elf" 2>&1 >/dev/null | awk -f tests/cross/count_insns.awk
+    done
+  fi
+fi
+stage "done"
