@@ -15,8 +15,11 @@ packages=(
   clang libclang-rt-14-dev
 )
 if [[ "${1:-}" == "--cross" ]]; then
+  # aarch64 target libraries are Debian multiarch (:arm64, needs `dpkg --add-architecture arm64`,
+  # which scripts/cross.sh does); LCM is not multi-arch and is unpacked into a private sysroot.
   packages+=(g++-aarch64-linux-gnu qemu-user gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
-             qemu-system-arm)
+             qemu-system-arm
+             libstdc++6:arm64 libgtest-dev:arm64 libgmock-dev:arm64 libglib2.0-dev:arm64)
 fi
 
 missing=()
