@@ -89,6 +89,8 @@ class FlightApp {
 
   // --- Inspection -------------------------------------------------------------------------------
   gnc::Mode mode() const { return gnc_.mode(); }
+  // On-board time: the sample time of the last GNC cycle (for acknowledgement time stamps).
+  double onboard_time() const { return last_gnc_t_; }
   const gnc::Gnc& core() const { return gnc_; }
   // The flight core's output of the last GNC cycle, with its raw mode events (gnc::ModeEvents).
   const gnc::GncOutput& core_output() const { return gout_; }

@@ -1,0 +1,152 @@
+#include "fsw/bus/bus_mapping.hpp"
+
+#include <cstring>
+
+#include "hal/lcm/convert.hpp"
+
+namespace rocksteady::fsw::bus {
+
+namespace {
+
+// Copy at most max_len bytes of a NUL-terminated text into a string with reserved capacity.
+void set_text(std::string& s, const char* text, int max_len) {
+  s.clear();
+  if (text == nullptr) return;
+  std::size_t n = 0;
+  while (n < static_cast<std::size_t>(max_len) && text[n] != '\0') ++n;
+  s.append(text, n);
+}
+
+std::int64_t i64(std::uint64_t v) {
+  return v > static_cast<std::uint64_t>(INT64_MAX) ? INT64_MAX : static_cast<std::int64_t>(v);
+}
+
+}  // namespace
+
+GroundCommand to_command(const rocksteady::ground_cmd_t& m) {
+  GroundCommand c;
+  c.seq = m.seq;
+  c.source = m.sender_id;
+  c.opcode = m.opcode;
+  c.arg_count = m.nargs;
+  for (int i = 0; i < kMaxCommandArgs && i < m.nargs; ++i) {
+    c.args[static_cast<std::size_t>(i)] = m.args[i];
+  }
+  return c;
+}
+
+void to_chunk(const rocksteady::trajectory_chunk_t& m, TrajectoryChunk& out) {
+  out.upload_id = m.upload_id;
+  out.chunk_index = m.chunk_index;
+  out.chunk_count = m.total_chunks;
+  out.total_samples = m.total_samples;
+  out.crc32 = static_cast<std::uint32_t>(m.table_crc & 0xFFFFFFFFLL);
+  out.n = m.count;
+  for (int i = 0; i < kChunkSamples; ++i) {
+    gnc::TrajectorySample& s = out.samples[static_cast<std::size_t>(i)];
+    if (i < m.count) {
+      s.t = m.t[i];
+      for (int a = 0; a < 3; ++a) {
+        s.omega_d(a) = m.omega_d[i][a];
+        s.omega_d_dot(a) = m.omega_d_dot[i][a];
+      }
+    } else {
+      s = gnc::TrajectorySample{};
+    }
+  }
+}
+
+void reserve_text(rocksteady::cmd_ack_t& m) {
+  m.text.reserve(static_cast<std::size_t>(rocksteady::cmd_ack_t::MAX_TEXT) + 1);
+}
+void reserve_text(rocksteady::event_t& m) {
+  m.text.reserve(static_cast<std::size_t>(rocksteady::event_t::MAX_TEXT) + 1);
+}
+
+void to_message(const CommandAck& ack, double t, rocksteady::cmd_ack_t& m) {
+  m.kind = rocksteady::cmd_ack_t::KIND;
+  m.version = rocksteady::cmd_ack_t::VERSION;
+  m.t = t;
+  m.seq = ack.seq;
+  m.sender_id = ack.source;
+  m.opcode = ack.opcode;
+  m.accepted = ack.accepted ? 1 : 0;
+  m.reason = static_cast<std::int32_t>(ack.reason);
+  m.detail = ack.detail;
+  set_text(m.text, ack.text, rocksteady::cmd_ack_t::MAX_TEXT);
+}
+
+void to_message(const Event& e, rocksteady::event_t& m) {
+  m.kind = rocksteady::event_t::KIND;
+  m.version = rocksteady::event_t::VERSION;
+  m.t = e.t;
+  m.seq = i64(e.seq);
+  m.severity = static_cast<std::int8_t>(e.severity);
+  m.id = static_cast<std::int32_t>(e.id);
+  m.arg0 = e.arg0;
+  m.arg1 = e.arg1;
+  set_text(m.text, e.text.data(), rocksteady::event_t::MAX_TEXT);
+}
+
+void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m) {
+  m.base_ticks = i64(h.base_ticks);
+  m.base_missed = h.base_missed;
+  m.rate_group_count = 2;
+  const RateGroupStats* groups[2] = {&h.gnc, &h.housekeeping};
+  for (int g = 0; g < rocksteady::gnc_telemetry_t::RATE_GROUPS; ++g) {
+    const bool used = g < 2;
+    m.rg_cycles[g] = used ? groups[g]->cycles : 0;
+    m.rg_last_exec_ns[g] = used ? groups[g]->last_exec_ns : 0;
+    m.rg_max_exec_ns[g] = used ? groups[g]->max_exec_ns : 0;
+    m.rg_slips[g] = used ? groups[g]->slips : 0;
+    m.rg_missed[g] = used ? groups[g]->missed_ticks : 0;
+  }
+  m.cmd_accepted = h.cmd_accepted;
+  m.cmd_rejected = h.cmd_rejected;
+  m.cmd_last_seq = h.last_cmd_seq;
+  m.cmd_last_opcode = h.last_cmd_opcode;
+  m.cmd_last_reject = static_cast<std::int32_t>(h.last_reject);
+  m.cmd_pending = static_cast<std::int32_t>(h.cmd_pending);
+  m.events_emitted = h.events_emitted;
+  m.events_dropped = h.events_dropped;
+  m.frames_accepted = h.frames_accepted;
+  m.frames_rejected = h.frames_rejected;
+  m.frameless_ticks = h.frameless_ticks;
+  m.sensor_rejects = h.sensor_rejects;
+  m.table_loads = h.table_loads;
+  m.table_activations = h.table_activations;
+  m.table_loaded = h.table_loaded ? 1 : 0;
+  m.uplink_id = h.uplink_id;
+  m.uplink_chunks_received = h.uplink_chunks_received;
+  m.uplink_total_chunks = h.uplink_chunk_count;
+  m.uplink_chunks_rejected = h.uplink_chunks_rejected;
+  m.trajectories_loaded = h.trajectories_loaded;
+}
+
+void fill_rx(const hal::wire::RxCounters& rx, rocksteady::gnc_telemetry_t& m) {
+  m.rx_ok = i64(rx.ok);
+  m.rx_malformed = i64(rx.malformed_total());
+  m.rx_bad_kind = i64(rx.bad_kind_total());
+  m.rx_out_of_range = i64(rx.out_of_range);
+}
+
+hal::SensorConfigError SensorFrontEnd::configure(const hal::SensorConfig& gyro,
+                                                 const hal::SensorConfig& star) {
+  const hal::SensorConfigError g = gyro_.configure(gyro);
+  if (g != hal::SensorConfigError::kOk) return g;
+  return star_.configure(star);
+}
+
+void SensorFrontEnd::reset() {
+  gyro_.reset();
+  star_.reset();
+}
+
+gnc::SensorSample SensorFrontEnd::sample(const rocksteady::sensor_frame_t& m) {
+  const hal::RawSensors raw = hal::wire::to_raw(m);
+  const hal::BodyRate rate = gyro_.read(raw.gyro, raw.t);
+  const hal::BodyAttitude att = star_.read(raw.star, raw.t);
+  return hal::make_sample(raw.t, rate, att);
+}
+
+}  // namespace rocksteady::fsw::bus
