@@ -1,4 +1,5 @@
 #include "ground/campaign/campaign.hpp"
+#include "ground/campaign/fsw_flight_side.hpp"
 
 #include <unistd.h>
 
@@ -334,7 +335,9 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
       opt.progress_ticks = &ticks;
       RunResult r;
       try {
-        GncFlightSide flight;
+        GncFlightSide core_only;
+        FswFlightSide app;
+        FlightSide& flight = spec.use_flight_app ? static_cast<FlightSide&>(app) : core_only;
         const gnc::TrajectoryTable* traj = st.needs_trajectory() ? plans[j.c].table.get() : nullptr;
         r = run_closed_loop(setup, st, flight, traj, opt, plans[j.c].note);
         if (st.needs_trajectory()) {

@@ -30,6 +30,9 @@ struct CampaignSpec {
   ProgressMode progress{ProgressMode::kAuto};
   double duration_s{-1.0};      // < 0: each case's own duration
   double log_interval_s{-1.0};  // < 0: duration / 5000
+  // The flight side: the flight application through the in-process HAL (the code that flies), or the
+  // bare flight core (for comparison).
+  bool use_flight_app{true};
 };
 
 struct CampaignReport {

@@ -103,6 +103,7 @@ int main(int argc, char** argv) {
   std::string case_arg = "1";
   std::string strategy_arg = "ntcl+dpd_ref";
   bool no_plots = false, no_series = false, quiet = false, progress = false;
+  std::string flight_arg = "app";
 
   CLI::App* run = app.add_subcommand("run", "one case with one strategy");
   run->add_option("--case", case_arg, "case number or case file")->capture_default_str();
@@ -123,9 +124,14 @@ int main(int argc, char** argv) {
     sub->add_flag("--no-timeseries", no_series, "skip the time series (and the plots)");
     sub->add_flag("--quiet,-q", quiet, "no progress display");
     sub->add_flag("--progress", progress, "progress display even when not on a terminal");
+    sub->add_option("--flight", flight_arg,
+                    "app: the flight application through the in-process HAL; core: gnc::Gnc alone")
+        ->check(CLI::IsMember({"app", "core"}))
+        ->capture_default_str();
   }
   CLI11_PARSE(app, argc, argv);
 
+  spec.use_flight_app = flight_arg == "app";
   if (mission.empty()) mission = config_dir + "/mission.yaml";
   if (gnc_file.empty()) gnc_file = config_dir + "/gnc.yaml";
   spec.mission_file = mission;

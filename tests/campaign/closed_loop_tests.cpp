@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "ground/campaign/fsw_flight_side.hpp"
 #include "ground/campaign/runner.hpp"
 #include "ground/config/config.hpp"
 #include "ground/plant/plant.hpp"
@@ -175,6 +176,34 @@ TEST(ClosedLoop, RunnerDrivesAnyFlightSideInLockstep) {
   const Eigen::Matrix3d j = gnc::total_inertia(s.truth.mass);
   const Eigen::Vector3d w0 = s.truth.omega0, w1 = r.series.back().omega;
   EXPECT_NEAR(w1.dot(j * w1), w0.dot(j * w0), 1e-9 * w0.dot(j * w0));
+}
+
+}  // namespace
+}  // namespace rocksteady::campaign
+
+namespace rocksteady::campaign {
+namespace {
+
+// The campaign flies the flight application (executive, commanding, uplink) through the in-process
+// HAL. It must reproduce the bare core's closed loop: the only difference is that the start mode is a
+// ground command, applied one tick (0.1 s) later than the core-only harness requests it.
+TEST(ClosedLoop, FlightApplicationThroughHalMatchesTheCoreAlone) {
+  const config::RunSetup s = config::load_run(
+      std::string(ROCKSTEADY_SOURCE_DIR) + "/configs/mission.yaml",
+      std::string(ROCKSTEADY_SOURCE_DIR) + "/configs/gnc.yaml",
+      std::string(ROCKSTEADY_SOURCE_DIR) + "/configs/cases/case1.yaml");
+  RunOptions opt;
+  opt.duration_s = 40000.0;
+  GncFlightSide core;
+  FswFlightSide app;
+  const RunResult a = run_closed_loop(s, *parse_strategy("ntcl+dpd_ref"), core, nullptr, opt);
+  const RunResult b = run_closed_loop(s, *parse_strategy("ntcl+dpd_ref"), app, nullptr, opt);
+  ASSERT_EQ(a.status, RunStatus::kOk) << a.note;
+  ASSERT_EQ(b.status, RunStatus::kOk) << b.note;
+  ASSERT_TRUE(a.t_omega_conv_s.has_value() && b.t_omega_conv_s.has_value());
+  EXPECT_NEAR(*b.t_omega_conv_s, *a.t_omega_conv_s, 0.002 * *a.t_omega_conv_s);
+  EXPECT_NEAR(b.total_fuel_kg, a.total_fuel_kg, 0.002 * a.total_fuel_kg);
+  EXPECT_EQ(b.final_mode, "HOLD");
 }
 
 }  // namespace
