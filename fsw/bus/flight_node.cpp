@@ -1,0 +1,384 @@
+#include "fsw/bus/flight_node.hpp"
+
+#include <poll.h>
+
+#include <cerrno>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+
+#include "hal/lcm/convert.hpp"
+#include "lcmtypes/channels.hpp"
+
+namespace rocksteady::fsw::bus {
+
+namespace {
+
+constexpr std::int64_t kNsPerS = 1000000000;
+constexpr std::int64_t kNsPerMs = 1000000;
+// Bus-layer events number their own sequence from here (the application's events count from 0).
+constexpr std::uint64_t kBusEventSeqBase = 1000000000000ULL;
+
+std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+
+void accumulate(hal::wire::RxCounters& a, const hal::wire::RxCounters& b) {
+  a.ok += b.ok;
+  a.too_short += b.too_short;
+  a.too_long += b.too_long;
+  a.bad_fingerprint += b.bad_fingerprint;
+  a.bad_length += b.bad_length;
+  a.malformed += b.malformed;
+  a.bad_kind += b.bad_kind;
+  a.bad_version += b.bad_version;
+  a.out_of_range += b.out_of_range;
+}
+
+// The Clock the real-time tick source sleeps on: it serves the bus until each deadline.
+class ServingClock final : public Clock {
+ public:
+  ServingClock(FlightNode& node, const Clock& base, const volatile std::sig_atomic_t* stop)
+      : node_(node), base_(base), stop_(stop) {}
+  std::int64_t now_ns() const override { return base_.now_ns(); }
+  void sleep_until(std::int64_t deadline_ns) override {
+    while (!error_ && (stop_ == nullptr || *stop_ == 0) && base_.now_ns() < deadline_ns) {
+      if (!node_.wait_once(deadline_ns)) error_ = true;
+    }
+  }
+  bool error() const { return error_; }
+
+ private:
+  FlightNode& node_;
+  const Clock& base_;
+  const volatile std::sig_atomic_t* stop_;
+  bool error_{false};
+};
+
+}  // namespace
+
+FlightNode::FlightNode(lcm_t* lcm, FlightApp& app, const hal::ThrusterBank& bank,
+                       SensorFrontEnd& sensors, const Clock& clock)
+    : lcm_(lcm), app_(app), bank_(bank), sensors_(sensors), clock_(clock) {
+  reserve_text(ack_msg_);
+  reserve_text(event_msg_);
+  tlm_msg_ = hal::wire::make<rocksteady::gnc_telemetry_t>();
+}
+
+FlightNode::~FlightNode() {
+  for (lcm_subscription_t*& s : subs_) {
+    if (s != nullptr && lcm_ != nullptr) lcm_unsubscribe(lcm_, s);
+    s = nullptr;
+  }
+}
+
+bool FlightNode::subscribe() {
+  subs_[0] = lcm_subscribe(lcm_, channels::kSensors, &FlightNode::on_sensors, this);
+  subs_[1] = lcm_subscribe(lcm_, channels::kGroundCmd, &FlightNode::on_command, this);
+  subs_[2] = lcm_subscribe(lcm_, channels::kTrajUplink, &FlightNode::on_chunk, this);
+  for (lcm_subscription_t* s : subs_) {
+    if (s == nullptr) return false;
+  }
+  // A whole table's uplink (32 chunks) may arrive between two ticks.
+  lcm_subscription_set_queue_capacity(subs_[2], 64);
+  return true;
+}
+
+hal::wire::RxCounters FlightNode::rx_total() const {
+  hal::wire::RxCounters t;
+  accumulate(t, stats_.rx_sensors);
+  accumulate(t, stats_.rx_commands);
+  accumulate(t, stats_.rx_uplink);
+  return t;
+}
+
+// ----------------------------------------------------------------------------------------------
+// Inputs
+// ----------------------------------------------------------------------------------------------
+
+void FlightNode::on_sensors(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
+  auto& n = *static_cast<FlightNode*>(self);
+  if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_frame_,
+                              &n.stats_.rx_sensors)) {
+    n.note_rx_reject(0, n.stats_.rx_sensors);
+    return;
+  }
+  ++n.stats_.frames;
+  if (n.have_seq_ && n.scratch_frame_.seq < n.last_seq_seen_) {
+    // The sensor stream restarted (a new plant, a rebooted front end): forget its old readings.
+    n.sensors_.reset();
+    n.restarted_ = true;
+    ++n.stats_.stream_restarts;
+    n.bus_event(Severity::kWarning, BusEventId::kStreamRestart,
+                static_cast<std::int32_t>(n.scratch_frame_.seq),
+                static_cast<std::int32_t>(n.stats_.stream_restarts),
+                "sensor frame seq went backwards: sensor stream restarted");
+  }
+  if (n.have_pending_) ++n.stats_.frames_superseded;
+  n.pending_frame_ = n.scratch_frame_;
+  n.have_pending_ = true;
+  n.have_seq_ = true;
+  n.last_seq_seen_ = n.scratch_frame_.seq;
+}
+
+void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
+  auto& n = *static_cast<FlightNode*>(self);
+  if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_cmd_,
+                              &n.stats_.rx_commands)) {
+    n.note_rx_reject(1, n.stats_.rx_commands);
+    return;
+  }
+  ++n.stats_.commands;
+  const CommandAck ack = n.app_.submit(to_command(n.scratch_cmd_));
+  to_message(ack, n.app_.core_output().telemetry.t, n.ack_msg_);
+  n.publish(channels::kCmdAck, n.ack_msg_);
+  n.drain_events();
+}
+
+void FlightNode::on_chunk(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
+  auto& n = *static_cast<FlightNode*>(self);
+  if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_chunk_,
+                              &n.stats_.rx_uplink)) {
+    n.note_rx_reject(2, n.stats_.rx_uplink);
+    return;
+  }
+  ++n.stats_.chunks;
+  to_chunk(n.scratch_chunk_, n.chunk_);
+  n.app_.receive_chunk(n.chunk_);  // the application raises the events and counts rejections
+  n.drain_events();
+}
+
+void FlightNode::note_rx_reject(int channel, const hal::wire::RxCounters& c) {
+  const std::int64_t now = clock_.now_ns();
+  if (rx_event_fired_[channel] && now - last_rx_event_ns_[channel] < kNsPerS) return;
+  rx_event_fired_[channel] = true;
+  last_rx_event_ns_[channel] = now;
+  static const char* const kText[3] = {"malformed message on RS_SENSORS: counted, ignored",
+                                       "malformed message on RS_GROUND_CMD: counted, ignored",
+                                       "malformed message on RS_TRAJ_UPLINK: counted, ignored"};
+  bus_event(Severity::kWarning, BusEventId::kRxRejected, channel,
+            static_cast<std::int32_t>(c.rejected()), kText[channel]);
+}
+
+// ----------------------------------------------------------------------------------------------
+// Outputs
+// ----------------------------------------------------------------------------------------------
+
+template <class T> void FlightNode::publish(const char* channel, const T& msg) {
+  const int n = hal::wire::encode(msg, buf_, static_cast<int>(sizeof buf_));
+  if (n < 0 || lcm_publish(lcm_, channel, buf_, static_cast<unsigned int>(n)) != 0) {
+    ++stats_.publish_errors;
+  }
+}
+
+void FlightNode::drain_events() {
+  Event e;
+  while (app_.pop_event(e)) {
+    to_message(e, event_msg_);
+    publish(channels::kEvents, event_msg_);
+  }
+}
+
+void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::int32_t arg1,
+                           const char* text) {
+  Event e;
+  e.seq = kBusEventSeqBase + bus_event_seq_++;
+  e.t = app_.core_output().telemetry.t;
+  e.severity = sev;
+  e.id = static_cast<EventId>(id);
+  e.arg0 = arg0;
+  e.arg1 = arg1;
+  std::snprintf(e.text.data(), e.text.size(), "%s", text);
+  to_message(e, event_msg_);
+  publish(channels::kEvents, event_msg_);
+}
+
+void FlightNode::tick(const Tick& t, const rocksteady::sensor_frame_t* frame, const NodeOptions& o) {
+  Outputs out;
+  gnc::SensorSample sample;
+  const gnc::SensorSample* sp = nullptr;
+  if (frame != nullptr) {
+    sample = sensors_.sample(*frame);
+    sp = &sample;
+    echo_seq_ = frame->seq;
+  }
+  app_.tick(t, sp, out);
+  last_index_ = t.index;
+  have_index_ = true;
+  ++stats_.ticks;
+  publish_outputs(out, o);
+}
+
+void FlightNode::publish_outputs(const Outputs& out, const NodeOptions& o) {
+  if (out.gnc_ran) {
+    bank_.command(out.command, thr_out_);
+    thr_msg_ = hal::wire::to_message(thr_out_, bank_.channel_forces(thr_out_), echo_seq_,
+                                     out.telemetry.t);
+    have_thr_msg_ = true;
+    publish(channels::kThrusterCmd, thr_msg_);
+    if (o.tlm_every <= 1 || gnc_cycles_ % o.tlm_every == 0) {
+      hal::wire::fill_gnc(app_.core_output(), tlm_msg_);
+      tlm_msg_.frame_seq = echo_seq_;
+      fill_health(app_.health(), tlm_msg_);
+      fill_rx(rx_total(), tlm_msg_);
+      publish(channels::kGncTelemetry, tlm_msg_);
+    }
+    ++gnc_cycles_;
+  }
+  drain_events();
+}
+
+void FlightNode::republish_command() {
+  if (have_thr_msg_) publish(channels::kThrusterCmd, thr_msg_);
+}
+
+void FlightNode::status_line(const char* prefix) const {
+  const HealthTelemetry h = app_.health();
+  const hal::wire::RxCounters rx = rx_total();
+  std::printf("%s t=%.1f s mode=%s law=%s ticks=%" PRIu64 " frames=%" PRIu64
+              " frameless=%u cmd=%u/%u rx_ok=%" PRIu64 " rx_rejected=%" PRIu64
+              " restarts=%" PRIu64 "\n",
+              prefix, h.t, gnc::to_string(h.mode), gnc::to_string(h.law), stats_.ticks,
+              stats_.frames, h.frameless_ticks, h.cmd_accepted, h.cmd_rejected, rx.ok,
+              rx.rejected(), stats_.stream_restarts);
+  std::fflush(stdout);
+}
+
+// ----------------------------------------------------------------------------------------------
+// Loops
+// ----------------------------------------------------------------------------------------------
+
+bool FlightNode::wait_once(std::int64_t deadline_ns) {
+  const int fd = lcm_get_fileno(lcm_);
+  std::int64_t rem = deadline_ns - clock_.now_ns();
+  if (rem < 0) rem = 0;
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
+  ts.tv_nsec = static_cast<long>(rem % kNsPerS);
+  pollfd p{};
+  p.fd = fd;
+  p.events = POLLIN;
+  const int r = ppoll(&p, 1, &ts, nullptr);
+  if (r < 0) return errno == EINTR;  // a signal: the caller looks at its stop flag
+  if (r == 0) return true;          // deadline
+  if (lcm_handle(lcm_) != 0) {
+    bus_error_ = true;
+    return false;
+  }
+  return true;
+}
+
+bool FlightNode::limits_reached(const NodeOptions& o, std::int64_t start_ns) const {
+  if (o.exit_after_ticks > 0 && stats_.ticks >= o.exit_after_ticks) return true;
+  if (o.exit_after_s >= 0.0 && clock_.now_ns() - start_ns >= to_ns(o.exit_after_s)) return true;
+  return false;
+}
+
+int FlightNode::run(const NodeOptions& o, const volatile std::sig_atomic_t* stop) {
+  last_status_ns_ = clock_.now_ns();
+  const int rc = o.clock == ClockMode::kLockstep ? run_lockstep(o, stop) : run_realtime(o, stop);
+  if (o.verbose) status_line("fsw exit:");
+  return rc;
+}
+
+int FlightNode::run_lockstep(const NodeOptions& o, const volatile std::sig_atomic_t* stop) {
+  const std::int64_t start = clock_.now_ns();
+  const std::int64_t period = app_.executive().base_period_ns();
+  const std::int64_t watchdog = to_ns(o.frame_watchdog_s);
+  LockstepSource source;
+  std::uint64_t offset = 0;
+  bool streaming = false;       // a frame has arrived (the watchdog is armed)
+  bool frameless = false;       // the watchdog fired: frameless ticks at the base period
+  std::int64_t last_frame_ns = start;
+  std::int64_t next_frameless_ns = start;
+
+  while ((stop == nullptr || *stop == 0) && !limits_reached(o, start)) {
+    std::int64_t deadline;
+    if (!streaming) {
+      deadline = clock_.now_ns() + 100 * kNsPerMs;  // wake up to look at the stop flag
+    } else if (!frameless) {
+      deadline = last_frame_ns + watchdog;
+    } else {
+      deadline = next_frameless_ns;
+    }
+    if (!wait_once(deadline)) return 1;
+    const std::int64_t now = clock_.now_ns();
+
+    if (have_pending_) {
+      have_pending_ = false;
+      const rocksteady::sensor_frame_t& frame = pending_frame_;
+      if (!restarted_ && !frameless && have_thr_msg_ && frame.seq == echo_seq_) {
+        // The plant resends a frame whose command it did not get: answer again, no new tick.
+        ++stats_.duplicate_frames;
+        republish_command();
+        last_frame_ns = now;
+        continue;
+      }
+      if (restarted_ || frameless) {
+        // A new stream, or the old one after a gap: new frame numbering, ticks continue.
+        source = LockstepSource{};
+        offset = have_index_ ? last_index_ + 1 : 0;
+        restarted_ = false;
+        frameless = false;
+      }
+      if (!source.on_frame(frame.seq, now)) {
+        ++stats_.stale_frames;
+        continue;
+      }
+      Tick t;
+      if (source.next(t)) {
+        t.index += offset;
+        tick(t, &frame, o);
+      }
+      streaming = true;
+      last_frame_ns = now;
+    } else if (streaming && now >= deadline) {
+      if (!frameless) {
+        frameless = true;
+        next_frameless_ns = now;
+        bus_event(Severity::kWarning, BusEventId::kFrameWatchdog,
+                  static_cast<std::int32_t>(echo_seq_), 0,
+                  "no sensor frame within the watchdog time: frameless ticks at the base rate");
+      }
+      const Tick t{have_index_ ? last_index_ + 1 : 0, now, 0};
+      tick(t, nullptr, o);
+      ++stats_.watchdog_ticks;
+      next_frameless_ns += period;
+      if (next_frameless_ns < now) next_frameless_ns = now + period;
+    }
+    if (o.verbose && now - last_status_ns_ >= kNsPerS) {
+      last_status_ns_ = now;
+      status_line("fsw:");
+    }
+  }
+  return bus_error_ ? 1 : 0;
+}
+
+int FlightNode::run_realtime(const NodeOptions& o, const volatile std::sig_atomic_t* stop) {
+  const std::int64_t start = clock_.now_ns();
+  ServingClock serving(*this, clock_, stop);
+  RealTimeClockSource source(serving, app_.executive().base_period_ns());
+  while ((stop == nullptr || *stop == 0) && !limits_reached(o, start)) {
+    Tick t;
+    source.next(t);
+    const std::int64_t now = clock_.now_ns();
+    if (serving.error()) return 1;
+    if (stop != nullptr && *stop != 0) break;
+    if (o.jitter_ns != nullptr && o.jitter_ns->size() < o.jitter_ns->capacity()) {
+      o.jitter_ns->push_back(now - t.start_ns);
+    }
+    if (have_pending_) {
+      have_pending_ = false;
+      restarted_ = false;
+      tick(t, &pending_frame_, o);
+    } else {
+      tick(t, nullptr, o);
+    }
+    if (o.verbose && now - last_status_ns_ >= kNsPerS) {
+      last_status_ns_ = now;
+      status_line("fsw:");
+    }
+  }
+  return bus_error_ ? 1 : 0;
+}
+
+}  // namespace rocksteady::fsw::bus

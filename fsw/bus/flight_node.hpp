@@ -1,0 +1,151 @@
+// rocksteady-fsw's bus loop: one FlightApp on the LCM bus.
+//
+// Inputs (raw-buffer subscriptions, decoded with hal::wire::safe_decode; a rejected message is
+// counted in gnc_telemetry_t.rx_* and dropped, never fatal): RS_SENSORS, RS_GROUND_CMD,
+// RS_TRAJ_UPLINK. Outputs: RS_THRUSTER_CMD (hal::ThrusterBank's physical thrusters, echoing the
+// frame), RS_GNC_TLM, RS_EVENTS, RS_CMD_ACK.
+//
+// Two clocks:
+//   lockstep  each new sensor frame is one base tick (fsw::LockstepSource); the thruster command
+//             echoes the frame's seq. A repeated frame (the plant resending after a lost command) is
+//             answered by re-publishing the command it already produced, without a second tick.
+//             After the first frame, when no frame arrives for `frame_watchdog_s` of wall time, the
+//             node runs frameless ticks at the base period, so the flight core's sensor timeout
+//             takes it to SAFE (thrusters off, event) when the plant is gone.
+//   realtime  fsw::RealTimeClockSource drives the base ticks on CLOCK_MONOTONIC; the bus is served
+//             while waiting for each deadline; each tick consumes the newest frame that arrived
+//             (a frameless tick when none did).
+// A frame whose seq goes backwards is a restarted sensor stream: the sensor front end forgets its
+// last readings (the flight application re-anchors its time base after frame_resync_count frames).
+//
+// Only this object's thread calls lcm_handle. Nothing here allocates per message except LCM itself.
+#pragma once
+
+#include <csignal>
+#include <cstdint>
+#include <vector>
+
+#include <lcm/lcm.h>
+
+#include "fsw/app/flight_app.hpp"
+#include "fsw/bus/bus_mapping.hpp"
+#include "fsw/executive/clock.hpp"
+#include "hal/lcm/codec.hpp"
+#include "hal/thruster_bank.hpp"
+
+namespace rocksteady::fsw::bus {
+
+enum class ClockMode { kLockstep, kRealtime };
+
+// Events of the bus layer itself (fsw::EventId are 100..; the plant's from 1000).
+enum class BusEventId : std::int32_t {
+  kStreamRestart = 200,  // sensor frame seq went backwards; arg0 = new seq, arg1 = restarts
+  kFrameWatchdog = 201,  // lockstep: no frame for frame_watchdog_s, frameless ticks
+  kRxRejected = 202,     // throttled; arg0 = channel (0 sensors, 1 ground cmd, 2 uplink), arg1 = total
+};
+
+struct NodeOptions {
+  ClockMode clock{ClockMode::kLockstep};
+  double frame_watchdog_s{1.0};     // lockstep only
+  std::uint32_t tlm_every{1};       // RS_GNC_TLM every N GNC cycles
+  double exit_after_s{-1.0};        // wall time; < 0: run until stopped
+  std::uint64_t exit_after_ticks{0};  // base ticks; 0: no limit
+  bool verbose{false};              // one status line per wall second on stdout
+  // Realtime: tick start minus its deadline, one value per base tick (capacity reserved by the
+  // caller; values beyond it are not recorded).
+  std::vector<std::int64_t>* jitter_ns{nullptr};
+};
+
+struct NodeStats {
+  std::uint64_t ticks{0};
+  std::uint64_t frames{0};          // valid frames received
+  std::uint64_t frames_superseded{0};  // realtime: a newer frame arrived before the tick
+  std::uint64_t duplicate_frames{0};   // lockstep: repeated frame, command re-published
+  std::uint64_t stale_frames{0};       // lockstep: older frame, dropped
+  std::uint64_t stream_restarts{0};
+  std::uint64_t watchdog_ticks{0};     // lockstep: frameless ticks after the watchdog fired
+  std::uint64_t commands{0};
+  std::uint64_t chunks{0};
+  std::uint64_t publish_errors{0};
+  hal::wire::RxCounters rx_sensors{};
+  hal::wire::RxCounters rx_commands{};
+  hal::wire::RxCounters rx_uplink{};
+};
+
+class FlightNode {
+ public:
+  // All referenced objects must outlive the node; `app` initialised, `bank` configured.
+  FlightNode(lcm_t* lcm, FlightApp& app, const hal::ThrusterBank& bank, SensorFrontEnd& sensors,
+             const Clock& clock);
+  FlightNode(const FlightNode&) = delete;
+  FlightNode& operator=(const FlightNode&) = delete;
+  ~FlightNode();
+
+  bool subscribe();
+  // Runs until *stop becomes non-zero or an exit limit is reached. Returns 0, or 1 on a bus error.
+  int run(const NodeOptions& options, const volatile std::sig_atomic_t* stop);
+
+  const NodeStats& stats() const { return stats_; }
+  hal::wire::RxCounters rx_total() const;
+
+  // Waits for the bus until `deadline_ns` (monotonic) or until one message was dispatched.
+  // Returns false on a bus error.
+  bool wait_once(std::int64_t deadline_ns);
+
+ private:
+  static void on_sensors(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+  static void on_command(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+  static void on_chunk(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+
+  int run_lockstep(const NodeOptions& o, const volatile std::sig_atomic_t* stop);
+  int run_realtime(const NodeOptions& o, const volatile std::sig_atomic_t* stop);
+
+  void tick(const Tick& tick, const rocksteady::sensor_frame_t* frame, const NodeOptions& o);
+  void publish_outputs(const Outputs& out, const NodeOptions& o);
+  void republish_command();
+  void drain_events();
+  void bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::int32_t arg1,
+                 const char* text);
+  void note_rx_reject(int channel, const hal::wire::RxCounters& c);
+  template <class T> void publish(const char* channel, const T& msg);
+  void status_line(const char* prefix) const;
+  bool limits_reached(const NodeOptions& o, std::int64_t start_ns) const;
+
+  lcm_t* lcm_;
+  FlightApp& app_;
+  const hal::ThrusterBank& bank_;
+  SensorFrontEnd& sensors_;
+  const Clock& clock_;
+  lcm_subscription_t* subs_[3]{nullptr, nullptr, nullptr};
+
+  // The newest valid frame not yet ticked.
+  rocksteady::sensor_frame_t scratch_frame_{};
+  rocksteady::sensor_frame_t pending_frame_{};
+  bool have_pending_{false};
+  bool have_seq_{false};
+  std::int64_t last_seq_seen_{-1};
+  bool restarted_{false};
+
+  rocksteady::ground_cmd_t scratch_cmd_{};
+  rocksteady::trajectory_chunk_t scratch_chunk_{};
+  TrajectoryChunk chunk_{};
+  rocksteady::cmd_ack_t ack_msg_{};
+  rocksteady::event_t event_msg_{};
+  rocksteady::gnc_telemetry_t tlm_msg_{};
+  rocksteady::thruster_cmd_t thr_msg_{};
+  hal::ThrusterOutputs thr_out_{};
+  bool have_thr_msg_{false};
+  std::int64_t echo_seq_{0};
+  std::uint64_t gnc_cycles_{0};
+  std::uint64_t bus_event_seq_{0};
+  std::int64_t last_rx_event_ns_[3]{0, 0, 0};
+  bool rx_event_fired_[3]{false, false, false};
+  std::int64_t last_status_ns_{0};
+  std::uint64_t last_index_{0};
+  bool have_index_{false};
+  bool bus_error_{false};
+  unsigned char buf_[4096]{};
+  NodeStats stats_{};
+};
+
+}  // namespace rocksteady::fsw::bus

@@ -1,0 +1,209 @@
+// rocksteady-fsw: the flight application on the LCM bus (processor-in-the-loop, or the flight
+// board's Linux process). Configuration is read once at start-up (YAML, through ground/config's
+// strict loader: only the flight side's estimates are used); after that the loop is the
+// FlightNode's, whose tick path does not allocate.
+//
+//   rocksteady-fsw --case 1 --clock lockstep --initial-mode DETUMBLE
+//   rocksteady-fsw --case 1 --clock realtime --rate 100 -v
+#include <algorithm>
+#include <cmath>
+#include <cctype>
+#include <cinttypes>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm.h>
+
+#include "fsw/app/flight_app.hpp"
+#include "fsw/bus/bus_mapping.hpp"
+#include "fsw/bus/flight_node.hpp"
+#include "fsw/executive/clock.hpp"
+#include "ground/config/config.hpp"
+#include "hal/thruster_bank.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int /*sig*/) { g_stop = 1; }
+
+std::string case_file(const std::string& config_dir, const std::string& arg) {
+  if (!arg.empty() && std::all_of(arg.begin(), arg.end(), [](unsigned char c) { return std::isdigit(c); })) {
+    return config_dir + "/cases/case" + arg + ".yaml";
+  }
+  return arg;
+}
+
+bool parse_law(const std::string& s, rocksteady::gnc::LawId& out) {
+  for (int i = 0; i < rocksteady::gnc::kLawCount; ++i) {
+    const auto id = static_cast<rocksteady::gnc::LawId>(i);
+    if (s == rocksteady::gnc::to_string(id)) {
+      out = id;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool parse_mode(std::string s, rocksteady::gnc::Mode& out) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::toupper(c); });
+  for (int i = 0; i < rocksteady::gnc::kModeCount; ++i) {
+    const auto m = static_cast<rocksteady::gnc::Mode>(i);
+    if (s == rocksteady::gnc::to_string(m)) {
+      out = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+void print_jitter(const char* label, std::vector<std::int64_t> v, double rate_hz) {
+  if (v.empty()) return;
+  for (auto& x : v) x = x < 0 ? -x : x;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+    return static_cast<double>(v[std::min(i, v.size() - 1)]) * 1e-3;
+  };
+  std::printf("%s rate=%.6g Hz ticks=%zu median=%.1f us p99=%.1f us max=%.1f us\n", label, rate_hz,
+              v.size(), at(0.5), at(0.99), static_cast<double>(v.back()) * 1e-3);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace rocksteady;
+  namespace bus = rocksteady::fsw::bus;
+  CLI::App cli{"Rocksteady flight software on the LCM bus"};
+  std::string config_dir = "configs";
+  std::string mission_path, gnc_path, case_arg = "1";
+  std::string lcm_url;
+  std::string clock_name = "lockstep";
+  std::string law_name, initial_mode;
+  double rate_hz = 0.0;
+  bus::NodeOptions opt;
+  bool jitter = false;
+  cli.add_option("--config-dir", config_dir, "folder with mission.yaml, gnc.yaml, cases/")
+      ->capture_default_str();
+  cli.add_option("--mission", mission_path, "mission file (default <config-dir>/mission.yaml)");
+  cli.add_option("--gnc", gnc_path, "GNC file (default <config-dir>/gnc.yaml)");
+  cli.add_option("--case", case_arg, "case number or case file (the flight side's estimates)")
+      ->capture_default_str();
+  cli.add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  cli.add_option("--clock", clock_name, "lockstep (one tick per sensor frame) or realtime")
+      ->check(CLI::IsMember({"lockstep", "realtime"}))
+      ->capture_default_str();
+  cli.add_option("--rate", rate_hz, "realtime base rate, Hz (default: the GNC rate; a multiple of it)");
+  cli.add_option("--law", law_name, "control law: ntcl, el, integral, adaptive, so3, dpd, feedforward");
+  cli.add_option("--initial-mode", initial_mode, "boot mode (mode.initial): IDLE, DETUMBLE, HOLD, SAFE");
+  cli.add_option("--frame-watchdog", opt.frame_watchdog_s,
+                 "lockstep: no sensor frame for this many wall seconds -> frameless ticks (-> SAFE)")
+      ->capture_default_str();
+  cli.add_option("--tlm-every", opt.tlm_every, "publish RS_GNC_TLM every N GNC cycles")
+      ->capture_default_str();
+  cli.add_option("--exit-after", opt.exit_after_s, "exit after this many wall seconds");
+  cli.add_option("--exit-after-ticks", opt.exit_after_ticks, "exit after this many base ticks");
+  cli.add_flag("-v,--verbose", opt.verbose, "one status line per second");
+  cli.add_flag("--jitter", jitter, "realtime: print tick-start deviation statistics at exit");
+  CLI11_PARSE(cli, argc, argv);
+
+  if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
+  if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
+
+  config::RunSetup setup;
+  try {
+    setup = config::load_run(mission_path, gnc_path, case_file(config_dir, case_arg));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rocksteady-fsw: %s\n", e.what());
+    return 2;
+  }
+
+  fsw::FlightConfig fc;
+  fc.gnc = setup.flight;  // the flight side's estimates only (never the truth)
+  if (!law_name.empty() && !parse_law(law_name, fc.gnc.law)) {
+    std::fprintf(stderr, "rocksteady-fsw: unknown law '%s'\n", law_name.c_str());
+    return 2;
+  }
+  if (!initial_mode.empty() && !parse_mode(initial_mode, fc.gnc.mode.initial)) {
+    std::fprintf(stderr, "rocksteady-fsw: unknown mode '%s'\n", initial_mode.c_str());
+    return 2;
+  }
+  const double dt = fc.gnc.dt;
+  if (clock_name == "lockstep") {
+    opt.clock = bus::ClockMode::kLockstep;
+    fc.executive = fsw::lockstep_executive(dt, 1.0);
+  } else {
+    opt.clock = bus::ClockMode::kRealtime;
+    const double base = rate_hz > 0.0 ? rate_hz : 1.0 / dt;
+    const double divider = std::round(base * dt);
+    if (divider < 1.0 || std::fabs(divider - base * dt) > 1e-9 * divider) {
+      std::fprintf(stderr, "rocksteady-fsw: --rate %g Hz is not a multiple of the GNC rate %g Hz\n",
+                   base, 1.0 / dt);
+      return 2;
+    }
+    fc.executive.base_rate_hz = base;
+    fc.executive.gnc_divider = static_cast<std::uint32_t>(divider);
+    fc.executive.housekeeping_divider = static_cast<std::uint32_t>(std::max(1.0, std::round(base)));
+  }
+
+  fsw::MonotonicClock clock;
+  static fsw::FlightApp app;  // large: static storage, initialised once
+  const fsw::InitResult ir = app.init(fc, clock);
+  if (!ir.ok) {
+    std::fprintf(stderr, "rocksteady-fsw: configuration rejected: %s: %s\n", ir.field, ir.reason);
+    return 2;
+  }
+  hal::ThrusterBank bank;
+  const hal::BankConfigCheck bc =
+      bank.configure(hal::default_thruster_bank_config(fc.gnc.rcs.u_max), &fc.gnc.rcs);
+  if (!bc.ok()) {
+    std::fprintf(stderr, "rocksteady-fsw: thruster bank: %s (channel %d)\n",
+                 hal::to_string(bc.error), bc.channel);
+    return 2;
+  }
+  bus::SensorFrontEnd sensors;
+  const hal::SensorConfig identity{};  // sensor frames are aligned with the body frame
+  if (sensors.configure(identity, identity) != hal::SensorConfigError::kOk) {
+    std::fprintf(stderr, "rocksteady-fsw: sensor configuration rejected\n");
+    return 2;
+  }
+
+  lcm_t* lcm = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
+  if (lcm == nullptr) {
+    std::fprintf(stderr, "rocksteady-fsw: cannot open the LCM bus\n");
+    return 3;
+  }
+  std::vector<std::int64_t> jitter_ns;
+  if (jitter && opt.clock == bus::ClockMode::kRealtime) {
+    const double base = fc.executive.base_rate_hz;
+    const double secs = opt.exit_after_s > 0.0 ? opt.exit_after_s : 3600.0;
+    jitter_ns.reserve(static_cast<std::size_t>(base * secs) + 16);
+    opt.jitter_ns = &jitter_ns;
+  }
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  int rc = 0;
+  {
+    bus::FlightNode node(lcm, app, bank, sensors, clock);
+    if (!node.subscribe()) {
+      std::fprintf(stderr, "rocksteady-fsw: cannot subscribe\n");
+      lcm_destroy(lcm);
+      return 3;
+    }
+    if (opt.verbose) {
+      std::printf("rocksteady-fsw: %s, base %.6g Hz, GNC every %u, law %s, boot mode %s\n",
+                  clock_name.c_str(), fc.executive.base_rate_hz, fc.executive.gnc_divider,
+                  gnc::to_string(fc.gnc.law), gnc::to_string(fc.gnc.mode.initial));
+      std::fflush(stdout);
+    }
+    rc = node.run(opt, &g_stop);
+    if (jitter) print_jitter("fsw jitter:", jitter_ns, fc.executive.base_rate_hz);
+  }
+  lcm_destroy(lcm);
+  return rc;
+}

@@ -1,0 +1,453 @@
+// rocksteady-plant: the truth model (ground/plant) as a process on the LCM bus, for
+// processor-in-the-loop runs against rocksteady-fsw.
+//
+// Each control period k: publish RS_SENSORS frame k (and RS_PLANT_TRUTH, decimated), then
+//   lockstep: wait for the RS_THRUSTER_CMD echoing seq k. A wait longer than --timeout-ms is
+//     counted; the frame is re-sent (--retries times; the flight software answers a repeated frame
+//     with the command it already computed), and if no echo comes the plant advances with the
+//     previous command held (zero-order hold), counted. Before frame 0 is answered the plant waits
+//     up to --startup-timeout for the flight software (not counted).
+//   realtime: advance on wall-clock deadlines with the newest command received (zero-order hold).
+// The plant commands nothing itself: mode commands come from the operator, a test or a script.
+// At the end, --summary prints the study's figures of merit (SPEC §7), computed on the true state
+// exactly as the in-process runner does (campaign::ConvergenceTracker, attitude_error).
+#include <poll.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <fstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm.h>
+
+#include "ground/campaign/runner.hpp"
+#include "ground/config/config.hpp"
+#include "ground/plant/plant.hpp"
+#include "hal/lcm/codec.hpp"
+#include "lcmtypes/channels.hpp"
+
+namespace {
+
+using namespace rocksteady;
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int /*sig*/) { g_stop = 1; }
+
+constexpr std::int64_t kNsPerS = 1000000000;
+
+std::int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
+}
+
+std::string case_file(const std::string& config_dir, const std::string& arg) {
+  if (!arg.empty() &&
+      std::all_of(arg.begin(), arg.end(), [](unsigned char c) { return std::isdigit(c); })) {
+    return config_dir + "/cases/case" + arg + ".yaml";
+  }
+  return arg;
+}
+
+// Plant events on RS_EVENTS (ids from 1000).
+enum PlantEvent : std::int32_t { kRunStarted = 1000, kEchoTimeout = 1001, kRunFinished = 1002 };
+
+// SPEC §4 wiring, the plant's own: channel 2k = pod k positions 0 (+) and 1 (-), channel 2k+1 =
+// positions 2 (+) and 3 (-); physical thruster = 4 pod + position.
+plant::Vec8 channel_forces_from_thrusters(const rocksteady::thruster_cmd_t& m) {
+  plant::Vec8 u = plant::Vec8::Zero();
+  if (m.enabled == 0) return u;
+  auto f = [&](int i) { return m.thruster_on[i] != 0 ? m.thruster_force[i] : 0.0; };
+  for (int pod = 0; pod < 4; ++pod) {
+    u(2 * pod) = f(4 * pod + 0) - f(4 * pod + 1);
+    u(2 * pod + 1) = f(4 * pod + 2) - f(4 * pod + 3);
+  }
+  return u;
+}
+
+struct Bus {
+  lcm_t* lcm{nullptr};
+  rocksteady::thruster_cmd_t scratch{};
+  rocksteady::gnc_telemetry_t tlm{};
+  bool have_cmd{false};
+  rocksteady::thruster_cmd_t latest{};  // newest valid command
+  hal::wire::RxCounters rx{};
+  std::uint64_t commands{0};
+  bool have_tlm{false};
+  int last_mode{-1};
+  double fuel_hat{0.0};
+  std::int64_t event_seq{0};
+  unsigned char buf[4096]{};
+
+  static void on_cmd(const lcm_recv_buf_t* rbuf, const char* /*ch*/, void* self) {
+    auto& b = *static_cast<Bus*>(self);
+    if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.scratch, &b.rx)) {
+      return;  // counted, ignored
+    }
+    ++b.commands;
+    b.latest = b.scratch;
+    b.have_cmd = true;
+  }
+  static void on_tlm(const lcm_recv_buf_t* rbuf, const char* /*ch*/, void* self) {
+    auto& b = *static_cast<Bus*>(self);
+    if (hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.tlm)) {
+      b.have_tlm = true;
+      b.last_mode = b.tlm.mode;
+      b.fuel_hat = b.tlm.fuel_kg;
+    }
+  }
+  template <class T> void publish(const char* channel, const T& msg) {
+    const int n = hal::wire::encode(msg, buf, static_cast<int>(sizeof buf));
+    if (n > 0) lcm_publish(lcm, channel, buf, static_cast<unsigned int>(n));
+  }
+  // One message dispatched or the deadline passed. False on a bus error.
+  bool wait_once(std::int64_t deadline) {
+    std::int64_t rem = deadline - now_ns();
+    if (rem < 0) rem = 0;
+    timespec ts{};
+    ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
+    ts.tv_nsec = static_cast<long>(rem % kNsPerS);
+    pollfd p{};
+    p.fd = lcm_get_fileno(lcm);
+    p.events = POLLIN;
+    const int r = ppoll(&p, 1, &ts, nullptr);
+    if (r < 0) return errno == EINTR;
+    if (r == 0) return true;
+    return lcm_handle(lcm) == 0;
+  }
+  void event(std::int8_t sev, std::int32_t id, std::int32_t a0, std::int32_t a1, double t,
+             const std::string& text) {
+    auto e = hal::wire::make<rocksteady::event_t>();
+    e.t = t;
+    e.seq = event_seq++;
+    e.severity = sev;
+    e.id = id;
+    e.arg0 = a0;
+    e.arg1 = a1;
+    e.text = text.substr(0, rocksteady::event_t::MAX_TEXT);
+    publish(channels::kEvents, e);
+  }
+};
+
+rocksteady::sensor_frame_t make_frame(std::int64_t seq, double t, const gnc::SensorSample& s) {
+  auto m = hal::wire::make<rocksteady::sensor_frame_t>();
+  m.seq = seq;
+  m.t = t;
+  // The plant's sensors are aligned with the body frame (the fsw's alignment is the identity).
+  m.gyro_t = s.t;
+  for (int i = 0; i < 3; ++i) m.gyro_rate[i] = s.gyro_rate(i);
+  m.gyro_valid = s.gyro_valid ? 1 : 0;
+  m.star_t = s.t;
+  for (int i = 0; i < 4; ++i) m.star_quat[i] = s.star_quat(i);
+  m.star_valid = s.star_valid ? 1 : 0;
+  return m;
+}
+
+rocksteady::plant_truth_t make_truth(std::int64_t seq, const plant::Plant& p) {
+  auto m = hal::wire::make<rocksteady::plant_truth_t>();
+  m.seq = seq;
+  m.t = p.t();
+  for (int i = 0; i < 4; ++i) m.quat[i] = p.beta()(i);
+  const plant::Vec3 q = p.mrp();
+  for (int i = 0; i < 3; ++i) m.q[i] = q(i);
+  for (int i = 0; i < 3; ++i) m.omega[i] = p.omega()(i);
+  m.omega_norm = p.omega().norm();
+  for (int i = 0; i < 8; ++i) m.channel_force[i] = p.applied_force()(i);
+  const plant::Vec3 tc = p.torque_matrix() * p.applied_force();
+  for (int i = 0; i < 3; ++i) m.torque_control[i] = tc(i);
+  for (int i = 0; i < 3; ++i) m.torque_disturbance[i] = p.disturbance()(i);
+  m.fuel_used_kg = p.fuel_kg();
+  return m;
+}
+
+std::string fmt_opt(const std::optional<double>& v, const char* unit, int prec) {
+  if (!v) return "NC";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f %s", prec, *v, unit);
+  return b;
+}
+std::string exact(const std::optional<double>& v) {
+  if (!v) return "NC";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.17g", *v);
+  return b;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"Rocksteady plant (truth model) on the LCM bus"};
+  std::string config_dir = "configs";
+  std::string mission_path, gnc_path, case_arg = "1", lcm_url, mode = "lockstep", out_csv;
+  double duration = -1.0, timeout_ms = 200.0, startup_timeout_s = 10.0, log_interval_s = 10.0;
+  int retries = 2;
+  std::uint32_t truth_every = 1;
+  bool summary = false, verbose = false;
+  cli.add_option("--config-dir", config_dir, "folder with mission.yaml, gnc.yaml, cases/")
+      ->capture_default_str();
+  cli.add_option("--mission", mission_path, "mission file (default <config-dir>/mission.yaml)");
+  cli.add_option("--gnc", gnc_path, "GNC file (default <config-dir>/gnc.yaml; q_final, u_max)");
+  cli.add_option("--case", case_arg, "case number or case file")->capture_default_str();
+  cli.add_option("--mode", mode, "lockstep or realtime")
+      ->check(CLI::IsMember({"lockstep", "realtime"}))
+      ->capture_default_str();
+  cli.add_option("--duration", duration, "simulated seconds (default: the case's)");
+  cli.add_option("--timeout-ms", timeout_ms, "lockstep: wait for each echo this long")
+      ->capture_default_str();
+  cli.add_option("--retries", retries, "lockstep: resend a frame this often before holding")
+      ->capture_default_str();
+  cli.add_option("--startup-timeout", startup_timeout_s,
+                 "lockstep: wait this long (s) for the flight software to answer frame 0")
+      ->capture_default_str();
+  cli.add_option("--truth-every", truth_every, "publish RS_PLANT_TRUTH every N periods (0: never)")
+      ->capture_default_str();
+  cli.add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  cli.add_flag("--summary", summary, "print the figures of merit and the bus statistics at the end");
+  cli.add_option("--out", out_csv, "time series CSV (true state, forces, fuel)");
+  cli.add_option("--log-interval", log_interval_s, "CSV row interval, s")->capture_default_str();
+  cli.add_flag("-v,--verbose", verbose, "progress once per wall second");
+  CLI11_PARSE(cli, argc, argv);
+  if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
+  if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
+
+  config::RunSetup setup;
+  try {
+    setup = config::load_run(mission_path, gnc_path, case_file(config_dir, case_arg));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rocksteady-plant: %s\n", e.what());
+    return 2;
+  }
+  plant::Plant plant(setup.truth);
+  const double dt = setup.truth.control_period_s;
+  const double run_s = duration >= 0.0 ? duration : setup.duration_s;
+  const auto n_ticks = static_cast<std::uint64_t>(std::llround(run_s / dt));
+  const Eigen::Vector3d q_final = setup.flight.guidance.q_final;
+  const bool lockstep = mode == "lockstep";
+
+  std::ofstream csv;
+  std::uint64_t csv_every = 0;
+  if (!out_csv.empty()) {
+    csv.open(out_csv);
+    if (!csv) {
+      std::fprintf(stderr, "rocksteady-plant: cannot write %s\n", out_csv.c_str());
+      return 2;
+    }
+    csv << "t_s,omega_x,omega_y,omega_z,q_x,q_y,q_z,fuel_kg,u0,u1,u2,u3,u4,u5,u6,u7\n";
+    csv.precision(17);
+    csv_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(log_interval_s / dt)));
+  }
+  auto write_row = [&]() {
+    if (!csv.is_open()) return;
+    csv << plant.t();
+    for (int i = 0; i < 3; ++i) csv << ',' << plant.omega()(i);
+    const plant::Vec3 q = plant.mrp();
+    for (int i = 0; i < 3; ++i) csv << ',' << q(i);
+    csv << ',' << plant.fuel_kg();
+    for (int i = 0; i < 8; ++i) csv << ',' << plant.applied_force()(i);
+    csv << '\n';
+  };
+
+  Bus bus;
+  bus.lcm = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
+  if (bus.lcm == nullptr) {
+    std::fprintf(stderr, "rocksteady-plant: cannot open the LCM bus\n");
+    return 3;
+  }
+  lcm_subscribe(bus.lcm, channels::kThrusterCmd, &Bus::on_cmd, &bus);
+  lcm_subscribe(bus.lcm, channels::kGncTelemetry, &Bus::on_tlm, &bus);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  campaign::ConvergenceTracker omega_conv(setup.omega_tol_rad_s);
+  campaign::ConvergenceTracker q_conv(setup.q_tol);
+  omega_conv.add(0.0, plant.omega().norm(), 0.0);
+  q_conv.add(0.0, campaign::attitude_error(plant.mrp(), q_final), 0.0);
+  double max_rate = plant.omega().norm();
+
+  std::uint64_t timeouts = 0, resends = 0, holds = 0, stale = 0, wiring_mismatch = 0, applied = 0;
+  std::uint64_t fresh_periods = 0;
+  bool started = !lockstep;
+  bool bus_error = false;
+  plant::Vec8 u = plant::Vec8::Zero();
+  bool enabled = false;
+  const auto timeout_ns = static_cast<std::int64_t>(timeout_ms * 1e6);
+  const auto period_ns = static_cast<std::int64_t>(std::llround(dt * 1e9));
+  bus.event(rocksteady::event_t::SEV_INFO, kRunStarted, 0, 0, 0.0,
+            "plant run started: " + setup.case_name + " (" + mode + ")");
+  if (verbose) {
+    std::printf("rocksteady-plant: %s, %s, %.6g s in %" PRIu64 " periods\n", setup.case_name.c_str(),
+                mode.c_str(), run_s, n_ticks);
+    std::fflush(stdout);
+  }
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::int64_t last_progress = now_ns();
+  const std::int64_t rt_start = now_ns();
+  std::uint64_t k = 0;
+  for (; k < n_ticks && g_stop == 0; ++k) {
+    const gnc::SensorSample s = plant.sample();
+    const rocksteady::sensor_frame_t frame = make_frame(static_cast<std::int64_t>(k), plant.t(), s);
+    bus.publish(channels::kSensors, frame);
+    if (truth_every > 0 && k % truth_every == 0) {
+      bus.publish(channels::kPlantTruth, make_truth(static_cast<std::int64_t>(k), plant));
+    }
+    if (csv_every != 0 && k % csv_every == 0) write_row();
+
+    if (lockstep) {
+      // Wait for the command echoing k.
+      bool got = false;
+      int attempts = 0;
+      std::int64_t deadline = now_ns() + timeout_ns;
+      const std::int64_t startup_deadline =
+          now_ns() + static_cast<std::int64_t>(startup_timeout_s * 1e9);
+      bus.have_cmd = false;
+      while (!got && g_stop == 0) {
+        if (!bus.wait_once(deadline)) {
+          bus_error = true;
+          break;
+        }
+        if (bus.have_cmd) {
+          bus.have_cmd = false;
+          if (bus.latest.seq == static_cast<std::int64_t>(k)) {
+            got = true;
+            break;
+          }
+          ++stale;  // an answer to an older frame (e.g. to a resend)
+          continue;
+        }
+        if (now_ns() < deadline) continue;
+        if (!started) {  // the flight software is not up yet: keep offering frame 0
+          if (now_ns() >= startup_deadline) break;
+          bus.publish(channels::kSensors, frame);
+          deadline = now_ns() + timeout_ns;
+          continue;
+        }
+        ++timeouts;
+        if (timeouts == 1 || timeouts % 100 == 0) {
+          bus.event(rocksteady::event_t::SEV_WARNING, kEchoTimeout, static_cast<std::int32_t>(k),
+                    static_cast<std::int32_t>(timeouts), plant.t(),
+                    "no thruster command echoing the frame within the timeout");
+        }
+        if (attempts++ < retries) {
+          ++resends;
+          bus.publish(channels::kSensors, frame);
+          deadline = now_ns() + timeout_ns;
+          continue;
+        }
+        break;  // hold the previous command
+      }
+      if (bus_error) break;
+      if (!started && !got) {
+        std::fprintf(stderr,
+                     "rocksteady-plant: no answer from the flight software within %.3g s\n",
+                     startup_timeout_s);
+        lcm_destroy(bus.lcm);
+        return 4;
+      }
+      started = true;
+      if (got) {
+        const plant::Vec8 from_thrusters = channel_forces_from_thrusters(bus.latest);
+        for (int i = 0; i < 8; ++i) {
+          if (std::fabs(from_thrusters(i) - bus.latest.channel_force[i]) > 1e-9 * (1.0 + std::fabs(from_thrusters(i)))) {
+            ++wiring_mismatch;
+            break;
+          }
+        }
+        u = from_thrusters;
+        enabled = bus.latest.enabled != 0;
+        ++applied;
+      } else if (g_stop == 0) {
+        ++holds;
+      }
+    } else {
+      // Real time: serve the bus until the next period, then apply the newest command.
+      const std::int64_t deadline = rt_start + static_cast<std::int64_t>(k + 1) * period_ns;
+      bus.have_cmd = false;
+      bool fresh = false;
+      while (g_stop == 0 && now_ns() < deadline) {
+        if (!bus.wait_once(deadline)) {
+          bus_error = true;
+          break;
+        }
+        if (bus.have_cmd) {
+          bus.have_cmd = false;
+          u = channel_forces_from_thrusters(bus.latest);
+          enabled = bus.latest.enabled != 0;
+          ++applied;
+          if (bus.latest.seq == static_cast<std::int64_t>(k)) fresh = true;
+        }
+      }
+      if (bus_error) break;
+      if (fresh) {
+        ++fresh_periods;
+      } else {
+        ++holds;
+      }
+    }
+    if (g_stop != 0) break;
+
+    plant.advance(u, enabled);
+    const double w = plant.omega().norm();
+    const double t = plant.t();
+    omega_conv.add(t, w, plant.fuel_kg());
+    q_conv.add(t, campaign::attitude_error(plant.mrp(), q_final), plant.fuel_kg());
+    max_rate = std::max(max_rate, w);
+    if (verbose && now_ns() - last_progress >= kNsPerS) {
+      last_progress = now_ns();
+      std::printf("plant: t=%.1f s |omega|=%.3e rad/s fuel=%.3f kg timeouts=%" PRIu64 "\n", t, w,
+                  plant.fuel_kg(), timeouts);
+      std::fflush(stdout);
+    }
+  }
+  // Drain what is still in flight (the telemetry of the last frame) for the summary.
+  const std::int64_t drain_until = now_ns() + 50000000;
+  while (now_ns() < drain_until && bus.wait_once(drain_until)) {
+  }
+  if (csv_every != 0) write_row();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  bus.event(rocksteady::event_t::SEV_INFO, kRunFinished, static_cast<std::int32_t>(timeouts),
+            static_cast<std::int32_t>(holds), plant.t(), "plant run finished");
+
+  if (summary) {
+    const double ticks_per_s = wall > 0.0 ? static_cast<double>(plant.ticks()) / wall : 0.0;
+    const char* mode_name = bus.last_mode >= 0 && bus.last_mode < gnc::kModeCount
+                                ? gnc::to_string(static_cast<gnc::Mode>(bus.last_mode))
+                                : "?";
+    std::printf("%s over LCM (%s): %.6g s simulated in %.2f s wall, %.0f periods/s\n",
+                setup.case_name.c_str(), mode.c_str(), plant.t(), wall, ticks_per_s);
+    std::printf("  t_omega,conv        %s\n", fmt_opt(omega_conv.time(), "s", 1).c_str());
+    std::printf("  fuel at t_omega     %s\n", fmt_opt(omega_conv.fuel_kg(), "kg", 3).c_str());
+    std::printf("  t_q,conv            %s\n", fmt_opt(q_conv.time(), "s", 1).c_str());
+    std::printf("  fuel at t_q         %s\n", fmt_opt(q_conv.fuel_kg(), "kg", 3).c_str());
+    std::printf("  total fuel          %.3f kg (flight estimate %.3f kg)\n", plant.fuel_kg(),
+                bus.fuel_hat);
+    std::printf("  max |omega|         %.5f rad/s, final %.3e rad/s, final |q - q_final| %.3e\n",
+                max_rate, plant.omega().norm(), campaign::attitude_error(plant.mrp(), q_final));
+    std::printf("  flight mode (last telemetry) %s\n", mode_name);
+    std::printf("  bus: commands %" PRIu64 " applied %" PRIu64 ", echo timeouts %" PRIu64
+                ", resends %" PRIu64 ", held periods %" PRIu64 ", stale %" PRIu64
+                ", rx rejected %" PRIu64 ", thruster/channel mismatches %" PRIu64 "\n",
+                bus.commands, applied, timeouts, resends, holds, stale, bus.rx.rejected(),
+                wiring_mismatch);
+    std::printf("summary: case=%d mode=%s periods=%" PRIu64 " t_omega=%s fuel_omega=%s t_q=%s "
+                "fuel_q=%s total_fuel=%.17g final_rate=%.17g final_q_error=%.17g flight_mode=%s "
+                "timeouts=%" PRIu64 " resends=%" PRIu64 " holds=%" PRIu64 " rx_rejected=%" PRIu64
+                " fresh=%" PRIu64 " wall_s=%.3f\n",
+                setup.case_number, mode.c_str(), plant.ticks(), exact(omega_conv.time()).c_str(),
+                exact(omega_conv.fuel_kg()).c_str(), exact(q_conv.time()).c_str(),
+                exact(q_conv.fuel_kg()).c_str(), plant.fuel_kg(), plant.omega().norm(),
+                campaign::attitude_error(plant.mrp(), q_final), mode_name, timeouts, resends, holds,
+                bus.rx.rejected(), fresh_periods, wall);
+    std::fflush(stdout);
+  }
+  lcm_destroy(bus.lcm);
+  return bus_error ? 1 : 0;
+}
