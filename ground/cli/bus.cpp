@@ -1,0 +1,291 @@
+#include "ground/cli/bus.hpp"
+
+#include <chrono>
+#include <deque>
+#include <thread>
+#include <vector>
+
+#include "ground/cli/dictionary.hpp"
+#include "hal/lcm/codec.hpp"
+#include "hal/lcm/uplink.hpp"
+#include "lcmtypes/channels.hpp"
+
+namespace rocksteady::ground::cli {
+
+namespace wire = hal::wire;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Milliseconds left until `deadline` (at least 0), for handleTimeout.
+int remaining_ms(Clock::time_point deadline) {
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+  return left.count() <= 0 ? 0 : static_cast<int>(left.count());
+}
+
+Clock::time_point after(double seconds) {
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double>(seconds < 0.0 ? 0.0 : seconds));
+}
+
+class AckWaiter {
+ public:
+  explicit AckWaiter(const rocksteady::ground_cmd_t& cmd) : cmd_(cmd) {}
+  void on_ack(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rocksteady::cmd_ack_t ack;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), ack, &rx_)) return;
+    if (ack.seq == cmd_.seq && ack.sender_id == cmd_.sender_id && ack.opcode == cmd_.opcode) {
+      if (!matched_) ack_ = ack;
+      matched_ = true;
+    } else {
+      ++others_;
+    }
+  }
+  bool matched() const { return matched_; }
+  const rocksteady::cmd_ack_t& ack() const { return ack_; }
+  std::uint64_t others() const { return others_; }
+  const wire::RxCounters& rx() const { return rx_; }
+
+ private:
+  rocksteady::ground_cmd_t cmd_;
+  rocksteady::cmd_ack_t ack_{};
+  bool matched_{false};
+  std::uint64_t others_{0};
+  wire::RxCounters rx_{};
+};
+
+class UplinkWatcher {
+ public:
+  explicit UplinkWatcher(std::int32_t id, int chunks, std::FILE* log)
+      : id_(id), chunks_(chunks), log_(log) {}
+  void on_event(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rocksteady::event_t e;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), e)) return;
+    if (e.arg0 != id_) return;
+    switch (e.id) {
+      case kEventUplinkComplete:
+        complete_ = true;
+        break;
+      case kEventChunkRejected:
+        ++rejections_;
+        if (log_ != nullptr) {
+          std::fprintf(log_, "chunk rejected: %s%s%s\n", chunk_status_name(e.arg1).c_str(),
+                       e.text.empty() ? "" : ": ", e.text.c_str());
+        }
+        break;
+      case kEventUplinkAbandoned:
+        abandoned_ = true;
+        if (log_ != nullptr) std::fprintf(log_, "uplink abandoned by the flight: %s\n", e.text.c_str());
+        break;
+      default:
+        break;
+    }
+  }
+  void on_telemetry(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rocksteady::gnc_telemetry_t m;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) return;
+    if (m.uplink_id == id_ && m.uplink_total_chunks == chunks_ && m.uplink_chunks_received == chunks_) {
+      complete_ = true;
+    }
+  }
+  bool complete() const { return complete_; }
+  bool abandoned() const { return abandoned_; }
+  std::uint64_t rejections() const { return rejections_; }
+
+ private:
+  std::int32_t id_;
+  int chunks_;
+  std::FILE* log_;
+  bool complete_{false};
+  bool abandoned_{false};
+  std::uint64_t rejections_{0};
+};
+
+class Monitor {
+ public:
+  Monitor(const MonitorOptions& options, std::FILE* out) : options_(options), out_(out) {}
+
+  void on_telemetry(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), tlm_, &counts_.rx)) return;
+    ++counts_.telemetry;
+    have_tlm_ = true;
+    if (options_.ansi) {
+      redraw();
+    } else {
+      std::fprintf(out_, "TLM %s\n", format_status_line(tlm_, counts_).c_str());
+      std::fflush(out_);
+    }
+  }
+  void on_event(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rocksteady::event_t e;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), e, &counts_.rx)) return;
+    ++counts_.events;
+    show("EVENT " + format_event(e));
+  }
+  void on_ack(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rocksteady::cmd_ack_t a;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), a, &counts_.rx)) return;
+    ++counts_.acks;
+    show("ACK " + format_ack(a));
+  }
+  const MonitorCounts& counts() const { return counts_; }
+
+ private:
+  void show(const std::string& line) {
+    if (!options_.ansi) {
+      std::fprintf(out_, "%s\n", line.c_str());
+      std::fflush(out_);
+      return;
+    }
+    recent_.push_back(line);
+    while (static_cast<int>(recent_.size()) > options_.event_lines) recent_.pop_front();
+    redraw();
+  }
+  void redraw() {
+    std::string screen = "\x1b[H\x1b[2J";  // home, clear
+    if (have_tlm_) {
+      for (const std::string& l : format_status(tlm_, counts_)) screen += l + "\n";
+    } else {
+      screen += "waiting for telemetry on " + std::string(channels::kGncTelemetry) + " ...\n";
+    }
+    screen += "--- events and acks ---\n";
+    for (const std::string& l : recent_) screen += l + "\n";
+    std::fputs(screen.c_str(), out_);
+    std::fflush(out_);
+  }
+
+  MonitorOptions options_;
+  std::FILE* out_;
+  MonitorCounts counts_{};
+  rocksteady::gnc_telemetry_t tlm_{};
+  bool have_tlm_{false};
+  std::deque<std::string> recent_;
+};
+
+}  // namespace
+
+int SendResult::exit_code() const {
+  switch (outcome) {
+    case Outcome::kAccepted: return kExitAccepted;
+    case Outcome::kRejected: return kExitRejected;
+    case Outcome::kTimeout:
+    case Outcome::kError: return kExitTimeoutOrUsage;
+  }
+  return kExitTimeoutOrUsage;
+}
+
+SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s) {
+  SendResult r;
+  AckWaiter waiter(cmd);
+  lcm::Subscription* sub = lcm.subscribe(channels::kCmdAck, &AckWaiter::on_ack, &waiter);
+  if (sub == nullptr) {
+    r.error = "cannot subscribe to " + std::string(channels::kCmdAck);
+    return r;
+  }
+  if (lcm.publish(channels::kGroundCmd, &cmd) != 0) {
+    lcm.unsubscribe(sub);
+    r.error = "publishing on " + std::string(channels::kGroundCmd) + " failed";
+    return r;
+  }
+  const Clock::time_point deadline = after(timeout_s);
+  while (!waiter.matched()) {
+    const int ms = remaining_ms(deadline);
+    if (ms <= 0) break;
+    if (lcm.handleTimeout(ms) < 0) {
+      r.error = "LCM receive failed";
+      break;
+    }
+  }
+  lcm.unsubscribe(sub);
+  r.other_acks = waiter.others();
+  r.rx = waiter.rx();
+  if (waiter.matched()) {
+    r.ack = waiter.ack();
+    r.outcome = r.ack.accepted != 0 ? SendResult::Outcome::kAccepted : SendResult::Outcome::kRejected;
+  } else if (r.error.empty()) {
+    r.outcome = SendResult::Outcome::kTimeout;
+  }
+  return r;
+}
+
+UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
+                           const UploadOptions& options, std::FILE* log) {
+  UploadResult r;
+  r.chunks = wire::chunk_count(table.count);
+  std::vector<rocksteady::trajectory_chunk_t> chunks(static_cast<std::size_t>(r.chunks));
+  for (int i = 0; i < r.chunks; ++i) {
+    if (!wire::make_chunk(table, options.upload_id, i, chunks[static_cast<std::size_t>(i)])) {
+      r.message = "cannot chunk the table (" + std::to_string(table.count) + " samples)";
+      return r;
+    }
+  }
+  UplinkWatcher watcher(options.upload_id, r.chunks, log);
+  lcm::Subscription* ev = lcm.subscribe(channels::kEvents, &UplinkWatcher::on_event, &watcher);
+  lcm::Subscription* tlm = lcm.subscribe(channels::kGncTelemetry, &UplinkWatcher::on_telemetry, &watcher);
+
+  for (int pass = 1; pass <= options.passes && !watcher.complete() && !watcher.abandoned(); ++pass) {
+    r.passes_used = pass;
+    for (const rocksteady::trajectory_chunk_t& c : chunks) {
+      if (lcm.publish(channels::kTrajUplink, &c) != 0) {
+        r.message = "publishing on " + std::string(channels::kTrajUplink) + " failed";
+        lcm.unsubscribe(ev);
+        lcm.unsubscribe(tlm);
+        return r;
+      }
+      // Pace the chunks and keep reading (the events of earlier chunks) meanwhile.
+      const Clock::time_point next = after(options.chunk_interval_s);
+      for (int ms = remaining_ms(next); ms > 0; ms = remaining_ms(next)) lcm.handleTimeout(ms);
+    }
+    if (log != nullptr) {
+      std::fprintf(log, "upload %d: pass %d sent %d chunks (%d samples, crc %08x)\n",
+                   options.upload_id, pass, r.chunks, table.count,
+                   static_cast<unsigned>(chunks.front().table_crc));
+    }
+    const Clock::time_point deadline = after(options.wait_s);
+    while (!watcher.complete() && !watcher.abandoned()) {
+      const int ms = remaining_ms(deadline);
+      if (ms <= 0) break;
+      lcm.handleTimeout(ms);
+    }
+  }
+  lcm.unsubscribe(ev);
+  lcm.unsubscribe(tlm);
+  r.complete = watcher.complete();
+  r.chunk_rejections = watcher.rejections();
+  if (r.complete) {
+    r.message = "upload " + std::to_string(options.upload_id) + " complete on board (" +
+                std::to_string(r.chunks) + " chunks)";
+  } else if (watcher.abandoned()) {
+    r.message = "the flight abandoned upload " + std::to_string(options.upload_id);
+  } else {
+    r.message = "no uplink_complete for upload " + std::to_string(options.upload_id) + " after " +
+                std::to_string(r.passes_used) + " passes";
+  }
+  return r;
+}
+
+MonitorCounts run_monitor(lcm::LCM& lcm, const MonitorOptions& options, std::FILE* out) {
+  Monitor monitor(options, out);
+  lcm::Subscription* subs[] = {
+      lcm.subscribe(channels::kGncTelemetry, &Monitor::on_telemetry, &monitor),
+      lcm.subscribe(channels::kEvents, &Monitor::on_event, &monitor),
+      lcm.subscribe(channels::kCmdAck, &Monitor::on_ack, &monitor),
+  };
+  const bool timed = options.seconds >= 0.0;
+  const Clock::time_point deadline = after(options.seconds);
+  for (;;) {
+    if (options.count >= 0 && monitor.counts().telemetry >= static_cast<std::uint64_t>(options.count)) break;
+    int ms = 500;
+    if (timed) {
+      ms = remaining_ms(deadline);
+      if (ms <= 0) break;
+    }
+    if (lcm.handleTimeout(ms) < 0) break;
+  }
+  for (lcm::Subscription* s : subs) {
+    if (s != nullptr) lcm.unsubscribe(s);
+  }
+  return monitor.counts();
+}
+
+}  // namespace rocksteady::ground::cli

@@ -1,0 +1,69 @@
+// The CLI's bus procedures: send one command and wait for its acknowledgement, uplink a trajectory
+// table in chunks and wait until the flight has all of them, and the live monitor. Every inbound
+// message is decoded with hal::wire::safe_decode from a raw-buffer subscription.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "gnc/guidance/trajectory.hpp"
+#include "ground/cli/monitor_format.hpp"
+#include "rocksteady/cmd_ack_t.hpp"
+#include "rocksteady/ground_cmd_t.hpp"
+
+namespace rocksteady::ground::cli {
+
+// Exit codes of `rocksteady-ground send`.
+inline constexpr int kExitAccepted = 0;
+inline constexpr int kExitRejected = 1;
+inline constexpr int kExitTimeoutOrUsage = 2;
+
+struct SendResult {
+  enum class Outcome { kAccepted, kRejected, kTimeout, kError };
+  Outcome outcome{Outcome::kError};
+  rocksteady::cmd_ack_t ack{};  // the matching acknowledgement (accepted / rejected)
+  std::string error;           // kError: what failed
+  std::uint64_t other_acks{0}; // acknowledgements of other commands seen meanwhile
+  hal::wire::RxCounters rx{};  // decode outcomes on RS_CMD_ACK
+  int exit_code() const;
+};
+
+// Publishes `cmd` on RS_GROUND_CMD and waits up to `timeout_s` for the cmd_ack_t that echoes its
+// seq, sender and opcode.
+SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s);
+
+struct UploadOptions {
+  std::int32_t upload_id{0};
+  double chunk_interval_s{0.02};  // pause between chunks: the flight drains its bus once per tick
+                                  // and LCM queues 30 messages per subscription
+  double wait_s{5.0};             // per pass: how long to wait for uplink_complete
+  int passes{3};                  // send every chunk up to this many times (repeats are harmless)
+};
+
+struct UploadResult {
+  bool complete{false};
+  int chunks{0};
+  int passes_used{0};
+  std::uint64_t chunk_rejections{0};  // chunk_rejected events for this upload
+  std::string message;                // how it ended
+};
+
+// Sends every chunk of `table` on RS_TRAJ_UPLINK and waits for the flight's uplink_complete event
+// (or telemetry showing every chunk received) for this upload id. Progress lines go to `log`.
+UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
+                           const UploadOptions& options, std::FILE* log);
+
+struct MonitorOptions {
+  long count{-1};       // stop after this many telemetry messages (< 0: no limit)
+  double seconds{-1.0}; // stop after this long (< 0: no limit)
+  bool ansi{false};     // redraw a status block (terminal) instead of one line per message
+  int event_lines{10};  // events kept under the status block (ansi)
+};
+
+// Runs until a limit is reached; returns what it saw.
+MonitorCounts run_monitor(lcm::LCM& lcm, const MonitorOptions& options, std::FILE* out);
+
+}  // namespace rocksteady::ground::cli

@@ -1,0 +1,294 @@
+#include "ground/cli/commands.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "gnc/math/rotation.hpp"
+#include "ground/cli/dictionary.hpp"
+
+namespace rocksteady::ground::cli {
+
+namespace {
+
+using Msg = rocksteady::ground_cmd_t;
+
+// The opcode table's ranges (fsw/commands/command_table.cpp) that the ground checks before sending.
+constexpr double kIdMax = 2147483647.0;  // upload ids: int32 >= 0
+constexpr double kValueMax = 1e30;       // parameter values
+constexpr double kQuatNormTolerance = 1e-3;
+
+const std::vector<CommandHelp> kHelp{
+    {"noop", "noop", "no operation (link check); the flight answers with an ack"},
+    {"set-mode", "set-mode IDLE|DETUMBLE|HOLD|TRACK|SAFE", "request a mode (next GNC tick)"},
+    {"set-target", "set-target q1 q2 q3  |  set-target --quat x y z w",
+     "HOLD/TRACK target attitude q_final as an MRP (|q| <= 1), or a unit quaternion, scalar last"},
+    {"select-law", "select-law ntcl|el|integral|adaptive|so3|dpd|feedforward [keep|dpd-ref|fuel-optimal]",
+     "select the control law and optionally the reference (dpd-ref: DETUMBLE/HOLD, fuel-optimal: TRACK)"},
+    {"set-gain", "set-gain PARAM VALUES...",
+     "load a parameter into the inactive table: a matrix takes 3 values (diagonal) or 6 (xx yy zz xy "
+     "xz yz), a scalar 1, a flag 0|1; PARAM is a name (ntcl.K) or number (see 'params')"},
+    {"activate-gains", "activate-gains", "the inactive table becomes active at the next GNC tick"},
+    {"discard-gains", "discard-gains", "drop the loads: inactive table := active table"},
+    {"reset-counters", "reset-counters", "reset the command/health counters (cycle counts are kept)"},
+    {"load-trajectory", "load-trajectory UPLOAD_ID",
+     "hand a completely uplinked trajectory to the flight core (not in TRACK)"},
+    {"abort-uplink", "abort-uplink UPLOAD_ID", "discard a trajectory uplink in progress"},
+    {"upload-trajectory", "upload-trajectory FILE",
+     "uplink a planner trajectory file in chunks, wait for the flight to complete it, then load it"},
+};
+
+std::string join(const std::vector<std::string>& words, const char* sep) {
+  std::string s;
+  for (const std::string& w : words) {
+    if (!s.empty()) s += sep;
+    s += w;
+  }
+  return s;
+}
+
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v + 0.0);  // + 0.0: no "-0"
+  return buf;
+}
+
+Encoded fail(const std::string& message) {
+  Encoded e;
+  e.error = message;
+  return e;
+}
+
+Encoded make(std::int32_t opcode, const std::vector<double>& args, const std::string& description) {
+  Encoded e;
+  e.ok = true;
+  e.cmd.kind = Msg::KIND;
+  e.cmd.version = Msg::VERSION;
+  e.cmd.opcode = opcode;
+  e.cmd.nargs = static_cast<std::int8_t>(args.size());
+  for (std::size_t i = 0; i < args.size(); ++i) e.cmd.args[i] = args[i];
+  e.description = description;
+  return e;
+}
+
+const CommandHelp* find_help(const std::string& name) {
+  for (const CommandHelp& h : kHelp) {
+    if (name == h.name) return &h;
+  }
+  return nullptr;
+}
+
+// "set-mode takes 1 argument (usage: ...), got 2"
+Encoded wrong_count(const std::string& name, const std::string& expected, std::size_t got) {
+  const CommandHelp* h = find_help(name);
+  return fail(name + " takes " + expected + ", got " + std::to_string(got) +
+              (h != nullptr ? std::string(" (usage: ") + h->usage + ")" : std::string()));
+}
+
+// Parses every word as a number, or names the first that is not one.
+bool numbers(const std::string& name, const std::vector<std::string>& words, std::size_t first,
+             std::vector<double>& out, std::string& error) {
+  out.clear();
+  for (std::size_t i = first; i < words.size(); ++i) {
+    double v = 0.0;
+    if (!parse_number(words[i], v)) {
+      error = name + ": argument " + std::to_string(i + 1) + " '" + words[i] +
+              "' is not a finite number";
+      return false;
+    }
+    out.push_back(v);
+  }
+  return true;
+}
+
+// An upload id: an integer in [0, 2^31 - 1].
+bool upload_id(const std::string& name, const std::string& word, double& out, std::string& error) {
+  if (!parse_number(word, out) || out < 0.0 || out > kIdMax || std::trunc(out) != out) {
+    error = name + ": upload id '" + word + "' must be an integer in [0, 2147483647]";
+    return false;
+  }
+  return true;
+}
+
+Encoded set_target(const std::vector<std::string>& args, const EncodeOptions& options) {
+  const std::string name = "set-target";
+  std::vector<double> v;
+  std::string error;
+  if (options.quaternion) {
+    if (args.size() != 4) return wrong_count(name, "4 arguments with --quat (x y z w)", args.size());
+    if (!numbers(name, args, 0, v, error)) return fail(error);
+    const gnc::Vec4 beta(v[0], v[1], v[2], v[3]);
+    const double n = beta.norm();
+    if (std::abs(n - 1.0) > kQuatNormTolerance) {
+      return fail(name + ": quaternion norm " + number_text(n) +
+                  " is not 1 (a unit quaternion [x y z w], scalar last, is expected)");
+    }
+    const gnc::Vec3 q = gnc::mrp::from_quaternion(beta / n);  // the |q| <= 1 set
+    return make(Msg::OP_SET_TARGET, {q.x(), q.y(), q.z()},
+                "SET_TARGET q_final = [" + number_text(q.x()) + ", " + number_text(q.y()) + ", " +
+                    number_text(q.z()) + "] (MRP, from quaternion)");
+  }
+  if (args.size() != 3) return wrong_count(name, "3 arguments (an MRP q1 q2 q3)", args.size());
+  if (!numbers(name, args, 0, v, error)) return fail(error);
+  const gnc::Vec3 q(v[0], v[1], v[2]);
+  const double n2 = q.squaredNorm();
+  if (q.norm() > 1.0) {
+    const gnc::Vec3 s = gnc::mrp::shadow(q);
+    return fail(name + ": MRP norm " + number_text(std::sqrt(n2)) +
+                " is above 1; the same attitude in the |q| <= 1 set is [" + number_text(s.x()) +
+                " " + number_text(s.y()) + " " + number_text(s.z()) + "]");
+  }
+  return make(Msg::OP_SET_TARGET, v,
+              "SET_TARGET q_final = [" + number_text(v[0]) + ", " + number_text(v[1]) + ", " +
+                  number_text(v[2]) + "] (MRP)");
+}
+
+Encoded select_law(const std::vector<std::string>& args) {
+  const std::string name = "select-law";
+  if (args.empty() || args.size() > 2) {
+    return wrong_count(name, "1 or 2 arguments (law [reference])", args.size());
+  }
+  const auto law = law_from_name(args[0]);
+  if (!law) {
+    return fail(name + ": unknown law '" + args[0] + "' (one of " + join(law_names(), ", ") + ")");
+  }
+  std::vector<double> a{static_cast<double>(*law)};
+  std::string description = std::string("SET_LAW ") + law_name(*law);
+  if (args.size() == 2) {
+    const auto ref = reference_from_name(args[1]);
+    if (!ref) {
+      return fail(name + ": unknown reference '" + args[1] + "' (one of keep, dpd-ref, fuel-optimal)");
+    }
+    if (*law == 5 && *ref == 2) {
+      return fail(name + ": the D+PD law cannot track the fuel-optimal reference");
+    }
+    a.push_back(static_cast<double>(*ref));
+    description += std::string(" reference ") + reference_name(*ref);
+  }
+  return make(Msg::OP_SET_LAW, a, description);
+}
+
+Encoded set_gain(const std::vector<std::string>& args) {
+  const std::string name = "set-gain";
+  if (args.size() < 2) return wrong_count(name, "a parameter and its values", args.size());
+  const auto p = find_param(args[0]);
+  if (!p) {
+    return fail(name + ": unknown parameter '" + args[0] +
+                "' (a name such as ntcl.K or guidance.omega_switch, or a number 0.." +
+                std::to_string(param_dictionary().size() - 1) + "; 'params' lists them)");
+  }
+  std::vector<double> values;
+  std::string error;
+  if (!numbers(name, args, 1, values, error)) return fail(error);
+  const std::size_t n = values.size();
+  switch (p->kind) {
+    case ParamKind::kMatrix:
+      if (n != 3 && n != 6) {
+        return fail(name + ": " + p->name + " is a matrix: 3 values (diagonal) or 6 (xx yy zz xy xz yz), got " +
+                    std::to_string(n));
+      }
+      break;
+    case ParamKind::kScalar:
+      if (n != 1) return fail(name + ": " + p->name + " is a scalar: 1 value, got " + std::to_string(n));
+      break;
+    case ParamKind::kFlag:
+      if (n != 1 || (values[0] != 0.0 && values[0] != 1.0)) {
+        return fail(name + ": " + p->name + " is a flag: one value, 0 or 1");
+      }
+      break;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::abs(values[i]) > kValueMax) {
+      return fail(name + ": value " + std::to_string(i + 1) + " is out of range (|v| <= 1e30)");
+    }
+  }
+  std::vector<double> a{static_cast<double>(p->id)};
+  a.insert(a.end(), values.begin(), values.end());
+  std::string description = std::string("PARAM_LOAD ") + p->name + " (" + std::to_string(p->id) + ") =";
+  for (const double v : values) description += " " + number_text(v);
+  return make(Msg::OP_PARAM_LOAD, a, description);
+}
+
+}  // namespace
+
+bool parse_number(const std::string& word, double& out) {
+  if (word.empty()) return false;
+  const char* s = word.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(s, &end);
+  if (end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
+  // strtod also reads "inf", "nan" and hex floats; an operator's number is decimal.
+  for (const char c : word) {
+    if ((c < '0' || c > '9') && c != '.' && c != '-' && c != '+' && c != 'e' && c != 'E') return false;
+  }
+  out = v;
+  return true;
+}
+
+Encoded encode_command(const std::string& name, const std::vector<std::string>& args,
+                       const EncodeOptions& options) {
+  if (options.quaternion && name != "set-target") {
+    return fail("--quat applies to set-target only");
+  }
+  auto no_args = [&](std::int32_t op, const char* description) {
+    if (!args.empty()) return wrong_count(name, "no arguments", args.size());
+    return make(op, {}, description);
+  };
+  if (name == "noop") return no_args(Msg::OP_NOOP, "NOOP");
+  if (name == "reset-counters") return no_args(Msg::OP_RESET_COUNTERS, "RESET_COUNTERS");
+  if (name == "activate-gains") return no_args(Msg::OP_PARAM_ACTIVATE, "PARAM_ACTIVATE");
+  if (name == "discard-gains") return no_args(Msg::OP_PARAM_DISCARD, "PARAM_DISCARD");
+  if (name == "set-mode") {
+    if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
+    const auto mode = mode_from_name(args[0]);
+    if (!mode) {
+      return fail(name + ": unknown mode '" + args[0] + "' (one of " + join(mode_names(), ", ") + ")");
+    }
+    return make(Msg::OP_SET_MODE, {static_cast<double>(*mode)},
+                std::string("SET_MODE ") + mode_name(*mode));
+  }
+  if (name == "set-target") return set_target(args, options);
+  if (name == "select-law") return select_law(args);
+  if (name == "set-gain") return set_gain(args);
+  if (name == "load-trajectory" || name == "abort-uplink") {
+    if (args.size() != 1) return wrong_count(name, "1 argument (the upload id)", args.size());
+    double id = 0.0;
+    std::string error;
+    if (!upload_id(name, args[0], id, error)) return fail(error);
+    const bool load = name == "load-trajectory";
+    const std::int32_t op = load ? static_cast<std::int32_t>(Msg::OP_LOAD_TRAJECTORY)
+                                  : static_cast<std::int32_t>(Msg::OP_ABORT_UPLINK);
+    return make(op, {id},
+                std::string(load ? "LOAD_TRAJECTORY " : "ABORT_UPLINK ") + args[0]);
+  }
+  if (name == "upload-trajectory") {
+    return fail("upload-trajectory is a procedure of many messages, not one command");
+  }
+  return fail("unknown command '" + name + "' (one of " + command_list() + ")");
+}
+
+const std::vector<CommandHelp>& command_help() { return kHelp; }
+
+std::string command_list() {
+  std::vector<std::string> names;
+  for (const CommandHelp& h : kHelp) names.emplace_back(h.name);
+  return join(names, ", ");
+}
+
+std::string opcode_name(int opcode) {
+  static const char* const kNames[] = {"NOOP",           "SET_MODE",     "SET_TARGET",
+                                       "SET_LAW",        "LOAD_TRAJECTORY", "ABORT_UPLINK",
+                                       "RESET_COUNTERS", "PARAM_LOAD",   "PARAM_ACTIVATE",
+                                       "PARAM_DISCARD"};
+  if (opcode >= 0 && opcode < Msg::OP_COUNT) return kNames[opcode];
+  return "OP " + std::to_string(opcode);
+}
+
+void stamp(rocksteady::ground_cmd_t& cmd, std::int64_t seq, std::int32_t sender_id) {
+  cmd.seq = seq;
+  cmd.sender_id = sender_id;
+}
+
+}  // namespace rocksteady::ground::cli
