@@ -1,5 +1,6 @@
 #include "ground/cli/bus.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <thread>
@@ -16,6 +17,8 @@ namespace wire = hal::wire;
 using Clock = std::chrono::steady_clock;
 
 namespace {
+
+constexpr int kResendQuietMs = 500;
 
 // Milliseconds left until `deadline` (at least 0), for handleTimeout.
 int remaining_ms(Clock::time_point deadline) {
@@ -68,9 +71,10 @@ class UplinkWatcher {
         break;
       case kEventChunkRejected:
         ++rejections_;
+        last_rejection_ = Clock::now();
         if (log_ != nullptr) {
-          std::fprintf(log_, "chunk rejected: %s%s%s\n", chunk_status_name(e.arg1).c_str(),
-                       e.text.empty() ? "" : ": ", e.text.c_str());
+          std::fprintf(log_, "chunk rejected: %s\n",
+                       e.text.empty() ? chunk_status_name(e.arg1).c_str() : e.text.c_str());
         }
         break;
       case kEventUplinkAbandoned:
@@ -91,6 +95,7 @@ class UplinkWatcher {
   bool complete() const { return complete_; }
   bool abandoned() const { return abandoned_; }
   std::uint64_t rejections() const { return rejections_; }
+  Clock::time_point last_rejection() const { return last_rejection_; }
 
  private:
   std::int32_t id_;
@@ -99,6 +104,7 @@ class UplinkWatcher {
   bool complete_{false};
   bool abandoned_{false};
   std::uint64_t rejections_{0};
+  Clock::time_point last_rejection_{};
 };
 
 class Monitor {
@@ -142,14 +148,18 @@ class Monitor {
     redraw();
   }
   void redraw() {
-    std::string screen = "\x1b[H\x1b[2J";  // home, clear
+    // Cursor home, each line overwritten and its rest cleared, then the rest of the screen
+    // cleared: no flicker from a full clear.
+    constexpr const char* kEol = "\x1b[K\n";
+    std::string screen = "\x1b[H";
     if (have_tlm_) {
-      for (const std::string& l : format_status(tlm_, counts_)) screen += l + "\n";
+      for (const std::string& l : format_status(tlm_, counts_)) screen += l + kEol;
     } else {
-      screen += "waiting for telemetry on " + std::string(channels::kGncTelemetry) + " ...\n";
+      screen += "waiting for telemetry on " + std::string(channels::kGncTelemetry) + " ..." + kEol;
     }
-    screen += "--- events and acks ---\n";
-    for (const std::string& l : recent_) screen += l + "\n";
+    screen += std::string("--- events and acks ---") + kEol;
+    for (const std::string& l : recent_) screen += l + kEol;
+    screen += "\x1b[J";
     std::fputs(screen.c_str(), out_);
     std::fflush(out_);
   }
@@ -225,6 +235,7 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
 
   for (int pass = 1; pass <= options.passes && !watcher.complete() && !watcher.abandoned(); ++pass) {
     r.passes_used = pass;
+    const std::uint64_t rejections_before = watcher.rejections();
     for (const rocksteady::trajectory_chunk_t& c : chunks) {
       if (lcm.publish(channels::kTrajUplink, &c) != 0) {
         r.message = "publishing on " + std::string(channels::kTrajUplink) + " failed";
@@ -241,9 +252,15 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
                    options.upload_id, pass, r.chunks, table.count,
                    static_cast<unsigned>(chunks.front().table_crc));
     }
+    // Wait for completion; after a rejected chunk (e.g. busy: the previous table is still waiting
+    // for the tick boundary) the next pass starts once the rejections have stopped for a while.
     const Clock::time_point deadline = after(options.wait_s);
     while (!watcher.complete() && !watcher.abandoned()) {
-      const int ms = remaining_ms(deadline);
+      if (watcher.rejections() > rejections_before &&
+          Clock::now() - watcher.last_rejection() > std::chrono::milliseconds(kResendQuietMs)) {
+        break;
+      }
+      const int ms = std::min(remaining_ms(deadline), kResendQuietMs);
       if (ms <= 0) break;
       lcm.handleTimeout(ms);
     }

@@ -124,7 +124,7 @@ std::string format_ack_verdict(const rocksteady::cmd_ack_t& a) {
   std::string s = "REJECTED: " + reason_name(a.reason);
   const std::string detail = reason_detail(a.reason, a.detail);
   if (!detail.empty()) s += " (" + detail + ")";
-  if (!a.text.empty()) s += ": " + a.text;
+  if (!a.text.empty() && a.text != detail) s += ": " + a.text;
   return s;
 }
 

@@ -157,8 +157,11 @@ TEST(MonitorFormat, AckVerdictNamesReasonDetailAndText) {
   a.reason = rocksteady::cmd_ack_t::REASON_NOT_ALLOWED_IN_MODE;
   a.detail = static_cast<std::int32_t>(gnc::TransitionCheck::kNoTrajectory);
   a.text = "no valid trajectory loaded";
+  EXPECT_EQ(format_ack_verdict(a), "REJECTED: not allowed in this mode (no valid trajectory loaded)");
+  a.text = "opcode not allowed in this mode";
   EXPECT_EQ(format_ack_verdict(a),
-            "REJECTED: not allowed in this mode (no valid trajectory loaded): no valid trajectory loaded");
+            "REJECTED: not allowed in this mode (no valid trajectory loaded): opcode not allowed in "
+            "this mode");
   a.reason = rocksteady::cmd_ack_t::REASON_UPLOAD_INCOMPLETE;
   a.detail = 3;
   a.text = "";
