@@ -18,15 +18,14 @@ namespace {
 const std::string kGround = ROCKSTEADY_GROUND_EXE;
 const std::string kResponder = ROCKSTEADY_RESPONDER_EXE;
 
-std::string url(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
+std::string url(int port) { return test::lcm_url(port); }
 
 // `script` runs in a fresh network namespace; `responder_args` (if any) start the responder first,
 // the script waits until it is subscribed, and `stop_responder` ends it after the script. The
 // script's status is the result; the responder's is printed to stderr as "responder=N".
 test::Run in_namespace(const test::TempDir& dir, const std::string& responder_args,
                        const std::string& script, bool stop_responder = false) {
-  std::string s =
-      "ip link set lo up && ip link set lo multicast on && ip route add 239.255.76.67 dev lo || exit 90\n";
+  std::string s;
   if (!responder_args.empty()) {
     const std::string ready = dir.file("responder.ready");
     s += test::quote(kResponder) + " --ready " + test::quote(ready) + " " + responder_args + " &\n";
@@ -37,7 +36,7 @@ test::Run in_namespace(const test::TempDir& dir, const std::string& responder_ar
   if (stop_responder) s += "kill $rpid\n";
   if (!responder_args.empty()) s += "wait $rpid; echo responder=$? >&2\n";
   s += "exit $rc\n";
-  return test::run("timeout 60 unshare -rn sh -c " + test::quote(s), dir);
+  return test::run_in_namespace(s, dir);
 }
 
 std::string ground(int port, const std::string& args) {

@@ -73,4 +73,17 @@ inline std::string quote(const std::string& s) {
   return q + "'";
 }
 
+// Runs `script` with /bin/sh in a fresh network namespace whose loopback carries the LCM multicast
+// group (ENVIRONMENT.md), bounded by `timeout`. Exit 90: the namespace could not be set up.
+inline Run run_in_namespace(const std::string& script, const TempDir& dir, int timeout_s = 60) {
+  const std::string s =
+      "ip link set lo up && ip link set lo multicast on && ip route add 239.255.76.67 dev lo || exit 90\n" +
+      script;
+  return run("timeout " + std::to_string(timeout_s) + " unshare -rn sh -c " + quote(s), dir);
+}
+
+inline std::string lcm_url(int port) {
+  return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
+}
+
 }  // namespace rocksteady::ground::cli::test
