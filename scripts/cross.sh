@@ -28,6 +28,9 @@ while (($#)); do
 done
 jobs=$(nproc)
 t_start=$SECONDS
+# The aarch64 programs use the multiarch loader and libraries at their normal paths: a QEMU_LD_PREFIX
+# would mix the cross toolchain's C library with the multiarch one (see ENVIRONMENT notes).
+unset QEMU_LD_PREFIX
 stage() { echo "cross: [$((SECONDS - t_start)) s] $*"; }
 
 if ((setup)); then
