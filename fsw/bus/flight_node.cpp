@@ -129,7 +129,7 @@ void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/,
   }
   ++n.stats_.commands;
   const CommandAck ack = n.app_.submit(to_command(n.scratch_cmd_));
-  to_message(ack, n.app_.core_output().telemetry.t, n.ack_msg_);
+  to_message(ack, n.app_.onboard_time(), n.ack_msg_);
   n.publish(channels::kCmdAck, n.ack_msg_);
   n.drain_events();
 }
@@ -182,7 +182,7 @@ void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::
                            const char* text) {
   Event e;
   e.seq = kBusEventSeqBase + bus_event_seq_++;
-  e.t = app_.core_output().telemetry.t;
+  e.t = app_.onboard_time();
   e.severity = sev;
   e.id = static_cast<EventId>(id);
   e.arg0 = arg0;
@@ -206,6 +206,18 @@ void FlightNode::tick(const Tick& t, const rocksteady::sensor_frame_t* frame, co
   have_index_ = true;
   ++stats_.ticks;
   publish_outputs(out, o);
+  if (o.has_start_mode && !start_done_ && out.gnc_ran && app_.health().frames_accepted > 0) {
+    start_done_ = true;
+    GroundCommand c;
+    c.seq = 1;
+    c.source = kStartupSource;
+    c.opcode = static_cast<std::int32_t>(Opcode::kSetMode);
+    c.arg_count = 1;
+    c.args[0] = static_cast<double>(static_cast<int>(o.start_mode));
+    to_message(app_.submit(c), app_.onboard_time(), ack_msg_);
+    publish(channels::kCmdAck, ack_msg_);
+    drain_events();
+  }
 }
 
 void FlightNode::publish_outputs(const Outputs& out, const NodeOptions& o) {

@@ -54,7 +54,14 @@ struct NodeOptions {
   // Realtime: tick start minus its deadline, one value per base tick (capacity reserved by the
   // caller; values beyond it are not recorded).
   std::vector<std::int64_t>* jitter_ns{nullptr};
+  // After the first GNC tick with an accepted frame, submit SET_MODE start_mode as a ground command from source
+  // kStartupSource (the in-process campaign's habit: the estimator has a state by then).
+  bool has_start_mode{false};
+  gnc::Mode start_mode{gnc::Mode::kDetumble};
 };
+
+// Command source of the --start-mode command (the operator's sources are unaffected).
+inline constexpr std::int32_t kStartupSource = 99;
 
 struct NodeStats {
   std::uint64_t ticks{0};
@@ -144,6 +151,7 @@ class FlightNode {
   std::uint64_t last_index_{0};
   bool have_index_{false};
   bool bus_error_{false};
+  bool start_done_{false};
   unsigned char buf_[4096]{};
   NodeStats stats_{};
 };

@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
   cli.add_option("--rate", rate_hz, "realtime base rate, Hz (default: the GNC rate; a multiple of it)");
   cli.add_option("--law", law_name, "control law: ntcl, el, integral, adaptive, so3, dpd, feedforward");
   cli.add_option("--initial-mode", initial_mode, "boot mode (mode.initial): IDLE, DETUMBLE, HOLD, SAFE");
+  std::string start_mode;
+  cli.add_option("--start-mode", start_mode,
+                 "after the first GNC tick, command this mode as the ground would (e.g. DETUMBLE)");
   cli.add_option("--frame-watchdog", opt.frame_watchdog_s,
                  "lockstep: no sensor frame for this many wall seconds -> frameless ticks (-> SAFE)")
       ->capture_default_str();
@@ -131,6 +134,13 @@ int main(int argc, char** argv) {
   if (!initial_mode.empty() && !parse_mode(initial_mode, fc.gnc.mode.initial)) {
     std::fprintf(stderr, "rocksteady-fsw: unknown mode '%s'\n", initial_mode.c_str());
     return 2;
+  }
+  if (!start_mode.empty()) {
+    opt.has_start_mode = true;
+    if (!parse_mode(start_mode, opt.start_mode)) {
+      std::fprintf(stderr, "rocksteady-fsw: unknown mode '%s'\n", start_mode.c_str());
+      return 2;
+    }
   }
   const double dt = fc.gnc.dt;
   if (clock_name == "lockstep") {
