@@ -79,7 +79,8 @@ class UplinkWatcher {
         break;
       case kEventUplinkAbandoned:
         abandoned_ = true;
-        if (log_ != nullptr) std::fprintf(log_, "uplink abandoned by the flight: %s\n", e.text.c_str());
+        if (log_ != nullptr)
+          std::fprintf(log_, "uplink abandoned by the flight: %s\n", e.text.c_str());
         break;
       default:
         break;
@@ -88,7 +89,8 @@ class UplinkWatcher {
   void on_telemetry(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     rocksteady::gnc_telemetry_t m;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) return;
-    if (m.uplink_id == id_ && m.uplink_total_chunks == chunks_ && m.uplink_chunks_received == chunks_) {
+    if (m.uplink_id == id_ && m.uplink_total_chunks == chunks_ &&
+        m.uplink_chunks_received == chunks_) {
       complete_ = true;
     }
   }
@@ -112,7 +114,8 @@ class Monitor {
   Monitor(const MonitorOptions& options, std::FILE* out) : options_(options), out_(out) {}
 
   void on_telemetry(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), tlm_, &counts_.rx)) return;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), tlm_, &counts_.rx))
+      return;
     ++counts_.telemetry;
     have_tlm_ = true;
     if (options_.ansi) {
@@ -176,10 +179,13 @@ class Monitor {
 
 int SendResult::exit_code() const {
   switch (outcome) {
-    case Outcome::kAccepted: return kExitAccepted;
-    case Outcome::kRejected: return kExitRejected;
+    case Outcome::kAccepted:
+      return kExitAccepted;
+    case Outcome::kRejected:
+      return kExitRejected;
     case Outcome::kTimeout:
-    case Outcome::kError: return kExitTimeoutOrUsage;
+    case Outcome::kError:
+      return kExitTimeoutOrUsage;
   }
   return kExitTimeoutOrUsage;
 }
@@ -211,7 +217,8 @@ SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, dou
   r.rx = waiter.rx();
   if (waiter.matched()) {
     r.ack = waiter.ack();
-    r.outcome = r.ack.accepted != 0 ? SendResult::Outcome::kAccepted : SendResult::Outcome::kRejected;
+    r.outcome =
+        r.ack.accepted != 0 ? SendResult::Outcome::kAccepted : SendResult::Outcome::kRejected;
   } else if (r.error.empty()) {
     r.outcome = SendResult::Outcome::kTimeout;
   }
@@ -231,9 +238,11 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
   }
   UplinkWatcher watcher(options.upload_id, r.chunks, log);
   lcm::Subscription* ev = lcm.subscribe(channels::kEvents, &UplinkWatcher::on_event, &watcher);
-  lcm::Subscription* tlm = lcm.subscribe(channels::kGncTelemetry, &UplinkWatcher::on_telemetry, &watcher);
+  lcm::Subscription* tlm =
+      lcm.subscribe(channels::kGncTelemetry, &UplinkWatcher::on_telemetry, &watcher);
 
-  for (int pass = 1; pass <= options.passes && !watcher.complete() && !watcher.abandoned(); ++pass) {
+  for (int pass = 1; pass <= options.passes && !watcher.complete() && !watcher.abandoned();
+       ++pass) {
     r.passes_used = pass;
     const std::uint64_t rejections_before = watcher.rejections();
     for (const rocksteady::trajectory_chunk_t& c : chunks) {
@@ -291,7 +300,9 @@ MonitorCounts run_monitor(lcm::LCM& lcm, const MonitorOptions& options, std::FIL
   const bool timed = options.seconds >= 0.0;
   const Clock::time_point deadline = after(options.seconds);
   for (;;) {
-    if (options.count >= 0 && monitor.counts().telemetry >= static_cast<std::uint64_t>(options.count)) break;
+    if (options.count >= 0 &&
+        monitor.counts().telemetry >= static_cast<std::uint64_t>(options.count))
+      break;
     int ms = 500;
     if (timed) {
       ms = remaining_ms(deadline);

@@ -25,9 +25,9 @@ struct SendResult {
   enum class Outcome { kAccepted, kRejected, kTimeout, kError };
   Outcome outcome{Outcome::kError};
   rocksteady::cmd_ack_t ack{};  // the matching acknowledgement (accepted / rejected)
-  std::string error;           // kError: what failed
-  std::uint64_t other_acks{0}; // acknowledgements of other commands seen meanwhile
-  hal::wire::RxCounters rx{};  // decode outcomes on RS_CMD_ACK
+  std::string error;            // kError: what failed
+  std::uint64_t other_acks{0};  // acknowledgements of other commands seen meanwhile
+  hal::wire::RxCounters rx{};   // decode outcomes on RS_CMD_ACK
   int exit_code() const;
 };
 
@@ -57,10 +57,10 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
                            const UploadOptions& options, std::FILE* log);
 
 struct MonitorOptions {
-  long count{-1};       // stop after this many telemetry messages (< 0: no limit)
-  double seconds{-1.0}; // stop after this long (< 0: no limit)
-  bool ansi{false};     // redraw a status block (terminal) instead of one line per message
-  int event_lines{10};  // events kept under the status block (ansi)
+  long count{-1};        // stop after this many telemetry messages (< 0: no limit)
+  double seconds{-1.0};  // stop after this long (< 0: no limit)
+  bool ansi{false};      // redraw a status block (terminal) instead of one line per message
+  int event_lines{10};   // events kept under the status block (ansi)
 };
 
 // Runs until a limit is reached; returns what it saw.

@@ -24,19 +24,24 @@ const std::vector<CommandHelp> kHelp{
     {"set-mode", "set-mode IDLE|DETUMBLE|HOLD|TRACK|SAFE", "request a mode (next GNC tick)"},
     {"set-target", "set-target q1 q2 q3  |  set-target --quat x y z w",
      "HOLD/TRACK target attitude q_final as an MRP (|q| <= 1), or a unit quaternion, scalar last"},
-    {"select-law", "select-law ntcl|el|integral|adaptive|so3|dpd|feedforward [keep|dpd-ref|fuel-optimal]",
-     "select the control law and optionally the reference (dpd-ref: DETUMBLE/HOLD, fuel-optimal: TRACK)"},
+    {"select-law",
+     "select-law ntcl|el|integral|adaptive|so3|dpd|feedforward [keep|dpd-ref|fuel-optimal]",
+     "select the control law and optionally the reference (dpd-ref: DETUMBLE/HOLD, fuel-optimal: "
+     "TRACK)"},
     {"set-gain", "set-gain PARAM VALUES...",
-     "load a parameter into the inactive table: a matrix takes 3 values (diagonal) or 6 (xx yy zz xy "
+     "load a parameter into the inactive table: a matrix takes 3 values (diagonal) or 6 (xx yy zz "
+     "xy "
      "xz yz), a scalar 1, a flag 0|1; PARAM is a name (ntcl.K) or number (see 'params')"},
     {"activate-gains", "activate-gains", "the inactive table becomes active at the next GNC tick"},
     {"discard-gains", "discard-gains", "drop the loads: inactive table := active table"},
-    {"reset-counters", "reset-counters", "reset the command/health counters (cycle counts are kept)"},
+    {"reset-counters", "reset-counters",
+     "reset the command/health counters (cycle counts are kept)"},
     {"load-trajectory", "load-trajectory UPLOAD_ID",
      "hand a completely uplinked trajectory to the flight core (not in TRACK)"},
     {"abort-uplink", "abort-uplink UPLOAD_ID", "discard a trajectory uplink in progress"},
     {"upload-trajectory", "upload-trajectory FILE",
-     "uplink a planner trajectory file in chunks, wait for the flight to complete it, then load it"},
+     "uplink a planner trajectory file in chunks, wait for the flight to complete it, then load "
+     "it"},
 };
 
 std::string join(const std::vector<std::string>& words, const char* sep) {
@@ -116,7 +121,8 @@ Encoded set_target(const std::vector<std::string>& args, const EncodeOptions& op
   std::vector<double> v;
   std::string error;
   if (options.quaternion) {
-    if (args.size() != 4) return wrong_count(name, "4 arguments with --quat (x y z w)", args.size());
+    if (args.size() != 4)
+      return wrong_count(name, "4 arguments with --quat (x y z w)", args.size());
     if (!numbers(name, args, 0, v, error)) return fail(error);
     const gnc::Vec4 beta(v[0], v[1], v[2], v[3]);
     const double n = beta.norm();
@@ -158,7 +164,8 @@ Encoded select_law(const std::vector<std::string>& args) {
   if (args.size() == 2) {
     const auto ref = reference_from_name(args[1]);
     if (!ref) {
-      return fail(name + ": unknown reference '" + args[1] + "' (one of keep, dpd-ref, fuel-optimal)");
+      return fail(name + ": unknown reference '" + args[1] +
+                  "' (one of keep, dpd-ref, fuel-optimal)");
     }
     if (*law == 5 && *ref == 2) {
       return fail(name + ": the D+PD law cannot track the fuel-optimal reference");
@@ -185,12 +192,14 @@ Encoded set_gain(const std::vector<std::string>& args) {
   switch (p->kind) {
     case ParamKind::kMatrix:
       if (n != 3 && n != 6) {
-        return fail(name + ": " + p->name + " is a matrix: 3 values (diagonal) or 6 (xx yy zz xy xz yz), got " +
+        return fail(name + ": " + p->name +
+                    " is a matrix: 3 values (diagonal) or 6 (xx yy zz xy xz yz), got " +
                     std::to_string(n));
       }
       break;
     case ParamKind::kScalar:
-      if (n != 1) return fail(name + ": " + p->name + " is a scalar: 1 value, got " + std::to_string(n));
+      if (n != 1)
+        return fail(name + ": " + p->name + " is a scalar: 1 value, got " + std::to_string(n));
       break;
     case ParamKind::kFlag:
       if (n != 1 || (values[0] != 0.0 && values[0] != 1.0)) {
@@ -205,7 +214,8 @@ Encoded set_gain(const std::vector<std::string>& args) {
   }
   std::vector<double> a{static_cast<double>(p->id)};
   a.insert(a.end(), values.begin(), values.end());
-  std::string description = std::string("PARAM_LOAD ") + p->name + " (" + std::to_string(p->id) + ") =";
+  std::string description =
+      std::string("PARAM_LOAD ") + p->name + " (" + std::to_string(p->id) + ") =";
   for (const double v : values) description += " " + number_text(v);
   return make(Msg::OP_PARAM_LOAD, a, description);
 }
@@ -221,7 +231,8 @@ bool parse_number(const std::string& word, double& out) {
   if (end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
   // strtod also reads "inf", "nan" and hex floats; an operator's number is decimal.
   for (const char c : word) {
-    if ((c < '0' || c > '9') && c != '.' && c != '-' && c != '+' && c != 'e' && c != 'E') return false;
+    if ((c < '0' || c > '9') && c != '.' && c != '-' && c != '+' && c != 'e' && c != 'E')
+      return false;
   }
   out = v;
   return true;
@@ -244,7 +255,8 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
     if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
     const auto mode = mode_from_name(args[0]);
     if (!mode) {
-      return fail(name + ": unknown mode '" + args[0] + "' (one of " + join(mode_names(), ", ") + ")");
+      return fail(name + ": unknown mode '" + args[0] + "' (one of " + join(mode_names(), ", ") +
+                  ")");
     }
     return make(Msg::OP_SET_MODE, {static_cast<double>(*mode)},
                 std::string("SET_MODE ") + mode_name(*mode));
@@ -259,9 +271,8 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
     if (!upload_id(name, args[0], id, error)) return fail(error);
     const bool load = name == "load-trajectory";
     const std::int32_t op = load ? static_cast<std::int32_t>(Msg::OP_LOAD_TRAJECTORY)
-                                  : static_cast<std::int32_t>(Msg::OP_ABORT_UPLINK);
-    return make(op, {id},
-                std::string(load ? "LOAD_TRAJECTORY " : "ABORT_UPLINK ") + args[0]);
+                                 : static_cast<std::int32_t>(Msg::OP_ABORT_UPLINK);
+    return make(op, {id}, std::string(load ? "LOAD_TRAJECTORY " : "ABORT_UPLINK ") + args[0]);
   }
   if (name == "upload-trajectory") {
     return fail("upload-trajectory is a procedure of many messages, not one command");
@@ -269,7 +280,9 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
   return fail("unknown command '" + name + "' (one of " + command_list() + ")");
 }
 
-const std::vector<CommandHelp>& command_help() { return kHelp; }
+const std::vector<CommandHelp>& command_help() {
+  return kHelp;
+}
 
 std::string command_list() {
   std::vector<std::string> names;
@@ -278,10 +291,9 @@ std::string command_list() {
 }
 
 std::string opcode_name(int opcode) {
-  static const char* const kNames[] = {"NOOP",           "SET_MODE",     "SET_TARGET",
-                                       "SET_LAW",        "LOAD_TRAJECTORY", "ABORT_UPLINK",
-                                       "RESET_COUNTERS", "PARAM_LOAD",   "PARAM_ACTIVATE",
-                                       "PARAM_DISCARD"};
+  static const char* const kNames[] = {
+      "NOOP",         "SET_MODE",       "SET_TARGET", "SET_LAW",        "LOAD_TRAJECTORY",
+      "ABORT_UPLINK", "RESET_COUNTERS", "PARAM_LOAD", "PARAM_ACTIVATE", "PARAM_DISCARD"};
   if (opcode >= 0 && opcode < Msg::OP_COUNT) return kNames[opcode];
   return "OP " + std::to_string(opcode);
 }

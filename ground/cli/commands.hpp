@@ -1,9 +1,9 @@
-// Operator input -> ground_cmd_t. The words an operator types ("set-mode HOLD", "set-gain ntcl.K 1e4
-// 1e4 2e4") are checked here, before anything goes on the bus: unknown command, wrong argument count,
-// non-numeric or non-finite numbers, names that are not in the dictionary and the ranges the flight
-// side's opcode table will check (fsw/README.md "Commands") are refused locally with a message that
-// says what is expected. The encoding is the flight side's contract: opcode numbers, argument order,
-// counts (tests/ground_cli checks every command against fsw::check_command).
+// Operator input -> ground_cmd_t. The words an operator types ("set-mode HOLD", "set-gain ntcl.K
+// 1e4 1e4 2e4") are checked here, before anything goes on the bus: unknown command, wrong argument
+// count, non-numeric or non-finite numbers, names that are not in the dictionary and the ranges the
+// flight side's opcode table will check (fsw/README.md "Commands") are refused locally with a
+// message that says what is expected. The encoding is the flight side's contract: opcode numbers,
+// argument order, counts (tests/ground_cli checks every command against fsw::check_command).
 #pragma once
 
 #include <cstdint>
@@ -15,14 +15,15 @@
 namespace rocksteady::ground::cli {
 
 struct EncodeOptions {
-  bool quaternion{false};  // set-target takes a quaternion [x y z w] (scalar last) instead of an MRP
+  bool quaternion{
+      false};  // set-target takes a quaternion [x y z w] (scalar last) instead of an MRP
 };
 
 struct Encoded {
   bool ok{false};
-  std::string error;            // why the input was refused (when !ok)
+  std::string error;               // why the input was refused (when !ok)
   rocksteady::ground_cmd_t cmd{};  // kind, version, opcode, nargs, args; seq and sender are 0
-  std::string description;      // what will be sent, for the operator ("SET_MODE HOLD")
+  std::string description;         // what will be sent, for the operator ("SET_MODE HOLD")
 };
 
 // Encodes one command; `name` is the command word, `args` the words after it. Does not handle

@@ -29,7 +29,8 @@ class Sink {
   }
   void text(const std::string& name, const std::string& v) { add(name, v); }
 
-  template <class T, std::size_t N> void array(const std::string& name, const T (&a)[N]) {
+  template <class T, std::size_t N>
+  void array(const std::string& name, const T (&a)[N]) {
     for (std::size_t i = 0; i < N; ++i) scalar(name + "_" + std::to_string(i), a[i]);
   }
   template <class T, std::size_t N, std::size_t M>
@@ -57,6 +58,8 @@ class Sink {
   std::vector<std::string> cells_;
 };
 
+// The fields of each type, grouped on lines in the .lcm file's order.
+// clang-format off
 #define RS_I(f) s.integer(#f, m.f)
 #define RS_D(f) s.real(#f, m.f)
 #define RS_A(f) s.array(#f, m.f)
@@ -122,6 +125,7 @@ void visit(const rocksteady::trajectory_chunk_t& m, Sink& s) {
 #undef RS_I
 #undef RS_D
 #undef RS_A
+// clang-format on
 
 struct Converter {
   std::function<std::vector<std::string>()> header;
@@ -130,7 +134,8 @@ struct Converter {
       row;
 };
 
-template <class T> Converter converter() {
+template <class T>
+Converter converter() {
   Converter c;
   c.header = [] {
     Sink s(true);
@@ -174,7 +179,9 @@ std::vector<std::string> csv_channels() {
   return names;
 }
 
-bool csv_supported(const std::string& channel) { return converters().count(channel) != 0; }
+bool csv_supported(const std::string& channel) {
+  return converters().count(channel) != 0;
+}
 
 std::vector<std::string> csv_header(const std::string& channel) {
   const auto it = converters().find(channel);

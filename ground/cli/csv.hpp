@@ -1,6 +1,6 @@
 // Bus messages as CSV rows, and log2csv: an LCM log (lcm-logger's format, read with lcm::LogFile)
-// converted one channel at a time. Every event is decoded with hal::wire::safe_decode; whatever fails
-// (truncated, wrong type, out-of-range fields) is counted and left out, never guessed at.
+// converted one channel at a time. Every event is decoded with hal::wire::safe_decode; whatever
+// fails (truncated, wrong type, out-of-range fields) is counted and left out, never guessed at.
 // Columns: log_utime (the log's receive time, microseconds since the epoch), then every field of
 // the message in the order of its .lcm file; arrays are expanded as name_0, name_1, ... (two
 // dimensions: name_i_j).

@@ -105,20 +105,36 @@ std::optional<int> mode_from_name(const std::string& name) {
                  [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   return index_of(kModes, up);
 }
-const char* mode_name(int mode) { return name_or(kModes, mode, "?"); }
-std::vector<std::string> mode_names() { return {kModes.begin(), kModes.end()}; }
+const char* mode_name(int mode) {
+  return name_or(kModes, mode, "?");
+}
+std::vector<std::string> mode_names() {
+  return {kModes.begin(), kModes.end()};
+}
 
-std::optional<int> law_from_name(const std::string& name) { return index_of(kLaws, lower(name)); }
-const char* law_name(int law) { return name_or(kLaws, law, "?"); }
-std::vector<std::string> law_names() { return {kLaws.begin(), kLaws.end()}; }
+std::optional<int> law_from_name(const std::string& name) {
+  return index_of(kLaws, lower(name));
+}
+const char* law_name(int law) {
+  return name_or(kLaws, law, "?");
+}
+std::vector<std::string> law_names() {
+  return {kLaws.begin(), kLaws.end()};
+}
 
 std::optional<int> reference_from_name(const std::string& name) {
   return index_of(kReferences, dashes_to_underscores(lower(name)));
 }
-const char* reference_name(int ref) { return name_or(kReferences, ref, "?"); }
-std::vector<std::string> reference_names() { return {kReferences.begin(), kReferences.end()}; }
+const char* reference_name(int ref) {
+  return name_or(kReferences, ref, "?");
+}
+std::vector<std::string> reference_names() {
+  return {kReferences.begin(), kReferences.end()};
+}
 
-const char* phase_name(int phase) { return name_or(kPhases, phase, "?"); }
+const char* phase_name(int phase) {
+  return name_or(kPhases, phase, "?");
+}
 
 const std::vector<ParamEntry>& param_dictionary() {
   static const std::vector<ParamEntry> table{
@@ -185,7 +201,9 @@ std::string chunk_status_name(int status) {
   return n != nullptr ? std::string(n) : "chunk status " + std::to_string(status);
 }
 
-const char* severity_name(int severity) { return name_or(kSeverities, severity, "?"); }
+const char* severity_name(int severity) {
+  return name_or(kSeverities, severity, "?");
+}
 
 std::string reason_detail(int reason, int detail) {
   switch (reason) {

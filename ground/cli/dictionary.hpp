@@ -1,7 +1,7 @@
-// The ground's command and telemetry dictionary: the names an operator types and reads, mapped to the
-// numbers on the bus (lcmtypes' ground_cmd_t OP_*, cmd_ack_t REASON_*, the fsw's event ids and
-// parameter ids). The ground keeps its own copy, as a ground system does; tests/ground_cli checks it
-// against the flight application's tables entry by entry.
+// The ground's command and telemetry dictionary: the names an operator types and reads, mapped to
+// the numbers on the bus (lcmtypes' ground_cmd_t OP_*, cmd_ack_t REASON_*, the fsw's event ids and
+// parameter ids). The ground keeps its own copy, as a ground system does; tests/ground_cli checks
+// it against the flight application's tables entry by entry.
 #pragma once
 
 #include <cstdint>
@@ -13,7 +13,7 @@ namespace rocksteady::ground::cli {
 
 // gnc::Mode numbers and names (IDLE, DETUMBLE, HOLD, TRACK, SAFE).
 std::optional<int> mode_from_name(const std::string& name);  // case-insensitive
-const char* mode_name(int mode);                              // "?" outside 0..4
+const char* mode_name(int mode);                             // "?" outside 0..4
 std::vector<std::string> mode_names();
 
 // gnc::LawId numbers and names (ntcl, el, integral, adaptive, so3, dpd, feedforward).

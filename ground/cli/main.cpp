@@ -5,8 +5,8 @@
 //   log2csv LOG --channel CH   one channel of an LCM log as CSV
 //   params                     the loadable parameters (set-gain)
 // See ground/cli/README.md.
-#include <CLI/CLI.hpp>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <exception>
@@ -138,7 +138,8 @@ int send_one(lcm::LCM* lcm, rocksteady::ground_cmd_t cmd, const std::string& des
       break;
   }
   if (r.rx.rejected() > 0) {
-    std::fprintf(stderr, "note: %s acknowledgement messages\n", cli::describe_rejections(r.rx).c_str());
+    std::fprintf(stderr, "note: %s acknowledgement messages\n",
+                 cli::describe_rejections(r.rx).c_str());
   }
   std::fflush(stdout);
   return r.exit_code();
@@ -161,7 +162,8 @@ planner::PlanModel expected_model(const SendArgs& a) {
     m.omega_init = mission.initial_omega;
     return m;
 #else
-    throw std::runtime_error("this build has no configuration loader: use --u-max/--delta-j/--delta-r");
+    throw std::runtime_error(
+        "this build has no configuration loader: use --u-max/--delta-j/--delta-r");
 #endif
   }
   return planner::study_case_model(a.u_max, a.delta_j, a.delta_r);
@@ -169,7 +171,8 @@ planner::PlanModel expected_model(const SendArgs& a) {
 
 int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   if (a.args.size() != 1) {
-    std::fprintf(stderr, "error: upload-trajectory takes 1 argument (the trajectory file), got %zu\n",
+    std::fprintf(stderr,
+                 "error: upload-trajectory takes 1 argument (the trajectory file), got %zu\n",
                  a.args.size());
     return cli::kExitTimeoutOrUsage;
   }
@@ -281,11 +284,13 @@ int main(int argc, char** argv) {
                    "sequence state directory (default $XDG_STATE_HOME/rocksteady or "
                    "~/.local/state/rocksteady)");
   send->add_flag("--dry-run", s.dry_run, "encode and print, send nothing");
-  send->add_option("--upload-id", s.upload_id, "upload-trajectory: the upload id (default: a fresh "
-                                               "sequence number)")
+  send->add_option("--upload-id", s.upload_id,
+                   "upload-trajectory: the upload id (default: a fresh "
+                   "sequence number)")
       ->check(CLI::Range(0LL, 2147483647LL));
   send->add_flag("--no-load", s.no_load, "upload-trajectory: uplink only, no LOAD_TRAJECTORY");
-  send->add_option("--chunk-interval", s.chunk_interval, "upload-trajectory: seconds between chunks")
+  send->add_option("--chunk-interval", s.chunk_interval,
+                   "upload-trajectory: seconds between chunks")
       ->check(CLI::NonNegativeNumber);
   send->add_option("--wait", s.wait, "upload-trajectory: seconds to wait for completion per pass")
       ->check(CLI::PositiveNumber);
@@ -296,7 +301,8 @@ int main(int argc, char** argv) {
   send->add_option("--u-max", s.u_max, "upload-trajectory: study-case model, u_max (N)");
   send->add_option("--delta-j", s.delta_j, "upload-trajectory: study-case model, ||dJ_ast||_2");
   send->add_option("--delta-r", s.delta_r, "upload-trajectory: study-case model, ||dr||_2 (m)");
-  send->add_option("--mission", s.mission, "upload-trajectory: model from mission YAML (with --gnc, --case)");
+  send->add_option("--mission", s.mission,
+                   "upload-trajectory: model from mission YAML (with --gnc, --case)");
   send->add_option("--gnc", s.gnc, "upload-trajectory: GNC YAML");
   send->add_option("--case", s.case_file, "upload-trajectory: case YAML");
 
@@ -304,8 +310,10 @@ int main(int argc, char** argv) {
   bool plain = false;
   bool ansi = false;
   CLI::App* monitor = app.add_subcommand("monitor", "live telemetry, events and acknowledgements");
-  monitor->add_option("--count", mon.count, "exit after N telemetry messages")->check(CLI::NonNegativeNumber);
-  monitor->add_option("--seconds", mon.seconds, "exit after S seconds")->check(CLI::NonNegativeNumber);
+  monitor->add_option("--count", mon.count, "exit after N telemetry messages")
+      ->check(CLI::NonNegativeNumber);
+  monitor->add_option("--seconds", mon.seconds, "exit after S seconds")
+      ->check(CLI::NonNegativeNumber);
   monitor->add_flag("--plain", plain, "one line per message even on a terminal");
   monitor->add_flag("--ansi", ansi, "redraw a status block even when not on a terminal");
 
@@ -313,7 +321,9 @@ int main(int argc, char** argv) {
   std::string channel = "RS_GNC_TLM";
   std::string output;
   CLI::App* log2csv = app.add_subcommand("log2csv", "one channel of an LCM log as CSV");
-  log2csv->add_option("logfile", log_path, "LCM log (lcm-logger)")->required()->check(CLI::ExistingFile);
+  log2csv->add_option("logfile", log_path, "LCM log (lcm-logger)")
+      ->required()
+      ->check(CLI::ExistingFile);
   log2csv->add_option("--channel", channel, "channel to convert (default RS_GNC_TLM)");
   log2csv->add_option("-o,--output", output, "CSV file (default: standard output)");
   bool strict = false;
@@ -341,8 +351,8 @@ int main(int argc, char** argv) {
       const cli::MonitorCounts c = cli::run_monitor(*lcm, mon, stdout);
       std::fprintf(stderr, "monitor: %llu telemetry, %llu events, %llu acks; %s\n",
                    static_cast<unsigned long long>(c.telemetry),
-                   static_cast<unsigned long long>(c.events), static_cast<unsigned long long>(c.acks),
-                   cli::describe_rejections(c.rx).c_str());
+                   static_cast<unsigned long long>(c.events),
+                   static_cast<unsigned long long>(c.acks), cli::describe_rejections(c.rx).c_str());
       return mon.count >= 0 && c.telemetry < static_cast<std::uint64_t>(mon.count) ? 1 : 0;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "error: %s\n", e.what());
@@ -363,7 +373,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: %llu events, %llu on %s, %llu rows; %s\n", log_path.c_str(),
                    static_cast<unsigned long long>(st.events),
                    static_cast<unsigned long long>(st.on_channel), channel.c_str(),
-                   static_cast<unsigned long long>(st.written), cli::describe_rejections(st.rx).c_str());
+                   static_cast<unsigned long long>(st.written),
+                   cli::describe_rejections(st.rx).c_str());
       return strict && st.rejected() > 0 ? 1 : 0;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "error: %s\n", e.what());
@@ -373,7 +384,7 @@ int main(int argc, char** argv) {
 
   if (*params) {
     for (const cli::ParamEntry& p : cli::param_dictionary()) {
-      const char* kind = p.kind == cli::ParamKind::kMatrix ? "matrix: 3 (diagonal) or 6 values"
+      const char* kind = p.kind == cli::ParamKind::kMatrix   ? "matrix: 3 (diagonal) or 6 values"
                          : p.kind == cli::ParamKind::kScalar ? "scalar: 1 value"
                                                              : "flag: 0 or 1";
       std::printf("%2d  %-30s %s\n", p.id, p.name, kind);

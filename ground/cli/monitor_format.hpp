@@ -25,7 +25,8 @@ double norm3(const double (&v)[3]);
 
 // The status block, one string per line (no line breaks inside). Sections: mode/law/phase, rates,
 // attitude error, actuators and fuel, rate groups, commanding, health counters, uplink.
-std::vector<std::string> format_status(const rocksteady::gnc_telemetry_t& m, const MonitorCounts& c);
+std::vector<std::string> format_status(const rocksteady::gnc_telemetry_t& m,
+                                       const MonitorCounts& c);
 // One line with the same essentials ("t=12.300 mode=HOLD law=ntcl ...").
 std::string format_status_line(const rocksteady::gnc_telemetry_t& m, const MonitorCounts& c);
 

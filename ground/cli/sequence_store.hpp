@@ -1,7 +1,7 @@
 // Per-sender command sequence numbers that survive the process: the flight side accepts a command
 // only if its seq is above the last one it accepted from that sender (fsw/README.md "Commands"), so
-// every send takes the next number from a small state file, under an exclusive lock (two consoles of
-// the same sender never get the same number). The number is written before the command is sent.
+// every send takes the next number from a small state file, under an exclusive lock (two consoles
+// of the same sender never get the same number). The number is written before the command is sent.
 #pragma once
 
 #include <cstdint>

@@ -39,8 +39,8 @@ struct Case {
   std::string name;
   std::vector<std::string> args;
   bool quat;
-  gnc::Mode mode;          // a mode the command is allowed in
-  fsw::Opcode opcode;      // what the flight must see
+  gnc::Mode mode;      // a mode the command is allowed in
+  fsw::Opcode opcode;  // what the flight must see
   std::vector<double> expected_args;
 };
 
@@ -61,23 +61,61 @@ std::vector<Case> cases() {
       {"set-target", {"0", "0", "1"}, false, M::kIdle, O::kSetTarget, {0.0, 0.0, 1.0}},
       {"set-target",
        {"0", "0", num(std::sin(M_PI / 4)), num(std::cos(M_PI / 4))},
-       true, M::kHold, O::kSetTarget, {0.0, 0.0, tan_pi_8}},
+       true,
+       M::kHold,
+       O::kSetTarget,
+       {0.0, 0.0, tan_pi_8}},
       {"set-target", {"1", "0", "0", "0"}, true, M::kHold, O::kSetTarget, {1.0, 0.0, 0.0}},
       {"select-law", {"ntcl"}, false, M::kHold, O::kSetLaw, {law(gnc::LawId::kNtcl)}},
       {"select-law", {"el"}, false, M::kHold, O::kSetLaw, {law(gnc::LawId::kNtclEl)}},
-      {"select-law", {"integral", "keep"}, false, M::kHold, O::kSetLaw,
+      {"select-law",
+       {"integral", "keep"},
+       false,
+       M::kHold,
+       O::kSetLaw,
        {law(gnc::LawId::kIntegral), ref(fsw::ReferenceId::kKeep)}},
-      {"select-law", {"adaptive", "fuel-optimal"}, false, M::kHold, O::kSetLaw,
+      {"select-law",
+       {"adaptive", "fuel-optimal"},
+       false,
+       M::kHold,
+       O::kSetLaw,
        {law(gnc::LawId::kAdaptive), ref(fsw::ReferenceId::kFuelOptimal)}},
-      {"select-law", {"so3", "fuel_optimal"}, false, M::kTrack, O::kSetLaw,
+      {"select-law",
+       {"so3", "fuel_optimal"},
+       false,
+       M::kTrack,
+       O::kSetLaw,
        {law(gnc::LawId::kSo3), ref(fsw::ReferenceId::kFuelOptimal)}},
-      {"select-law", {"dpd", "dpd-ref"}, false, M::kIdle, O::kSetLaw,
+      {"select-law",
+       {"dpd", "dpd-ref"},
+       false,
+       M::kIdle,
+       O::kSetLaw,
        {law(gnc::LawId::kDpd), ref(fsw::ReferenceId::kDpdRef)}},
-      {"select-law", {"feedforward"}, false, M::kTrack, O::kSetLaw, {law(gnc::LawId::kFeedforward)}},
-      {"set-gain", {"ntcl.K", "1e4", "2e4", "3e4"}, false, M::kHold, O::kParamLoad, {0, 1e4, 2e4, 3e4}},
-      {"set-gain", {"so3.Lambda", "1", "2", "3", "0.1", "0.2", "0.3"}, false, M::kTrack,
-       O::kParamLoad, {16, 1, 2, 3, 0.1, 0.2, 0.3}},
-      {"set-gain", {"guidance.omega_switch", "0.002"}, false, M::kDetumble, O::kParamLoad, {19, 0.002}},
+      {"select-law",
+       {"feedforward"},
+       false,
+       M::kTrack,
+       O::kSetLaw,
+       {law(gnc::LawId::kFeedforward)}},
+      {"set-gain",
+       {"ntcl.K", "1e4", "2e4", "3e4"},
+       false,
+       M::kHold,
+       O::kParamLoad,
+       {0, 1e4, 2e4, 3e4}},
+      {"set-gain",
+       {"so3.Lambda", "1", "2", "3", "0.1", "0.2", "0.3"},
+       false,
+       M::kTrack,
+       O::kParamLoad,
+       {16, 1, 2, 3, 0.1, 0.2, 0.3}},
+      {"set-gain",
+       {"guidance.omega_switch", "0.002"},
+       false,
+       M::kDetumble,
+       O::kParamLoad,
+       {19, 0.002}},
       {"set-gain", {"24", "0"}, false, M::kIdle, O::kParamLoad, {24, 0}},
       {"activate-gains", {}, false, M::kHold, O::kParamActivate, {}},
       {"discard-gains", {}, false, M::kHold, O::kParamDiscard, {}},
@@ -114,7 +152,8 @@ TEST(GroundCommands, EveryListedCommandIsCoveredByTheFlightCheckTest) {
   std::set<std::string> covered;
   for (const Case& c : cases()) covered.insert(c.name);
   for (const CommandHelp& h : command_help()) {
-    if (std::string(h.name) == "upload-trajectory") continue;  // a procedure (its load: load-trajectory)
+    if (std::string(h.name) == "upload-trajectory")
+      continue;  // a procedure (its load: load-trajectory)
     EXPECT_TRUE(covered.count(h.name)) << h.name;
   }
 }
@@ -140,9 +179,9 @@ TEST(GroundCommands, SetGainValuesAreWhatTheFlightParameterWriterExpects) {
 
   const Encoded s = encode_command("set-gain", {"dpd.k_p", "2.5"});
   ASSERT_TRUE(s.ok);
-  ASSERT_TRUE(fsw::write_param(p, static_cast<std::int32_t>(s.cmd.args[0]), &s.cmd.args[1],
-                               s.cmd.nargs - 1)
-                  .ok());
+  ASSERT_TRUE(
+      fsw::write_param(p, static_cast<std::int32_t>(s.cmd.args[0]), &s.cmd.args[1], s.cmd.nargs - 1)
+          .ok());
   EXPECT_EQ(p.dpd.k_p, 2.5);
 }
 

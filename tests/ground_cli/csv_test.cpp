@@ -1,5 +1,5 @@
-// log2csv: an LCM log written here with lcm::LogFile (telemetry, truth, an event, and garbage on the
-// telemetry channel) converts to CSV whose header is the .lcm file's fields (parsed here,
+// log2csv: an LCM log written here with lcm::LogFile (telemetry, truth, an event, and garbage on
+// the telemetry channel) converts to CSV whose header is the .lcm file's fields (parsed here,
 // independently of the converter) and whose values are the messages'; the garbage is counted.
 #include <gtest/gtest.h>
 
@@ -20,7 +20,8 @@ namespace {
 
 namespace wire = hal::wire;
 
-// Field names of an .lcm struct in file order, arrays expanded (name_i, name_i_j); constants skipped.
+// Field names of an .lcm struct in file order, arrays expanded (name_i, name_i_j); constants
+// skipped.
 std::vector<std::string> lcm_fields(const std::string& type) {
   std::ifstream in(std::string(ROCKSTEADY_LCM_DIR) + "/" + type + ".lcm");
   EXPECT_TRUE(in.good()) << type;
@@ -41,7 +42,8 @@ std::vector<std::string> lcm_fields(const std::string& type) {
     if (!std::regex_search(line, m, field)) continue;
     std::vector<int> dims;
     const std::string d = m[2];
-    for (auto it = std::sregex_iterator(d.begin(), d.end(), dim); it != std::sregex_iterator(); ++it) {
+    for (auto it = std::sregex_iterator(d.begin(), d.end(), dim); it != std::sregex_iterator();
+         ++it) {
       dims.push_back(std::stoi((*it)[1]));
     }
     const std::string name = m[1];
@@ -101,7 +103,8 @@ std::size_t column(const std::vector<std::string>& header, const std::string& na
   return 0;
 }
 
-template <class T> std::vector<unsigned char> bytes(const T& m) {
+template <class T>
+std::vector<unsigned char> bytes(const T& m) {
   std::vector<unsigned char> b(static_cast<std::size_t>(m.getEncodedSize()));
   EXPECT_EQ(wire::encode(m, b.data(), static_cast<int>(b.size())), static_cast<int>(b.size()));
   return b;
@@ -243,17 +246,22 @@ TEST_F(Log2Csv, EventTextWithCommasAndQuotesSurvives) {
   const auto rows = parse_csv(out.str());
   ASSERT_EQ(rows.size(), 2u);
   ASSERT_EQ(rows[1].size(), rows[0].size());
-  EXPECT_EQ(rows[1][column(rows[0], "text")], "SET_TARGET (2) seq 5 rejected: \"not allowed\", in TRACK");
+  EXPECT_EQ(rows[1][column(rows[0], "text")],
+            "SET_TARGET (2) seq 5 rejected: \"not allowed\", in TRACK");
   EXPECT_EQ(rows[1][column(rows[0], "id")], "101");
   EXPECT_EQ(rows[1][column(rows[0], "severity")], "2");
 }
 
 TEST(CsvHeaders, EverySupportedChannelHasItsLcmFields) {
   const std::vector<std::pair<std::string, std::string>> channel_types{
-      {channels::kGncTelemetry, "gnc_telemetry_t"}, {channels::kPlantTruth, "plant_truth_t"},
-      {channels::kSensors, "sensor_frame_t"},       {channels::kThrusterCmd, "thruster_cmd_t"},
-      {channels::kEvents, "event_t"},               {channels::kCmdAck, "cmd_ack_t"},
-      {channels::kGroundCmd, "ground_cmd_t"},       {channels::kTrajUplink, "trajectory_chunk_t"},
+      {channels::kGncTelemetry, "gnc_telemetry_t"},
+      {channels::kPlantTruth, "plant_truth_t"},
+      {channels::kSensors, "sensor_frame_t"},
+      {channels::kThrusterCmd, "thruster_cmd_t"},
+      {channels::kEvents, "event_t"},
+      {channels::kCmdAck, "cmd_ack_t"},
+      {channels::kGroundCmd, "ground_cmd_t"},
+      {channels::kTrajUplink, "trajectory_chunk_t"},
   };
   for (const auto& [channel, type] : channel_types) {
     EXPECT_TRUE(csv_supported(channel)) << channel;
@@ -267,7 +275,8 @@ TEST(CsvHeaders, EverySupportedChannelHasItsLcmFields) {
 
 TEST(CsvHeaders, UnsupportedChannelOrMissingLogIsAnError) {
   std::ostringstream out;
-  EXPECT_THROW(log2csv("/nonexistent/run.lcmlog", channels::kGncTelemetry, out), std::runtime_error);
+  EXPECT_THROW(log2csv("/nonexistent/run.lcmlog", channels::kGncTelemetry, out),
+               std::runtime_error);
   test::TempDir dir;
   { lcm::LogFile(dir.file("empty.lcmlog"), "w"); }
   EXPECT_THROW(log2csv(dir.file("empty.lcmlog"), "RS_NOT_A_CHANNEL", out), std::runtime_error);
@@ -280,22 +289,24 @@ TEST(CsvLine, QuotesOnlyWhereNeeded) {
 
 TEST_F(Log2Csv, CommandLineWritesTheFileAndReportsRejections) {
   const std::string csv = dir_.file("tlm.csv");
-  const test::Run r = test::run(std::string(ROCKSTEADY_GROUND_EXE) + " log2csv " + test::quote(log_) +
-                                    " --channel RS_GNC_TLM -o " + test::quote(csv),
-                                dir_);
+  const test::Run r =
+      test::run(std::string(ROCKSTEADY_GROUND_EXE) + " log2csv " + test::quote(log_) +
+                    " --channel RS_GNC_TLM -o " + test::quote(csv),
+                dir_);
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("3 rows; 3 rejected: 1 too short, 2 bad fingerprint"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 rows; 3 rejected: 1 too short, 2 bad fingerprint"), std::string::npos)
+      << r.err;
   EXPECT_EQ(parse_csv(test::read_file(csv)).size(), 4u);
 
-  const test::Run strict = test::run(std::string(ROCKSTEADY_GROUND_EXE) + " log2csv " +
-                                         test::quote(log_) + " --channel RS_GNC_TLM --strict -o " +
-                                         test::quote(csv),
-                                     dir_);
+  const test::Run strict =
+      test::run(std::string(ROCKSTEADY_GROUND_EXE) + " log2csv " + test::quote(log_) +
+                    " --channel RS_GNC_TLM --strict -o " + test::quote(csv),
+                dir_);
   EXPECT_EQ(strict.exit_code, 1);
 
-  const test::Run bad = test::run(std::string(ROCKSTEADY_GROUND_EXE) + " log2csv " + test::quote(log_) +
-                                      " --channel RS_NOPE",
-                                  dir_);
+  const test::Run bad = test::run(
+      std::string(ROCKSTEADY_GROUND_EXE) + " log2csv " + test::quote(log_) + " --channel RS_NOPE",
+      dir_);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("not supported"), std::string::npos) << bad.err;
 }

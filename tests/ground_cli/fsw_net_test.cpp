@@ -28,16 +28,16 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
   planner::write_trajectory_file(file, problem, plan);
 
   const std::string url = test::lcm_url(17620);
-  const std::string g = test::quote(ROCKSTEADY_GROUND_EXE) + " --lcm-url " + test::quote(url) +
-                        " ";
+  const std::string g = test::quote(ROCKSTEADY_GROUND_EXE) + " --lcm-url " + test::quote(url) + " ";
   const std::string state = " --state-dir " + test::quote(dir.file("state"));
   std::string s;
   s += test::quote(ROCKSTEADY_FSW_EXE) + " --config-dir " + test::quote(ROCKSTEADY_CONFIG_DIR) +
-       " --case 1 --clock realtime --exit-after 20 --lcm-url " + test::quote(url) +
-       " >" + test::quote(dir.file("fsw.txt")) + " 2>&1 &\n";
+       " --case 1 --clock realtime --exit-after 20 --lcm-url " + test::quote(url) + " >" +
+       test::quote(dir.file("fsw.txt")) + " 2>&1 &\n";
   s += "fpid=$!\n";
   // Link check: noops until the flight answers (it may not be subscribed yet).
-  s += "i=0; until " + g + "send noop --timeout 0.25" + state + " >/dev/null 2>&1; do\n"
+  s += "i=0; until " + g + "send noop --timeout 0.25" + state +
+       " >/dev/null 2>&1; do\n"
        "  i=$((i+1)); [ $i -ge 40 ] && { echo LINK DOWN; kill $fpid; exit 3; }\n"
        "done\n";
   s += "echo LINK UP\n";
@@ -51,20 +51,25 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
   s += "kill $fpid; wait $fpid\n";
   const test::Run r = test::run_in_namespace(s, dir, 90);
   const std::string& o = r.out;
-  ASSERT_NE(o.find("LINK UP"), std::string::npos) << o << r.err << test::read_file(dir.file("fsw.txt"));
+  // Everything the three parties said, for a failure message.
+  const std::string said = "--- stdout\n" + o + "--- stderr\n" + r.err + "--- rocksteady-fsw\n" +
+                           test::read_file(dir.file("fsw.txt"));
+  ASSERT_NE(o.find("LINK UP"), std::string::npos) << said;
   EXPECT_NE(o.find("REJECTED: not allowed in this mode (no valid state estimate)\nrc=1\n"),
             std::string::npos)
-      << o;
+      << said;
   // set-gain, activate-gains, then the upload's LOAD_TRAJECTORY: accepted, exit 0.
-  EXPECT_NE(o.find("ACCEPTED\nrc=0\nACCEPTED\nrc=0\nACCEPTED\nrc=0\n"), std::string::npos) << o << r.err;
-  EXPECT_NE(r.err.find("complete on board (4 chunks)"), std::string::npos) << r.err;
+  EXPECT_NE(o.find("ACCEPTED\nrc=0\nACCEPTED\nrc=0\nACCEPTED\nrc=0\n"), std::string::npos) << said;
+  EXPECT_NE(r.err.find("complete on board (4 chunks)"), std::string::npos) << said;
   std::size_t tlm = 0;
-  for (std::size_t at = o.find("TLM t="); at != std::string::npos; at = o.find("TLM t=", at + 1)) ++tlm;
-  EXPECT_EQ(tlm, 2u) << o;
-  // The flight's counters as the monitor shows them: the gain load and activation, the load, and at
-  // least one link-check noop accepted; the HOLD request rejected.
-  EXPECT_NE(o.find("cmd_rej=1"), std::string::npos) << o;
-  EXPECT_NE(o.find("rx_malformed=0"), std::string::npos) << o;
+  for (std::size_t at = o.find("TLM t="); at != std::string::npos; at = o.find("TLM t=", at + 1)) {
+    ++tlm;
+  }
+  EXPECT_EQ(tlm, 2u) << said;
+  // The flight's counters as the monitor shows them: only the HOLD request was rejected, and the
+  // flight decoded everything the console sent.
+  EXPECT_NE(o.find("cmd_rej=1 "), std::string::npos) << said;
+  EXPECT_NE(o.find("rx_malformed=0 rx_bad_kind=0 rx_out_of_range=0"), std::string::npos) << said;
 }
 
 }  // namespace

@@ -89,7 +89,8 @@ TEST(MonitorFormat, StatusBlockShowsEverySection) {
   expect_has(s, "gnc  cycles 12345  last 1.500 ms  max 2.250 ms  slips 2  missed 1");
   expect_has(s, "hk   cycles 1234");
   EXPECT_EQ(s.find("cycles 999"), std::string::npos) << s;
-  expect_has(s, "accepted 17  rejected 4  last seq 21 SET_TARGET  last reject not allowed in this mode");
+  expect_has(
+      s, "accepted 17  rejected 4  last seq 21 SET_TARGET  last reject not allowed in this mode");
   expect_has(s, "fsw: ok 5000  malformed 6  bad kind 7  out of range 8");
   expect_has(s, "monitor: ok 100  rejected 3");
   expect_has(s, "uplink id 33  5/32 chunks");
@@ -157,11 +158,13 @@ TEST(MonitorFormat, AckVerdictNamesReasonDetailAndText) {
   a.reason = rocksteady::cmd_ack_t::REASON_NOT_ALLOWED_IN_MODE;
   a.detail = static_cast<std::int32_t>(gnc::TransitionCheck::kNoTrajectory);
   a.text = "no valid trajectory loaded";
-  EXPECT_EQ(format_ack_verdict(a), "REJECTED: not allowed in this mode (no valid trajectory loaded)");
-  a.text = "opcode not allowed in this mode";
   EXPECT_EQ(format_ack_verdict(a),
-            "REJECTED: not allowed in this mode (no valid trajectory loaded): opcode not allowed in "
-            "this mode");
+            "REJECTED: not allowed in this mode (no valid trajectory loaded)");
+  a.text = "opcode not allowed in this mode";
+  EXPECT_EQ(
+      format_ack_verdict(a),
+      "REJECTED: not allowed in this mode (no valid trajectory loaded): opcode not allowed in "
+      "this mode");
   a.reason = rocksteady::cmd_ack_t::REASON_UPLOAD_INCOMPLETE;
   a.detail = 3;
   a.text = "";

@@ -18,7 +18,9 @@ namespace {
 const std::string kGround = ROCKSTEADY_GROUND_EXE;
 const std::string kResponder = ROCKSTEADY_RESPONDER_EXE;
 
-std::string url(int port) { return test::lcm_url(port); }
+std::string url(int port) {
+  return test::lcm_url(port);
+}
 
 // `script` runs in a fresh network namespace; `responder_args` (if any) start the responder first,
 // the script waits until it is subscribed, and `stop_responder` ends it after the script. The
@@ -30,7 +32,8 @@ test::Run in_namespace(const test::TempDir& dir, const std::string& responder_ar
     const std::string ready = dir.file("responder.ready");
     s += test::quote(kResponder) + " --ready " + test::quote(ready) + " " + responder_args + " &\n";
     s += "rpid=$!\n";
-    s += "i=0; while [ ! -e " + test::quote(ready) + " ] && [ $i -lt 400 ]; do sleep 0.025; i=$((i+1)); done\n";
+    s += "i=0; while [ ! -e " + test::quote(ready) +
+         " ] && [ $i -lt 400 ]; do sleep 0.025; i=$((i+1)); done\n";
   }
   s += "( " + script + " )\nrc=$?\n";
   if (stop_responder) s += "kill $rpid\n";
@@ -54,9 +57,9 @@ TEST(GroundCliNet, SendNoopPrintsAcceptedAndExitsZero) {
   test::TempDir dir;
   const int port = 17601;
   const std::string state = dir.file("state");
-  const test::Run r = in_namespace(
-      dir, "--url " + test::quote(url(port)) + " --commands 1 --seconds 20",
-      ground(port, "send noop --timeout 10 --state-dir " + test::quote(state)));
+  const test::Run r =
+      in_namespace(dir, "--url " + test::quote(url(port)) + " --commands 1 --seconds 20",
+                   ground(port, "send noop --timeout 10 --state-dir " + test::quote(state)));
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_EQ(r.out, "ACCEPTED\n") << r.err;
   EXPECT_NE(r.err.find("responder=0"), std::string::npos) << r.err;
@@ -73,7 +76,8 @@ TEST(GroundCliNet, SequenceNumbersKeepIncreasingAndAStaleOneIsRejected) {
       dir, "--url " + test::quote(url(port)) + " --commands 3 --seconds 20",
       ground(port, send) + " && " + ground(port, send) + " && " + ground(port, send + " --seq 2"));
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
-  EXPECT_EQ(r.out, "ACCEPTED\nACCEPTED\nREJECTED: stale or repeated sequence number: stale sequence\n")
+  EXPECT_EQ(r.out,
+            "ACCEPTED\nACCEPTED\nREJECTED: stale or repeated sequence number: stale sequence\n")
       << r.err;
   EXPECT_NE(r.err.find("hint:"), std::string::npos) << r.err;
 }
@@ -106,12 +110,13 @@ TEST(GroundCliNet, BadOperatorInputExitsTwoWithoutSending) {
 TEST(GroundCliNet, MonitorPrintsOneLinePerTelemetryMessage) {
   test::TempDir dir;
   const int port = 17606;
-  const test::Run r = in_namespace(
-      dir, "--url " + test::quote(url(port)) + " --telemetry --commands 0 --seconds 6",
-      ground(port, "monitor --count 3 --seconds 5 --plain"), true);
+  const test::Run r =
+      in_namespace(dir, "--url " + test::quote(url(port)) + " --telemetry --commands 0 --seconds 6",
+                   ground(port, "monitor --count 3 --seconds 5 --plain"), true);
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   int lines = 0;
-  for (std::size_t at = r.out.find("TLM t="); at != std::string::npos; at = r.out.find("TLM t=", at + 1)) {
+  for (std::size_t at = r.out.find("TLM t="); at != std::string::npos;
+       at = r.out.find("TLM t=", at + 1)) {
     ++lines;
   }
   EXPECT_EQ(lines, 3) << r.out;

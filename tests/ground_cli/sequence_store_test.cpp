@@ -43,7 +43,8 @@ TEST(SequenceStore, ConcurrentSendersNeverShareANumber) {
   std::vector<std::thread> threads;
   for (int t = 0; t < kThreads; ++t) {
     threads.emplace_back([&, t] {
-      for (int i = 0; i < kEach; ++i) got[static_cast<std::size_t>(t)].push_back(SequenceStore(path).next());
+      for (int i = 0; i < kEach; ++i)
+        got[static_cast<std::size_t>(t)].push_back(SequenceStore(path).next());
     });
   }
   for (std::thread& th : threads) th.join();

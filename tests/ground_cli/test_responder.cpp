@@ -1,8 +1,8 @@
 // A stand-in for the flight side's bus layer, for the networked ground CLI tests: answers every
 // ground_cmd_t on RS_GROUND_CMD with a cmd_ack_t judged by the flight's own checks
 // (fsw::check_command in a fixed mode, fsw::SequenceTracker), reassembles trajectory uplinks with
-// fsw::TrajectoryUplink (uplink_complete event when the last chunk arrives; LOAD_TRAJECTORY accepted
-// only if the table validates, CRC included) and can publish telemetry at 20 Hz.
+// fsw::TrajectoryUplink (uplink_complete event when the last chunk arrives; LOAD_TRAJECTORY
+// accepted only if the table validates, CRC included) and can publish telemetry at 20 Hz.
 //
 //   ground_cli_test_responder --url URL --ready FILE [--mode IDLE..SAFE] [--commands N]
 //                             [--telemetry] [--seconds S]
@@ -74,8 +74,8 @@ struct Responder {
       } else {
         const rocksteady::gnc::TrajectoryError e = uplink->finalize(1e9);
         if (e != rocksteady::gnc::TrajectoryError::kOk) {
-          c = fsw::CommandCheck{fsw::RejectReason::kTrajectoryRejected, static_cast<std::int32_t>(e),
-                                rocksteady::gnc::to_string(e)};
+          c = fsw::CommandCheck{fsw::RejectReason::kTrajectoryRejected,
+                                static_cast<std::int32_t>(e), rocksteady::gnc::to_string(e)};
         }
       }
     }
@@ -108,7 +108,8 @@ struct Responder {
       auto& s = c.samples[static_cast<std::size_t>(i)];
       s.t = m.t[i];
       s.omega_d = rocksteady::gnc::Vec3(m.omega_d[i][0], m.omega_d[i][1], m.omega_d[i][2]);
-      s.omega_d_dot = rocksteady::gnc::Vec3(m.omega_d_dot[i][0], m.omega_d_dot[i][1], m.omega_d_dot[i][2]);
+      s.omega_d_dot =
+          rocksteady::gnc::Vec3(m.omega_d_dot[i][0], m.omega_d_dot[i][1], m.omega_d_dot[i][2]);
     }
     const fsw::ChunkResult r = uplink->receive(c);
     if (r.status != fsw::ChunkStatus::kStored) {
@@ -164,14 +165,15 @@ int main(int argc, char** argv) {
 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(seconds));
+  const auto deadline =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   auto next_tlm = start;
   std::int64_t tick = 0;
   while (max_commands <= 0 || r.commands < max_commands) {
     const auto now = Clock::now();
     if (now >= deadline) {
-      std::fprintf(stderr, "responder: timeout after %ld commands, %ld chunks\n", r.commands, r.chunks);
+      std::fprintf(stderr, "responder: timeout after %ld commands, %ld chunks\n", r.commands,
+                   r.chunks);
       return 3;
     }
     if (telemetry && now >= next_tlm) {

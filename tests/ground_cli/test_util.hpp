@@ -77,7 +77,8 @@ inline std::string quote(const std::string& s) {
 // group (ENVIRONMENT.md), bounded by `timeout`. Exit 90: the namespace could not be set up.
 inline Run run_in_namespace(const std::string& script, const TempDir& dir, int timeout_s = 60) {
   const std::string s =
-      "ip link set lo up && ip link set lo multicast on && ip route add 239.255.76.67 dev lo || exit 90\n" +
+      "ip link set lo up && ip link set lo multicast on && ip route add 239.255.76.67 dev lo || "
+      "exit 90\n" +
       script;
   return run("timeout " + std::to_string(timeout_s) + " unshare -rn sh -c " + quote(s), dir);
 }

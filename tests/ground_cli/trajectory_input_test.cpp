@@ -49,9 +49,11 @@ TEST_F(TrajectoryInput, FileModelIsTheModelThePlanWasMadeFor) {
 }
 
 TEST_F(TrajectoryInput, PlanIsRefusedAgainstAnotherModelAndAcceptedAgainstItsOwn) {
-  const planner::LoadResult nominal = load_trajectory(path_, planner::study_case_model(200.0, 0.0, 0.0));
+  const planner::LoadResult nominal =
+      load_trajectory(path_, planner::study_case_model(200.0, 0.0, 0.0));
   EXPECT_FALSE(nominal.ok);
-  EXPECT_NE(nominal.error.find("planned for a different model"), std::string::npos) << nominal.error;
+  EXPECT_NE(nominal.error.find("planned for a different model"), std::string::npos)
+      << nominal.error;
 
   const planner::LoadResult own = load_trajectory_own_model(path_);
   ASSERT_TRUE(own.ok) << own.error;
