@@ -14,7 +14,9 @@ packages=(
   iproute2 util-linux
   clang libclang-rt-14-dev
 )
+cross=0
 if [[ "${1:-}" == "--cross" ]]; then
+  cross=1
   # aarch64 target libraries are Debian multiarch (:arm64, needs `dpkg --add-architecture arm64`,
   # which scripts/cross.sh does); LCM is not multi-arch and is unpacked into a private sysroot.
   packages+=(g++-aarch64-linux-gnu qemu-user gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
@@ -36,6 +38,10 @@ fi
 
 SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+# The arm64 multiarch target libraries need the architecture enabled first.
+if ((cross)) && ! dpkg --print-foreign-architectures | grep -qx arm64; then
+  $SUDO dpkg --add-architecture arm64
+fi
 echo "setup: installing ${missing[*]}"
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

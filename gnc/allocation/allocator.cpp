@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/Eigenvalues>
 
 namespace rocksteady::gnc {
@@ -36,8 +36,9 @@ bool Allocator::configure(const Mat38& b_hat, double u_max, AllocatorKind kind) 
   b_hat_ = b_hat;
   u_max_ = u_max;
   const Mat3 bbt = b_hat * b_hat.transpose();
-  // Eq. (53): B' (B B')^-1, through a Cholesky solve of the SPD 3x3 rather than an explicit inverse.
-  pinv_ = bbt.llt().solve(b_hat).transpose();
+  // Eq. (53): B' (B B')^-1. The 3x3 inverse is closed-form (fixed size, no solver workspace that
+  // could reach the heap); B B' is SPD and well conditioned (validated rank).
+  pinv_ = b_hat.transpose() * bbt.inverse();
   return true;
 }
 
