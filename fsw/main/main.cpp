@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/prctl.h>
+
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
 
@@ -195,6 +197,8 @@ int main(int argc, char** argv) {
     opt.jitter_ns = &jitter_ns;
   }
 
+  // Real time: wake up at the deadline, not up to the default 50 us timer slack later.
+  if (opt.clock == bus::ClockMode::kRealtime) prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   int rc = 0;
