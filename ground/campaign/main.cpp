@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
   std::string strategy_arg = "ntcl+dpd_ref";
   bool no_plots = false, no_series = false, quiet = false, progress = false;
   std::string flight_arg = "app";
+  std::string plan_cache = "out/plans";
 
   CLI::App* run = app.add_subcommand("run", "one case with one strategy");
   run->add_option("--case", case_arg, "case number or case file")->capture_default_str();
@@ -127,6 +128,9 @@ int main(int argc, char** argv) {
     sub->add_option("--flight", flight_arg,
                     "app: the flight application through the in-process HAL; core: gnc::Gnc alone")
         ->check(CLI::IsMember({"app", "core"}))
+        ->capture_default_str();
+    sub->add_option("--plan-cache", plan_cache,
+                    "folder of verified trajectory files reused per model and case ('' to replan)")
         ->capture_default_str();
   }
   CLI11_PARSE(app, argc, argv);
@@ -155,7 +159,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
 
-  const auto source = campaign::make_default_trajectory_source();
+  const auto source = campaign::make_default_trajectory_source(plan_cache);
   campaign::CampaignReport rep;
   try {
     rep = campaign::run_campaign(spec, *source, std::cerr);

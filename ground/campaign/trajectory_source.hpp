@@ -40,8 +40,9 @@ class NoTrajectorySource final : public TrajectorySource {
   std::string name() const override { return "none"; }
 };
 
-// The planner (ground/planner) when this build has it, else NoTrajectorySource.
-std::unique_ptr<TrajectorySource> make_default_trajectory_source();
+// The planner (ground/planner) when this build has it, else NoTrajectorySource. With a cache folder,
+// each (model, case) is planned once and the verified trajectory file is reused.
+std::unique_ptr<TrajectorySource> make_default_trajectory_source(const std::string& cache_dir = "");
 bool have_planner();
 
 }  // namespace rocksteady::campaign

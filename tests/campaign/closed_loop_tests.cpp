@@ -208,3 +208,47 @@ TEST(ClosedLoop, FlightApplicationThroughHalMatchesTheCoreAlone) {
 
 }  // namespace
 }  // namespace rocksteady::campaign
+
+#include "ground/campaign/trajectory_source.hpp"
+
+namespace rocksteady::campaign {
+namespace {
+
+// Issue: the fuel-optimal reference end to end. Case 1 is planned (Eq. 44) for the flight software's
+// model, uplinked in chunks to the flight application and flown in TRACK (Eqs. 45-48): it despins
+// and reaches the attitude goal, and the plan's fuel is below what plain D+PD burns on the same case.
+TEST(ClosedLoop, PlannedCase1TrackDespinsReachesTheGoalAndPlansLessFuelThanDpd) {
+  ASSERT_TRUE(have_planner()) << "this build has no ground/planner";
+  const config::RunSetup s = config::load_run(
+      std::string(ROCKSTEADY_SOURCE_DIR) + "/configs/mission.yaml",
+      std::string(ROCKSTEADY_SOURCE_DIR) + "/configs/gnc.yaml",
+      std::string(ROCKSTEADY_SOURCE_DIR) + "/configs/cases/case1.yaml");
+  auto source = make_default_trajectory_source();
+  PlanRequest req;
+  req.setup = &s;
+  req.model = s.flight;
+  req.omega_init = s.truth.omega0;  // case 1: perfect gyro, so this is the first measurement
+  const PlanOutcome plan = source->plan(req);
+  ASSERT_NE(plan.table, nullptr) << plan.note;
+  const double planned_fuel = std::stod(plan.note.substr(plan.note.find("planned fuel ") + 13));
+
+  RunOptions opt;
+  FswFlightSide app;
+  const RunResult track =
+      run_closed_loop(s, *parse_strategy("ntcl+fuel_optimal"), app, plan.table.get(), opt);
+  ASSERT_EQ(track.status, RunStatus::kOk) << track.note;
+  EXPECT_EQ(track.final_mode, "TRACK");
+  ASSERT_TRUE(track.t_omega_conv_s.has_value());
+  ASSERT_TRUE(track.t_q_conv_s.has_value());
+  EXPECT_LE(track.final_rate_rad_s, 1e-4);  // SPEC §5 goals on the true state
+  EXPECT_LE(track.final_q_error, 1e-2);
+  EXPECT_LE(track.max_rate_rad_s, s.flight.guidance.eps_trans);
+
+  GncFlightSide core;
+  const RunResult dpd = run_closed_loop(s, *parse_strategy("dpd"), core, nullptr, opt);
+  ASSERT_EQ(dpd.status, RunStatus::kOk) << dpd.note;
+  EXPECT_LT(planned_fuel, dpd.total_fuel_kg);
+}
+
+}  // namespace
+}  // namespace rocksteady::campaign
