@@ -3,9 +3,9 @@
 // kinds, saturated and not, and a full Gnc tick with the L1 allocator.
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "heap_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 #include <random>
 
 #include "gnc/allocation/allocator.hpp"
@@ -13,77 +13,18 @@
 #include "gnc/model/mass_properties.hpp"
 #include "gnc/model/rcs.hpp"
 
-namespace {
-std::atomic<bool> g_armed{false};
-std::atomic<long> g_allocations{0};
-void note_allocation() {
-  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-}
-}  // namespace
-
-void* operator new(std::size_t n) {
-  note_allocation();
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  return operator new(n);
-}
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  note_allocation();
-  return std::malloc(n == 0 ? 1 : n);
-}
-void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept {
-  return operator new(n, t);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-
-#if !defined(ROCKSTEADY_SANITIZE) && defined(__GLIBC__)
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
-extern "C" void* malloc(std::size_t n) {
-  note_allocation();
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t m) {
-  note_allocation();
-  return __libc_calloc(n, m);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  note_allocation();
-  return __libc_realloc(p, n);
-}
-#endif
 
 namespace rocksteady::gnc {
 namespace {
 
-struct Armed {
-  Armed() {
-    g_allocations = 0;
-    g_armed = true;
-  }
-  ~Armed() { g_armed = false; }
-};
+using Armed = rocksteady::test::HeapArmed;
 
 TEST(L1ZeroAllocation, CountingHookSeesAnAllocation) {
   long counted = 0;
   {
     Armed armed;
     int* volatile p = new int(3);
-    counted = g_allocations.load();
+    counted = rocksteady::test::heap_allocations();
     delete p;
   }
   EXPECT_GE(counted, 1);
@@ -115,7 +56,7 @@ TEST(L1ZeroAllocation, AllocateNeverTouchesTheHeap) {
       pinv.allocate(r, u, st);
       sink += u.sum();
     }
-    counted = g_allocations.load();
+    counted = rocksteady::test::heap_allocations();
   }
   EXPECT_EQ(counted, 0);
   EXPECT_GT(saturated, 50);  // both paths of the rescale were exercised
@@ -145,7 +86,7 @@ TEST(L1ZeroAllocation, GncTickWithL1AllocatorNeverTouchesTheHeap) {
       cmd = GncCommands{};
       enabled += out.command.enabled ? 1 : 0;
     }
-    counted = g_allocations.load();
+    counted = rocksteady::test::heap_allocations();
   }
   EXPECT_EQ(counted, 0);
   EXPECT_EQ(enabled, 300);

@@ -3,77 +3,17 @@
 // frames, command submission, trajectory chunks, table activation, events and their draining.
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "heap_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 
 #include "fsw_harness.hpp"
 
-namespace {
-std::atomic<bool> g_armed{false};
-std::atomic<long> g_allocations{0};
-void note_allocation() {
-  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-}
-}  // namespace
-
-void* operator new(std::size_t n) {
-  note_allocation();
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  return operator new(n);
-}
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  note_allocation();
-  return std::malloc(n == 0 ? 1 : n);
-}
-void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept {
-  return operator new(n, t);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-
-#if !defined(ROCKSTEADY_SANITIZE) && defined(__GLIBC__)
-// C allocations too (vsnprintf of the event text must not allocate).
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
-extern "C" void* malloc(std::size_t n) {
-  note_allocation();
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t m) {
-  note_allocation();
-  return __libc_calloc(n, m);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  note_allocation();
-  return __libc_realloc(p, n);
-}
-#endif
 
 namespace rocksteady::fsw {
 namespace {
 
-struct Armed {
-  Armed() {
-    g_allocations = 0;
-    g_armed = true;
-  }
-  ~Armed() { g_armed = false; }
-};
+using Armed = rocksteady::test::HeapArmed;
 
 // The instrument itself: an allocation while armed is seen.
 TEST(FlightAppAllocation, CounterSeesAnAllocationWhileArmed) {
@@ -83,7 +23,7 @@ TEST(FlightAppAllocation, CounterSeesAnAllocationWhileArmed) {
     auto p = std::make_unique<std::vector<int>>(100, 1);
     volatile int sink = (*p)[99];
     (void)sink;
-    n = g_allocations.load();
+    n = rocksteady::test::heap_allocations();
   }
   EXPECT_GE(n, 2);
 }
@@ -126,7 +66,7 @@ TEST(FlightAppAllocation, TheFlightLoopAllocatesNothingAfterInit) {
       }
       f.clock.advance(50000000);
     }
-    allocations = g_allocations.load();
+    allocations = rocksteady::test::heap_allocations();
   }
   EXPECT_EQ(allocations, 0);
   // The loop did what it was asked: detumbled into HOLD, activated the table, loaded the plan.

@@ -3,69 +3,22 @@
 // is on as well (this executable compiles the gnc sources with it and with assertions enabled).
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "heap_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 
 #include "gnc/gnc.hpp"
 #include "gnc_harness.hpp"
 
-namespace {
-std::atomic<bool> g_armed{false};
-std::atomic<long> g_allocations{0};
-void note_allocation() {
-  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-}
-}  // namespace
-
-void* operator new(std::size_t n) {
-  note_allocation();
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  note_allocation();
-  return std::malloc(n == 0 ? 1 : n);
-}
-void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept { return operator new(n, t); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-
-#if !defined(ROCKSTEADY_SANITIZE) && defined(__GLIBC__)
-// Also catch C allocations (glibc lets a program interpose malloc and reach the real one).
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
-extern "C" void* malloc(std::size_t n) {
-  note_allocation();
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t m) {
-  note_allocation();
-  return __libc_calloc(n, m);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  note_allocation();
-  return __libc_realloc(p, n);
-}
-#endif
 
 namespace rocksteady::gnc {
 namespace {
 
+// Counts heap use and makes Eigen assert on any allocation of its own.
 struct Armed {
-  Armed() {
-    g_allocations = 0;
-    Eigen::internal::set_is_malloc_allowed(false);
-    g_armed = true;
-  }
-  ~Armed() {
-    g_armed = false;
-    Eigen::internal::set_is_malloc_allowed(true);
-  }
+  Armed() { Eigen::internal::set_is_malloc_allowed(false); }
+  ~Armed() { Eigen::internal::set_is_malloc_allowed(true); }
+  rocksteady::test::HeapArmed heap;
 };
 
 TEST(ZeroAllocation, CountingHookSeesAnAllocation) {
@@ -75,7 +28,7 @@ TEST(ZeroAllocation, CountingHookSeesAnAllocation) {
     Armed armed;
     Eigen::internal::set_is_malloc_allowed(true);
     int* volatile p = new int(3);
-    counted = g_allocations.load();
+    counted = rocksteady::test::heap_allocations();
     delete p;
   }
   EXPECT_GE(counted, 1);
@@ -116,7 +69,7 @@ TEST(ZeroAllocation, NoHeapInAnyTickOfAnyLawAndMode) {
           ++ticks;
         }
       }
-      EXPECT_EQ(g_allocations.load(), 0) << to_string(law) << " over " << ticks << " ticks";
+      EXPECT_EQ(rocksteady::test::heap_allocations(), 0) << to_string(law) << " over " << ticks << " ticks";
       EXPECT_EQ(loop->gnc.mode(), Mode::kSafe);
       delete tab;
       delete loop;
