@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Private aarch64 sysroot for the target libraries Debian does not ship multi-arch (LCM).
-# `apt-get install liblcm-dev:arm64` would replace the host's LCM (lcm-gen, lcm.jar), so the arm64
+# Private aarch64 sysroot for the target libraries Debian does not ship multi-arch (LCM, yaml-cpp).
+# `apt-get install liblcm-dev:arm64` would replace the host's LCM (lcm-gen, lcm.jar), and
+# `libyaml-cpp-dev:arm64` the host's libyaml-cpp-dev (not Multi-Arch: same), so the arm64
 # packages are downloaded and unpacked (dpkg -x, no root needed) into SYSROOT instead, and their
 # pkg-config files are rewritten to point into it. Multi-arch dependencies (libglib2.0-dev:arm64)
 # come from apt (scripts/setup.sh --cross). Needs `dpkg --add-architecture arm64` + apt-get update.
 # Usage: arm64-sysroot.sh SYSROOT        (idempotent: does nothing when SYSROOT is complete)
 set -euo pipefail
 sysroot=${1:?usage: arm64-sysroot.sh SYSROOT}
-packages=(liblcm1:arm64 liblcm-dev:arm64)
+# yaml-cpp: rocksteady-fsw's start-up configuration loader (fsw/main/CMakeLists.txt). Its CMake
+# package files locate themselves (relative import prefix), so find_package works from here.
+packages=(liblcm1:arm64 liblcm-dev:arm64 libyaml-cpp0.7:arm64 libyaml-cpp-dev:arm64)
 stamp="$sysroot/.rocksteady-sysroot"
 if [[ -f "$stamp" && "$(cat "$stamp")" == "${packages[*]}" ]]; then
   exit 0
