@@ -37,7 +37,7 @@ class References {
   // re-synchronised to the sample whose omega_d is nearest omega_hat.
   void reset_track(double t, const Vec3& q_hat, const Vec3& omega_hat, const TrajectoryTable& traj);
 
-  // One tick. `entered` is true on the first tick of a new mode.
+  // One tick. `entered` is true on the first tick spent in the current mode.
   ReferenceSample update(Mode mode, bool entered, double t, const Vec3& q_hat,
                          const Vec3& omega_hat, const TrajectoryTable& traj);
 

@@ -33,7 +33,7 @@ enum class TrajectoryError : std::uint8_t {
   kRateAboveBound,
   kBadChecksum,
   kNotAtRestAtEnd,
-  kBusyTracking,  // a new table cannot replace the one TRACK is following
+  kBusyTracking,  // TRACK is following the loaded table: it cannot be replaced now
 };
 const char* to_string(TrajectoryError e);
 
