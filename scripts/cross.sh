@@ -2,8 +2,12 @@
 # Cross builds of the flight side, from a fresh Debian 12 machine:
 #   1. packages: the arm64 architecture for multiarch target libraries, then scripts/setup.sh --cross;
 #   2. aarch64 Linux (preset aarch64): the flight side and its tests, built with Debian's cross
-#      compiler, tests run by ctest under qemu-aarch64; LCM comes from a private sysroot inside the
-#      build tree (cmake/toolchains/arm64-sysroot.sh);
+#      compiler, tests run by ctest under qemu-aarch64; LCM and yaml-cpp come from a private sysroot
+#      inside the build tree (cmake/toolchains/arm64-sysroot.sh); then processor-in-the-loop on the
+#      emulated board (scripts/pil-qemu.sh --fast): the cross-built rocksteady-fsw under qemu-aarch64
+#      flies the shortened case 1 of tests/pil in lockstep with the native rocksteady-plant, and its
+#      figures of merit must equal the native rocksteady-fsw's bit for bit (native programs from
+#      build/release, configured and built here if missing);
 #   3. bare-metal Cortex-M7 (preset baremetal-m7): the gnc core + firmware image, run in
 #      qemu-system-arm (mps2-an500, semihosting): it closes the loop on a built-in plant and exits
 #      0 when DETUMBLE has despun the vehicle and handed over to HOLD.
@@ -47,10 +51,26 @@ fi
 if [[ -z "$only" || "$only" == "aarch64" ]]; then
   stage "aarch64: sysroot, configure, build"
   cmake/toolchains/arm64-sysroot.sh build/aarch64/sysroot
+  # The toolchain's compiler flags (no FMA: bit-identical to the host) take effect at a fresh
+  # configure: start afresh when the toolchain file changed since the last one.
+  if [[ cmake/toolchains/aarch64-linux-gnu.cmake -nt build/aarch64/CMakeCache.txt ]]; then
+    rm -f build/aarch64/CMakeCache.txt
+  fi
   cmake --preset aarch64 >/dev/null
   cmake --build --preset aarch64 -j "$jobs"
   stage "aarch64: ctest under qemu-aarch64"
   ctest --preset aarch64 -j "$jobs"
+  stage "aarch64: PIL on the emulated board (qemu-aarch64 rocksteady-fsw + native rocksteady-plant)"
+  if [[ ! -f build/release/CMakeCache.txt ]]; then
+    cmake --preset release >/dev/null
+  fi
+  cmake --build --preset release -j "$jobs" --target rocksteady-fsw rocksteady-plant
+  # 6000 lockstep periods: a few seconds; bounded all the same. Non-zero exit on any difference.
+  if ! scripts/pil-qemu.sh --fast --native build/release --cross build/aarch64 \
+      --out build/aarch64/pil-qemu --timeout 120; then
+    echo "cross: FAIL: PIL on the emulated board (logs in build/aarch64/pil-qemu)" >&2
+    exit 1
+  fi
   if ((bench)); then
     stage "aarch64: instructions per Gnc::step (qemu-aarch64 -singlestep -d exec)"
     for mode in detumble hold; do
