@@ -1,6 +1,6 @@
 // rocksteady-fsw: the flight application on the LCM bus (processor-in-the-loop, or the flight
-// board's Linux process). Configuration is read once at start-up (YAML, through ground/config's
-// strict loader: only the flight side's estimates are used); after that the loop is the
+// board's Linux process). Configuration is read once at start-up (YAML, through fsw/config's
+// strict loader: the flight side's estimates only, never the truth); after that the loop is the
 // FlightNode's, whose tick path does not allocate.
 //
 //   rocksteady-fsw --case 1 --clock lockstep --initial-mode DETUMBLE
@@ -25,7 +25,7 @@
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/bus/flight_node.hpp"
 #include "fsw/executive/clock.hpp"
-#include "ground/config/config.hpp"
+#include "fsw/config/config_files.hpp"
 #include "hal/thruster_bank.hpp"
 
 namespace {
@@ -119,16 +119,14 @@ int main(int argc, char** argv) {
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
   if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
 
-  config::RunSetup setup;
+  fsw::FlightConfig fc;
   try {
-    setup = config::load_run(mission_path, gnc_path, case_file(config_dir, case_arg));
+    fc.gnc = config::load_flight_params(mission_path, gnc_path, case_file(config_dir, case_arg));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rocksteady-fsw: %s\n", e.what());
     return 2;
   }
 
-  fsw::FlightConfig fc;
-  fc.gnc = setup.flight;  // the flight side's estimates only (never the truth)
   if (!law_name.empty() && !parse_law(law_name, fc.gnc.law)) {
     std::fprintf(stderr, "rocksteady-fsw: unknown law '%s'\n", law_name.c_str());
     return 2;

@@ -13,7 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ground/campaign/campaign.hpp"
-#include "ground/config/config_error.hpp"
+#include "fsw/config/config_error.hpp"
 
 namespace {
 

@@ -1,64 +1,14 @@
-// Rocksteady's configuration files (configs/): mission.yaml, gnc.yaml and the case files, loaded
-// strictly (unknown or missing keys, wrong shapes, non-positive-definite inertias, negative noise
-// powers and unreadable files are a ConfigError naming the file, the key and the reason), and
-// assembled into the flight core's GncParams (estimated quantities) and the plant's PlantParams
-// (true quantities), SPEC Eq. (6).
+// The configuration files assembled for a closed-loop run: the flight software's parameters
+// (fsw/config) and the plant's truth (true mass properties, thrusters, disturbance, sensor noise,
+// initial state), SPEC Eq. (6).
 #pragma once
 
-#include <array>
-#include <cstdint>
 #include <string>
 
-#include "gnc/params.hpp"
-#include "ground/config/config_error.hpp"
+#include "fsw/config/config_files.hpp"
 #include "ground/plant/plant.hpp"
 
 namespace rocksteady::config {
-
-using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
-
-struct MissionConfig {
-  std::string file;
-  gnc::MassProperties mass{};                 // true
-  std::array<double, 4> pod_azimuths_deg{};  // SPEC §4
-  double pod_radius_m{2.5};
-  double pod_plane_z_m{3.0};
-  double isp_s{287.0};
-  double g0{9.8};
-  double sensor_period_s{0.1};
-  double disturbance_sigma_nm{0.0};
-  double disturbance_hold_s{10.0};
-  Vec3 initial_mrp{Vec3::Zero()};
-  Vec3 initial_omega{Vec3::Zero()};
-  Vec3 delta_j_diag_direction{-1.0, 1.0, 0.5};  // scaled to unit spectral norm on load
-  Vec3 delta_r_direction{Vec3::Ones()};         // unit length on load
-  double omega_tol_rad_s{1e-4};
-  double q_tol{1e-2};
-  int rk4_substeps{1};
-};
-
-enum class EstimatorChoice { kAuto, kPassThrough, kFilter };
-
-struct GncConfig {
-  std::string file;
-  gnc::GncParams params{};  // mass_hat, rcs and law are filled in by assemble()
-  EstimatorChoice estimator{EstimatorChoice::kAuto};
-};
-
-struct CaseConfig {
-  std::string file;
-  int number{0};
-  std::string description;
-  double delta_j_norm{0.0};   // ||dJ_ast||_2, kg m^2
-  double delta_r_norm{0.0};   // ||dr_SO/BCM||_2, m
-  double gyro_psd{0.0};       // P(dw)
-  double star_psd{0.0};       // P(dq)
-  double u_max{200.0};        // N
-  Vec3 bias_nm{Vec3::Zero()};
-  double duration_s{1e5};
-  std::uint64_t seed{1};
-};
 
 // Everything one closed-loop run needs.
 struct RunSetup {
@@ -73,15 +23,9 @@ struct RunSetup {
   gnc::MassProperties mass_hat{};
 };
 
-MissionConfig load_mission(const std::string& path);
-GncConfig load_gnc(const std::string& path);
-CaseConfig load_case(const std::string& path);
 // Applies the case's errors (true minus estimate) and validates the result.
 RunSetup assemble(const MissionConfig& mission, const GncConfig& gnc, const CaseConfig& c);
 RunSetup load_run(const std::string& mission_path, const std::string& gnc_path,
                   const std::string& case_path);
-
-// The RCS layout of SPEC §4 with the mission's pod azimuths, radius and plane.
-gnc::RcsLayout rcs_layout(const MissionConfig& m, double u_max);
 
 }  // namespace rocksteady::config

@@ -1,4 +1,4 @@
-#include "ground/config/yaml_reader.hpp"
+#include "fsw/config/yaml_reader.hpp"
 
 #include <cmath>
 #include <fstream>
