@@ -13,6 +13,7 @@
 
 #include "fsw/app/flight_app.hpp"
 #include "gnc/gnc.hpp"
+#include "rigid_body.hpp"
 
 namespace rocksteady::fsw::test {
 
@@ -65,34 +66,13 @@ inline FlightConfig small_config() {
   return c;
 }
 
-// Truth: J w_dot = (J w) x w + tau (Eq. 2), beta_dot from Eq. (3), RK4 with zero-order hold.
-struct Truth {
-  M3 j{M3::Identity()};
-  V4 beta{0, 0, 0, 1};
-  V3 omega{V3::Zero()};
+// Truth: the shared test-only rigid body (Eq. 2, quaternion kinematics Eq. 3, RK4 with zero-order
+// hold; tests/common/rigid_body.hpp), with its clock.
+struct Truth : rocksteady::test::RigidBody {
   double t{0.0};
 
-  static V4 beta_dot(const V4& b, const V3& w) {
-    V4 d;
-    d.head<3>() = 0.5 * (b.w() * w + b.head<3>().cross(w));
-    d.w() = -0.5 * b.head<3>().dot(w);
-    return d;
-  }
-  V3 omega_dot(const V3& w, const V3& tau) const { return j.ldlt().solve((j * w).cross(w) + tau); }
-
   void step(double h, const V3& tau) {
-    const V3 w0 = omega;
-    const V4 b0 = beta;
-    const V3 k1w = omega_dot(w0, tau);
-    const V4 k1b = beta_dot(b0, w0);
-    const V3 k2w = omega_dot(w0 + 0.5 * h * k1w, tau);
-    const V4 k2b = beta_dot(b0 + 0.5 * h * k1b, w0 + 0.5 * h * k1w);
-    const V3 k3w = omega_dot(w0 + 0.5 * h * k2w, tau);
-    const V4 k3b = beta_dot(b0 + 0.5 * h * k2b, w0 + 0.5 * h * k2w);
-    const V3 k4w = omega_dot(w0 + h * k3w, tau);
-    const V4 k4b = beta_dot(b0 + h * k3b, w0 + h * k3w);
-    omega = w0 + (h / 6) * (k1w + 2 * k2w + 2 * k3w + k4w);
-    beta = (b0 + (h / 6) * (k1b + 2 * k2b + 2 * k3b + k4b)).normalized();
+    RigidBody::step(h, tau);
     t += h;
   }
 

@@ -42,7 +42,7 @@ inline V4 axis_angle(const V3& axis, double angle) {
 }
 
 struct RigidBody {
-  M3 j;
+  M3 j{M3::Identity()};
   V4 beta{0, 0, 0, 1};
   V3 omega{V3::Zero()};
 
