@@ -18,6 +18,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "fsw/bus/bus_mapping.hpp"
 #include "fsw/commands/command_table.hpp"
 #include "fsw/uplink/trajectory_uplink.hpp"
 #include "hal/lcm/codec.hpp"
@@ -50,12 +51,7 @@ struct Responder {
   void on_command(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     rocksteady::ground_cmd_t m;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) return;
-    fsw::GroundCommand cmd;
-    cmd.seq = m.seq;
-    cmd.source = m.sender_id;
-    cmd.opcode = m.opcode;
-    cmd.arg_count = m.nargs;
-    for (int i = 0; i < m.nargs; ++i) cmd.args[static_cast<std::size_t>(i)] = m.args[i];
+    const fsw::GroundCommand cmd = fsw::bus::to_command(m);  // the flight's own mapping
 
     fsw::CommandCheck c;
     const fsw::RejectReason seq = seqs.check(cmd.source, cmd.seq);
@@ -98,19 +94,7 @@ struct Responder {
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) return;
     ++chunks;
     fsw::TrajectoryChunk c;
-    c.upload_id = m.upload_id;
-    c.chunk_index = m.chunk_index;
-    c.chunk_count = m.total_chunks;
-    c.total_samples = m.total_samples;
-    c.crc32 = static_cast<std::uint32_t>(m.table_crc);
-    c.n = m.count;
-    for (int i = 0; i < m.count; ++i) {
-      auto& s = c.samples[static_cast<std::size_t>(i)];
-      s.t = m.t[i];
-      s.omega_d = rocksteady::gnc::Vec3(m.omega_d[i][0], m.omega_d[i][1], m.omega_d[i][2]);
-      s.omega_d_dot =
-          rocksteady::gnc::Vec3(m.omega_d_dot[i][0], m.omega_d_dot[i][1], m.omega_d_dot[i][2]);
-    }
+    fsw::bus::to_chunk(m, c);  // the flight's own mapping
     const fsw::ChunkResult r = uplink->receive(c);
     if (r.status != fsw::ChunkStatus::kStored) {
       event(117, m.upload_id, static_cast<std::int32_t>(r.status), fsw::to_string(r.status));
