@@ -57,18 +57,16 @@ SensorConfigError Gyro::configure(const SensorConfig& config) {
   return e;
 }
 
-BodyRate Gyro::read(const GyroReading& r, double t_tick) {
-  BodyRate out{};
-  out.t = r.t;
-  out.status = check_reading(configured_, r.valid, r.rate.allFinite(), r.t, t_tick,
-                             config_.max_age_s, have_last_, last_t_);
-  out.valid = out.status == ReadingStatus::kOk;
-  if (out.valid) {
-    out.rate = config_.body_from_sensor * r.rate;
+ReadingStatus Gyro::read(const GyroReading& r, double t_tick, gnc::SensorSample& out) {
+  const ReadingStatus status = check_reading(configured_, r.valid, r.rate.allFinite(), r.t, t_tick,
+                                             config_.max_age_s, have_last_, last_t_);
+  out.gyro_valid = status == ReadingStatus::kOk;
+  if (out.gyro_valid) {
+    out.gyro_rate = config_.body_from_sensor * r.rate;
   } else {
     ++rejects_;
   }
-  return out;
+  return status;
 }
 
 SensorConfigError StarTracker::configure(const SensorConfig& config) {
@@ -83,28 +81,17 @@ SensorConfigError StarTracker::configure(const SensorConfig& config) {
   return e;
 }
 
-BodyAttitude StarTracker::read(const StarTrackerReading& r, double t_tick) {
-  BodyAttitude out{};
-  out.t = r.t;
-  out.status = check_reading(configured_, r.valid, r.quat.allFinite(), r.t, t_tick,
-                             config_.max_age_s, have_last_, last_t_);
-  out.valid = out.status == ReadingStatus::kOk;
-  if (out.valid) {
-    out.quat = gnc::quat::multiply(r.quat, beta_sb_);
+ReadingStatus StarTracker::read(const StarTrackerReading& r, double t_tick,
+                                gnc::SensorSample& out) {
+  const ReadingStatus status = check_reading(configured_, r.valid, r.quat.allFinite(), r.t, t_tick,
+                                             config_.max_age_s, have_last_, last_t_);
+  out.star_valid = status == ReadingStatus::kOk;
+  if (out.star_valid) {
+    out.star_quat = gnc::quat::multiply(r.quat, beta_sb_);
   } else {
     ++rejects_;
   }
-  return out;
-}
-
-gnc::SensorSample make_sample(double t_tick, const BodyRate& gyro, const BodyAttitude& star) {
-  gnc::SensorSample s{};
-  s.t = t_tick;
-  s.gyro_valid = gyro.valid;
-  if (gyro.valid) s.gyro_rate = gyro.rate;
-  s.star_valid = star.valid;
-  if (star.valid) s.star_quat = star.quat;
-  return s;
+  return status;
 }
 
 }  // namespace rocksteady::hal

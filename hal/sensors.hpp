@@ -1,5 +1,7 @@
-// Gyro and StarTracker: raw readings in the sensor's own frame, with timestamps and validity, turned
-// into body-frame values for gnc::SensorSample through the sensor-to-body alignment (configuration).
+// Gyro and StarTracker: raw readings (hal/readings.hpp) in the sensor's own frame, with timestamps
+// and validity, written straight into the flight core's input gnc::SensorSample in the body frame
+// through the sensor-to-body alignment (configuration). The reading checks below are made here and
+// nowhere else on the flight path.
 // A reading is usable only if the device flagged it valid, its values are finite, it is not older
 // than `max_age_s` at the tick, and its timestamp advanced since the last usable reading (a frozen
 // sensor repeats itself). No heap, no exceptions.
@@ -9,28 +11,9 @@
 
 #include "gnc/gnc.hpp"
 #include "gnc/types.hpp"
+#include "hal/readings.hpp"
 
 namespace rocksteady::hal {
-
-struct GyroReading {
-  double t{0.0};                          // s, sample time
-  gnc::Vec3 rate{gnc::Vec3::Zero()};      // rad/s, in the gyro frame
-  bool valid{false};                      // device's own validity flag
-};
-
-struct StarTrackerReading {
-  double t{0.0};                            // s, sample time
-  gnc::Vec4 quat{0.0, 0.0, 0.0, 1.0};       // attitude of the tracker frame in F_I, scalar last
-  bool valid{false};
-};
-
-// One sensor frame as the back ends deliver it.
-struct RawSensors {
-  std::int64_t seq{-1};  // frame number (echoed by the thruster command in lockstep)
-  double t{0.0};         // s, frame time
-  GyroReading gyro{};
-  StarTrackerReading star{};
-};
 
 struct SensorConfig {
   // C_BS: maps sensor-frame vectors to the body frame (v_B = C_BS v_S). Must be a rotation.
@@ -52,26 +35,13 @@ enum class ReadingStatus : std::uint8_t {
   kNotConfigured,
 };
 
-struct BodyRate {
-  double t{0.0};
-  gnc::Vec3 rate{gnc::Vec3::Zero()};  // rad/s in F_B
-  bool valid{false};
-  ReadingStatus status{ReadingStatus::kNotConfigured};
-};
-
-struct BodyAttitude {
-  double t{0.0};
-  gnc::Vec4 quat{0.0, 0.0, 0.0, 1.0};  // attitude of F_B in F_I, scalar last
-  bool valid{false};
-  ReadingStatus status{ReadingStatus::kNotConfigured};
-};
-
 class Gyro {
  public:
   SensorConfigError configure(const SensorConfig& config);
   void reset() { have_last_ = false; }
-  // omega_B = C_BS omega_S.
-  BodyRate read(const GyroReading& r, double t_tick);
+  // omega_B = C_BS omega_S into out.gyro_rate / out.gyro_valid (the rate is left untouched when
+  // the reading is not usable). Returns why it was not.
+  ReadingStatus read(const GyroReading& r, double t_tick, gnc::SensorSample& out);
   std::uint32_t rejects() const { return rejects_; }
 
  private:
@@ -86,8 +56,9 @@ class StarTracker {
  public:
   SensorConfigError configure(const SensorConfig& config);
   void reset() { have_last_ = false; }
-  // R_IB = R_IS C_SB, i.e. beta_IB = beta_IS (x) beta_SB with beta_SB the conjugate of C_BS's.
-  BodyAttitude read(const StarTrackerReading& r, double t_tick);
+  // R_IB = R_IS C_SB, i.e. beta_IB = beta_IS (x) beta_SB with beta_SB the conjugate of C_BS's, into
+  // out.star_quat / out.star_valid.
+  ReadingStatus read(const StarTrackerReading& r, double t_tick, gnc::SensorSample& out);
   std::uint32_t rejects() const { return rejects_; }
 
  private:
@@ -98,8 +69,5 @@ class StarTracker {
   double last_t_{0.0};
   std::uint32_t rejects_{0};
 };
-
-// The flight core's input: t is the tick time; each sensor's validity is its reading's.
-gnc::SensorSample make_sample(double t_tick, const BodyRate& gyro, const BodyAttitude& star);
 
 }  // namespace rocksteady::hal

@@ -90,10 +90,15 @@ BankStatus ThrusterBank::command(const gnc::ThrusterCommand& cmd, ThrusterOutput
 }
 
 gnc::Vec8 ThrusterBank::channel_forces(const ThrusterOutputs& outputs) const {
+  if (!configured_) return gnc::Vec8::Zero();
+  return hal::channel_forces(config_, outputs);
+}
+
+gnc::Vec8 channel_forces(const ThrusterBankConfig& wiring, const ThrusterOutputs& outputs) {
   gnc::Vec8 u = gnc::Vec8::Zero();
-  if (!configured_ || !outputs.enabled) return u;
+  if (!outputs.enabled) return u;
   for (int i = 0; i < gnc::kChannels; ++i) {
-    const ChannelWiring& w = config_.channel[static_cast<std::size_t>(i)];
+    const ChannelWiring& w = wiring.channel[static_cast<std::size_t>(i)];
     const auto p = static_cast<std::size_t>(thruster_index(w.pod, w.plus));
     const auto m = static_cast<std::size_t>(thruster_index(w.pod, w.minus));
     const double fp = outputs.on[p] ? outputs.force[p] : 0.0;

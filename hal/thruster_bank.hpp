@@ -8,16 +8,11 @@
 #include <cstdint>
 
 #include "gnc/gnc.hpp"
+#include "hal/readings.hpp"
 #include "gnc/model/rcs.hpp"
 #include "gnc/types.hpp"
 
 namespace rocksteady::hal {
-
-inline constexpr int kThrustersPerPod = 4;
-inline constexpr int kThrusters = gnc::kPods * kThrustersPerPod;  // 16
-
-// Physical thruster number: 4 * pod + position in the pod (0..3).
-constexpr int thruster_index(int pod, int position) { return pod * kThrustersPerPod + position; }
 
 struct ChannelWiring {
   int pod{0};    // 0..3
@@ -57,16 +52,13 @@ struct BankConfigCheck {
 BankConfigCheck validate(const ThrusterBankConfig& config, const gnc::RcsLayout* layout = nullptr);
 
 // What the bank drives: one on/off and force per physical thruster.
-struct ThrusterOutputs {
-  bool enabled{false};
-  std::array<bool, kThrusters> on{};
-  std::array<double, kThrusters> force{};  // N, >= 0; zero when off
-};
-
 struct BankStatus {
   int clamped{0};     // channels whose |u| exceeded u_max (fired at u_max)
   int non_finite{0};  // channels with a NaN/Inf force (left off)
 };
+
+// The same mapping for a wiring alone (a port that reports channel forces beside the thrusters).
+gnc::Vec8 channel_forces(const ThrusterBankConfig& wiring, const ThrusterOutputs& outputs);
 
 class ThrusterBank {
  public:

@@ -2,9 +2,51 @@
 
 #include <cstring>
 
-#include "hal/lcm/convert.hpp"
+#include "wire/convert.hpp"
 
 namespace rocksteady::fsw::bus {
+
+// Every opcode and reject reason is the number its .lcm constant says (lcmtypes/ground_cmd_t.lcm,
+// cmd_ack_t.lcm): a renumbering on either side stops the build.
+using GroundCmd = rocksteady::ground_cmd_t;
+using Ack = rocksteady::cmd_ack_t;
+static_assert(static_cast<std::int32_t>(Opcode::kNoop) == GroundCmd::OP_NOOP);
+static_assert(static_cast<std::int32_t>(Opcode::kSetMode) == GroundCmd::OP_SET_MODE);
+static_assert(static_cast<std::int32_t>(Opcode::kSetTarget) == GroundCmd::OP_SET_TARGET);
+static_assert(static_cast<std::int32_t>(Opcode::kSetLaw) == GroundCmd::OP_SET_LAW);
+static_assert(static_cast<std::int32_t>(Opcode::kLoadTrajectory) == GroundCmd::OP_LOAD_TRAJECTORY);
+static_assert(static_cast<std::int32_t>(Opcode::kAbortUplink) == GroundCmd::OP_ABORT_UPLINK);
+static_assert(static_cast<std::int32_t>(Opcode::kResetCounters) == GroundCmd::OP_RESET_COUNTERS);
+static_assert(static_cast<std::int32_t>(Opcode::kParamLoad) == GroundCmd::OP_PARAM_LOAD);
+static_assert(static_cast<std::int32_t>(Opcode::kParamActivate) == GroundCmd::OP_PARAM_ACTIVATE);
+static_assert(static_cast<std::int32_t>(Opcode::kParamDiscard) == GroundCmd::OP_PARAM_DISCARD);
+static_assert(kOpcodeCount == GroundCmd::OP_COUNT);
+static_assert(kMaxCommandArgs == GroundCmd::MAX_ARGS);
+static_assert(static_cast<std::int32_t>(RejectReason::kNone) == Ack::REASON_OK);
+static_assert(static_cast<std::int32_t>(RejectReason::kUnknownOpcode) == Ack::REASON_UNKNOWN_OPCODE);
+static_assert(static_cast<std::int32_t>(RejectReason::kBadLength) == Ack::REASON_BAD_ARG_COUNT);
+static_assert(static_cast<std::int32_t>(RejectReason::kArgNotFinite) == Ack::REASON_ARG_NOT_FINITE);
+static_assert(static_cast<std::int32_t>(RejectReason::kOutOfRange) == Ack::REASON_ARG_OUT_OF_RANGE);
+static_assert(static_cast<std::int32_t>(RejectReason::kStaleSequence) == Ack::REASON_STALE_SEQUENCE);
+static_assert(static_cast<std::int32_t>(RejectReason::kNotAuthenticated) ==
+              Ack::REASON_NOT_AUTHENTICATED);
+static_assert(static_cast<std::int32_t>(RejectReason::kNotAllowedInMode) ==
+              Ack::REASON_NOT_ALLOWED_IN_MODE);
+static_assert(static_cast<std::int32_t>(RejectReason::kTrajectoryRejected) ==
+              Ack::REASON_TRAJECTORY_REJECTED);
+static_assert(static_cast<std::int32_t>(RejectReason::kBusy) == Ack::REASON_BUSY);
+static_assert(static_cast<std::int32_t>(RejectReason::kInternal) == Ack::REASON_INTERNAL);
+static_assert(static_cast<std::int32_t>(RejectReason::kInvalidTable) == Ack::REASON_INVALID_TABLE);
+static_assert(static_cast<std::int32_t>(RejectReason::kNothingToActivate) ==
+              Ack::REASON_NOTHING_TO_ACTIVATE);
+static_assert(static_cast<std::int32_t>(RejectReason::kUploadIncomplete) ==
+              Ack::REASON_UPLOAD_INCOMPLETE);
+static_assert(static_cast<std::int8_t>(Severity::kDebug) == rocksteady::event_t::SEV_DEBUG);
+static_assert(static_cast<std::int8_t>(Severity::kInfo) == rocksteady::event_t::SEV_INFO);
+static_assert(static_cast<std::int8_t>(Severity::kWarning) == rocksteady::event_t::SEV_WARNING);
+static_assert(static_cast<std::int8_t>(Severity::kError) == rocksteady::event_t::SEV_ERROR);
+static_assert(static_cast<std::int8_t>(Severity::kFatal) == rocksteady::event_t::SEV_FATAL);
+static_assert(kChunkSamples == rocksteady::trajectory_chunk_t::SAMPLES);
 
 namespace {
 
@@ -123,30 +165,11 @@ void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m) {
   m.trajectories_loaded = h.trajectories_loaded;
 }
 
-void fill_rx(const hal::wire::RxCounters& rx, rocksteady::gnc_telemetry_t& m) {
+void fill_rx(const wire::RxCounters& rx, rocksteady::gnc_telemetry_t& m) {
   m.rx_ok = i64(rx.ok);
   m.rx_malformed = i64(rx.malformed_total());
   m.rx_bad_kind = i64(rx.bad_kind_total());
   m.rx_out_of_range = i64(rx.out_of_range);
-}
-
-hal::SensorConfigError SensorFrontEnd::configure(const hal::SensorConfig& gyro,
-                                                 const hal::SensorConfig& star) {
-  const hal::SensorConfigError g = gyro_.configure(gyro);
-  if (g != hal::SensorConfigError::kOk) return g;
-  return star_.configure(star);
-}
-
-void SensorFrontEnd::reset() {
-  gyro_.reset();
-  star_.reset();
-}
-
-gnc::SensorSample SensorFrontEnd::sample(const rocksteady::sensor_frame_t& m) {
-  const hal::RawSensors raw = hal::wire::to_raw(m);
-  const hal::BodyRate rate = gyro_.read(raw.gyro, raw.t);
-  const hal::BodyAttitude att = star_.read(raw.star, raw.t);
-  return hal::make_sample(raw.t, rate, att);
 }
 
 }  // namespace rocksteady::fsw::bus

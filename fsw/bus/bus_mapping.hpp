@@ -1,5 +1,7 @@
 // The flight side of the bus: LCM messages <-> the flight application's plain structs
-// (fsw/interface.hpp) and the HAL's sensor front end. No LCM calls, no heap after configuration
+// (fsw/interface.hpp): commands, acknowledgements, uplink chunks, events, health telemetry. Sensor
+// frames and thruster commands are not here: they are device readings, mapped by the bus library
+// (wire/convert.hpp) inside the HAL's LCM ports. No LCM calls, no heap after configuration
 // (event_t / cmd_ack_t carry a std::string: give them capacity once with reserve_text()).
 #pragma once
 
@@ -7,8 +9,7 @@
 
 #include "fsw/app/flight_app.hpp"
 #include "fsw/interface.hpp"
-#include "hal/lcm/codec.hpp"
-#include "hal/sensors.hpp"
+#include "wire/codec.hpp"
 #include "rocksteady/cmd_ack_t.hpp"
 #include "rocksteady/event_t.hpp"
 #include "rocksteady/gnc_telemetry_t.hpp"
@@ -37,22 +38,7 @@ void to_message(const Event& e, rocksteady::event_t& m);
 // The fsw's part of gnc_telemetry_t: executive, commanding, health counters, tables, uplink.
 void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m);
 // Inbound bus counters (every input channel together).
-void fill_rx(const hal::wire::RxCounters& rx, rocksteady::gnc_telemetry_t& m);
+void fill_rx(const wire::RxCounters& rx, rocksteady::gnc_telemetry_t& m);
 
-// The sensor front end of a bus frame: sensor-frame readings -> body frame (hal::Gyro,
-// hal::StarTracker with their alignment) -> gnc::SensorSample at the frame's time.
-class SensorFrontEnd {
- public:
-  hal::SensorConfigError configure(const hal::SensorConfig& gyro, const hal::SensorConfig& star);
-  // A restarted sensor stream: forget the last reading times.
-  void reset();
-  gnc::SensorSample sample(const rocksteady::sensor_frame_t& m);
-  std::uint32_t gyro_rejects() const { return gyro_.rejects(); }
-  std::uint32_t star_rejects() const { return star_.rejects(); }
-
- private:
-  hal::Gyro gyro_{};
-  hal::StarTracker star_{};
-};
 
 }  // namespace rocksteady::fsw::bus

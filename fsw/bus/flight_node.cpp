@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <ctime>
 
-#include "hal/lcm/convert.hpp"
 #include "lcmtypes/channels.hpp"
+#include "wire/convert.hpp"
 
 namespace rocksteady::fsw::bus {
 
@@ -22,7 +22,7 @@ constexpr std::uint64_t kBusEventSeqBase = 1000000000000ULL;
 
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
-void accumulate(hal::wire::RxCounters& a, const hal::wire::RxCounters& b) {
+void accumulate(wire::RxCounters& a, const wire::RxCounters& b) {
   a.ok += b.ok;
   a.too_short += b.too_short;
   a.too_long += b.too_long;
@@ -56,12 +56,12 @@ class ServingClock final : public Clock {
 
 }  // namespace
 
-FlightNode::FlightNode(lcm_t* lcm, FlightApp& app, const hal::ThrusterBank& bank,
-                       SensorFrontEnd& sensors, const Clock& clock)
-    : lcm_(lcm), app_(app), bank_(bank), sensors_(sensors), clock_(clock) {
+FlightNode::FlightNode(lcm_t* lcm, FlightComputer& computer, hal::LcmSensorSource& sensors,
+                       hal::LcmThrusterSink& thrusters, const Clock& clock)
+    : lcm_(lcm), computer_(computer), sensors_(sensors), thrusters_(thrusters), clock_(clock) {
   reserve_text(ack_msg_);
   reserve_text(event_msg_);
-  tlm_msg_ = hal::wire::make<rocksteady::gnc_telemetry_t>();
+  tlm_msg_ = wire::make<rocksteady::gnc_telemetry_t>();
 }
 
 FlightNode::~FlightNode() {
@@ -83,9 +83,9 @@ bool FlightNode::subscribe() {
   return true;
 }
 
-hal::wire::RxCounters FlightNode::rx_total() const {
-  hal::wire::RxCounters t;
-  accumulate(t, stats_.rx_sensors);
+wire::RxCounters FlightNode::rx_total() const {
+  wire::RxCounters t;
+  accumulate(t, sensors_.counters());
   accumulate(t, stats_.rx_commands);
   accumulate(t, stats_.rx_uplink);
   return t;
@@ -97,57 +97,60 @@ hal::wire::RxCounters FlightNode::rx_total() const {
 
 void FlightNode::on_sensors(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
   auto& n = *static_cast<FlightNode*>(self);
-  if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_frame_,
-                              &n.stats_.rx_sensors)) {
-    n.note_rx_reject(0, n.stats_.rx_sensors);
+  const wire::RxCounters before = n.sensors_.counters();
+  if (!n.sensors_.on_message(rbuf->data, static_cast<int>(rbuf->data_size))) {
+    if (n.sensors_.counters().rejected() != before.rejected()) {
+      n.note_rx_reject(0, n.sensors_.counters());
+    }
     return;
   }
-  ++n.stats_.frames;
-  if (n.have_seq_ && n.scratch_frame_.seq < n.last_seq_seen_) {
-    // The sensor stream restarted (a new plant, a rebooted front end): forget its old readings.
-    n.sensors_.reset();
-    n.restarted_ = true;
-    ++n.stats_.stream_restarts;
+  n.sync_sensor_stats();
+  if (n.sensors_.restarts() != n.restarts_seen_) {
+    // The sensor stream restarted (a new plant, a rebooted front end): the devices forget their old
+    // readings when the flagged frame is polled.
+    n.restarts_seen_ = n.sensors_.restarts();
     n.bus_event(Severity::kWarning, BusEventId::kStreamRestart,
-                static_cast<std::int32_t>(n.scratch_frame_.seq),
+                static_cast<std::int32_t>(n.sensors_.pending_seq()),
                 static_cast<std::int32_t>(n.stats_.stream_restarts),
                 "sensor frame seq went backwards: sensor stream restarted");
   }
-  if (n.have_pending_) ++n.stats_.frames_superseded;
-  n.pending_frame_ = n.scratch_frame_;
-  n.have_pending_ = true;
-  n.have_seq_ = true;
-  n.last_seq_seen_ = n.scratch_frame_.seq;
+}
+
+void FlightNode::sync_sensor_stats() {
+  stats_.frames = sensors_.frames();
+  stats_.frames_superseded = sensors_.superseded();
+  stats_.stream_restarts = sensors_.restarts();
+  stats_.rx_sensors = sensors_.counters();
 }
 
 void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
   auto& n = *static_cast<FlightNode*>(self);
-  if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_cmd_,
+  if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_cmd_,
                               &n.stats_.rx_commands)) {
     n.note_rx_reject(1, n.stats_.rx_commands);
     return;
   }
   ++n.stats_.commands;
-  const CommandAck ack = n.app_.submit(to_command(n.scratch_cmd_));
-  to_message(ack, n.app_.onboard_time(), n.ack_msg_);
+  const CommandAck ack = n.computer_.submit(to_command(n.scratch_cmd_));
+  to_message(ack, n.computer_.onboard_time(), n.ack_msg_);
   n.publish(channels::kCmdAck, n.ack_msg_);
   n.drain_events();
 }
 
 void FlightNode::on_chunk(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
   auto& n = *static_cast<FlightNode*>(self);
-  if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_chunk_,
+  if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_chunk_,
                               &n.stats_.rx_uplink)) {
     n.note_rx_reject(2, n.stats_.rx_uplink);
     return;
   }
   ++n.stats_.chunks;
   to_chunk(n.scratch_chunk_, n.chunk_);
-  n.app_.receive_chunk(n.chunk_);  // the application raises the events and counts rejections
+  n.computer_.receive_chunk(n.chunk_);  // the application raises the events, counts rejections
   n.drain_events();
 }
 
-void FlightNode::note_rx_reject(int channel, const hal::wire::RxCounters& c) {
+void FlightNode::note_rx_reject(int channel, const wire::RxCounters& c) {
   const std::int64_t now = clock_.now_ns();
   if (rx_event_fired_[channel] && now - last_rx_event_ns_[channel] < kNsPerS) return;
   rx_event_fired_[channel] = true;
@@ -164,7 +167,7 @@ void FlightNode::note_rx_reject(int channel, const hal::wire::RxCounters& c) {
 // ----------------------------------------------------------------------------------------------
 
 template <class T> void FlightNode::publish(const char* channel, const T& msg) {
-  const int n = hal::wire::encode(msg, buf_, static_cast<int>(sizeof buf_));
+  const int n = wire::encode(msg, buf_, static_cast<int>(sizeof buf_));
   if (n < 0 || lcm_publish(lcm_, channel, buf_, static_cast<unsigned int>(n)) != 0) {
     ++stats_.publish_errors;
   }
@@ -172,7 +175,7 @@ template <class T> void FlightNode::publish(const char* channel, const T& msg) {
 
 void FlightNode::drain_events() {
   Event e;
-  while (app_.pop_event(e)) {
+  while (computer_.pop_event(e)) {
     to_message(e, event_msg_);
     publish(channels::kEvents, event_msg_);
   }
@@ -182,7 +185,7 @@ void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::
                            const char* text) {
   Event e;
   e.seq = kBusEventSeqBase + bus_event_seq_++;
-  e.t = app_.onboard_time();
+  e.t = computer_.onboard_time();
   e.severity = sev;
   e.id = static_cast<EventId>(id);
   e.arg0 = arg0;
@@ -192,21 +195,14 @@ void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::
   publish(channels::kEvents, event_msg_);
 }
 
-void FlightNode::tick(const Tick& t, const rocksteady::sensor_frame_t* frame, const NodeOptions& o) {
-  Outputs out;
-  gnc::SensorSample sample;
-  const gnc::SensorSample* sp = nullptr;
-  if (frame != nullptr) {
-    sample = sensors_.sample(*frame);
-    sp = &sample;
-    echo_seq_ = frame->seq;
-  }
-  app_.tick(t, sp, out);
+void FlightNode::tick(const Tick& t, const NodeOptions& o) {
+  const TickReport r = computer_.tick(t);  // sensors in and thrusters out through the ports
   last_index_ = t.index;
   have_index_ = true;
   ++stats_.ticks;
-  publish_outputs(out, o);
-  if (o.has_start_mode && !start_done_ && out.gnc_ran && app_.health().frames_accepted > 0) {
+  if (r.gnc_ran) publish_telemetry(o);
+  drain_events();
+  if (o.has_start_mode && !start_done_ && r.gnc_ran && computer_.health().frames_accepted > 0) {
     start_done_ = true;
     GroundCommand c;
     c.seq = 1;
@@ -214,38 +210,26 @@ void FlightNode::tick(const Tick& t, const rocksteady::sensor_frame_t* frame, co
     c.opcode = static_cast<std::int32_t>(Opcode::kSetMode);
     c.arg_count = 1;
     c.args[0] = static_cast<double>(static_cast<int>(o.start_mode));
-    to_message(app_.submit(c), app_.onboard_time(), ack_msg_);
+    to_message(computer_.submit(c), computer_.onboard_time(), ack_msg_);
     publish(channels::kCmdAck, ack_msg_);
     drain_events();
   }
 }
 
-void FlightNode::publish_outputs(const Outputs& out, const NodeOptions& o) {
-  if (out.gnc_ran) {
-    bank_.command(out.command, thr_out_);
-    thr_msg_ = hal::wire::to_message(thr_out_, bank_.channel_forces(thr_out_), echo_seq_,
-                                     out.telemetry.t);
-    have_thr_msg_ = true;
-    publish(channels::kThrusterCmd, thr_msg_);
-    if (o.tlm_every <= 1 || gnc_cycles_ % o.tlm_every == 0) {
-      hal::wire::fill_gnc(app_.core_output(), tlm_msg_);
-      tlm_msg_.frame_seq = echo_seq_;
-      fill_health(app_.health(), tlm_msg_);
-      fill_rx(rx_total(), tlm_msg_);
-      publish(channels::kGncTelemetry, tlm_msg_);
-    }
-    ++gnc_cycles_;
+void FlightNode::publish_telemetry(const NodeOptions& o) {
+  if (o.tlm_every <= 1 || gnc_cycles_ % o.tlm_every == 0) {
+    wire::fill_gnc(computer_.core_output(), tlm_msg_);
+    tlm_msg_.frame_seq = computer_.echo_seq();
+    fill_health(computer_.health(), tlm_msg_);
+    fill_rx(rx_total(), tlm_msg_);
+    publish(channels::kGncTelemetry, tlm_msg_);
   }
-  drain_events();
-}
-
-void FlightNode::republish_command() {
-  if (have_thr_msg_) publish(channels::kThrusterCmd, thr_msg_);
+  ++gnc_cycles_;
 }
 
 void FlightNode::status_line(const char* prefix) const {
-  const HealthTelemetry h = app_.health();
-  const hal::wire::RxCounters rx = rx_total();
+  const HealthTelemetry h = computer_.health();
+  const wire::RxCounters rx = rx_total();
   std::printf("%s t=%.1f s mode=%s law=%s ticks=%" PRIu64 " frames=%" PRIu64
               " frameless=%u cmd=%u/%u rx_ok=%" PRIu64 " rx_rejected=%" PRIu64
               " restarts=%" PRIu64 "\n",
@@ -294,7 +278,7 @@ int FlightNode::run(const NodeOptions& o, const volatile std::sig_atomic_t* stop
 
 int FlightNode::run_lockstep(const NodeOptions& o, const volatile std::sig_atomic_t* stop) {
   const std::int64_t start = clock_.now_ns();
-  const std::int64_t period = app_.executive().base_period_ns();
+  const std::int64_t period = computer_.app().executive().base_period_ns();
   const std::int64_t watchdog = to_ns(o.frame_watchdog_s);
   LockstepSource source;
   std::uint64_t offset = 0;
@@ -315,31 +299,35 @@ int FlightNode::run_lockstep(const NodeOptions& o, const volatile std::sig_atomi
     if (!wait_once(deadline)) return 1;
     const std::int64_t now = clock_.now_ns();
 
-    if (have_pending_) {
-      have_pending_ = false;
-      const rocksteady::sensor_frame_t& frame = pending_frame_;
-      if (!restarted_ && !frameless && have_thr_msg_ && frame.seq == echo_seq_) {
+    if (sensors_.pending()) {
+      const std::int64_t seq = sensors_.pending_seq();
+      const bool restarted = sensors_.restarts() != restarts_handled_;
+      if (!restarted && !frameless && thrusters_.written() && seq == computer_.echo_seq()) {
         // The plant resends a frame whose command it did not get: answer again, no new tick.
+        sensors_.drop();
         ++stats_.duplicate_frames;
-        republish_command();
+        thrusters_.republish();
         last_frame_ns = now;
         continue;
       }
-      if (restarted_ || frameless) {
+      if (restarted || frameless) {
         // A new stream, or the old one after a gap: new frame numbering, ticks continue.
         source = LockstepSource{};
         offset = have_index_ ? last_index_ + 1 : 0;
-        restarted_ = false;
+        restarts_handled_ = sensors_.restarts();
         frameless = false;
       }
-      if (!source.on_frame(frame.seq, now)) {
+      if (!source.on_frame(seq, now)) {
+        sensors_.drop();
         ++stats_.stale_frames;
         continue;
       }
       Tick t;
       if (source.next(t)) {
         t.index += offset;
-        tick(t, &frame, o);
+        tick(t, o);
+      } else {
+        sensors_.drop();
       }
       streaming = true;
       last_frame_ns = now;
@@ -348,11 +336,12 @@ int FlightNode::run_lockstep(const NodeOptions& o, const volatile std::sig_atomi
         frameless = true;
         next_frameless_ns = now;
         bus_event(Severity::kWarning, BusEventId::kFrameWatchdog,
-                  static_cast<std::int32_t>(echo_seq_), 0,
+                  static_cast<std::int32_t>(computer_.echo_seq()), 0,
                   "no sensor frame within the watchdog time: frameless ticks at the base rate");
       }
       const Tick t{have_index_ ? last_index_ + 1 : 0, now, 0};
-      tick(t, nullptr, o);
+      sensors_.drop();  // nothing is waiting here; a frame would have been handled above
+      tick(t, o);
       ++stats_.watchdog_ticks;
       next_frameless_ns += period;
       if (next_frameless_ns < now) next_frameless_ns = now + period;
@@ -368,7 +357,7 @@ int FlightNode::run_lockstep(const NodeOptions& o, const volatile std::sig_atomi
 int FlightNode::run_realtime(const NodeOptions& o, const volatile std::sig_atomic_t* stop) {
   const std::int64_t start = clock_.now_ns();
   ServingClock serving(*this, clock_, stop);
-  RealTimeClockSource source(serving, app_.executive().base_period_ns());
+  RealTimeClockSource source(serving, computer_.app().executive().base_period_ns());
   while ((stop == nullptr || *stop == 0) && !limits_reached(o, start)) {
     Tick t;
     source.next(t);
@@ -378,13 +367,7 @@ int FlightNode::run_realtime(const NodeOptions& o, const volatile std::sig_atomi
     if (o.jitter_ns != nullptr && o.jitter_ns->size() < o.jitter_ns->capacity()) {
       o.jitter_ns->push_back(now - t.start_ns);
     }
-    if (have_pending_) {
-      have_pending_ = false;
-      restarted_ = false;
-      tick(t, &pending_frame_, o);
-    } else {
-      tick(t, nullptr, o);
-    }
+    tick(t, o);  // the newest frame that arrived, if any, is polled by the computer
     if (o.verbose && now - last_status_ns_ >= kNsPerS) {
       last_status_ns_ = now;
       status_line("fsw:");

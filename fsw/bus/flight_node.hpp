@@ -1,6 +1,6 @@
 // rocksteady-fsw's bus loop: one FlightApp on the LCM bus.
 //
-// Inputs (raw-buffer subscriptions, decoded with hal::wire::safe_decode; a rejected message is
+// Inputs (raw-buffer subscriptions, decoded with wire::safe_decode; a rejected message is
 // counted in gnc_telemetry_t.rx_* and dropped, never fatal): RS_SENSORS, RS_GROUND_CMD,
 // RS_TRAJ_UPLINK. Outputs: RS_THRUSTER_CMD (hal::ThrusterBank's physical thrusters, echoing the
 // frame), RS_GNC_TLM, RS_EVENTS, RS_CMD_ACK.
@@ -15,8 +15,9 @@
 //   realtime  fsw::RealTimeClockSource drives the base ticks on CLOCK_MONOTONIC; the bus is served
 //             while waiting for each deadline; each tick consumes the newest frame that arrived
 //             (a frameless tick when none did).
-// A frame whose seq goes backwards is a restarted sensor stream: the sensor front end forgets its
-// last readings (the flight application re-anchors its time base after frame_resync_count frames).
+// A frame whose seq goes backwards is a restarted sensor stream: the sensor source flags it and the
+// devices forget their last readings (the application re-anchors its time base after
+// frame_resync_count frames).
 //
 // Only this object's thread calls lcm_handle. Nothing here allocates per message except LCM itself.
 #pragma once
@@ -27,11 +28,11 @@
 
 #include <lcm/lcm.h>
 
-#include "fsw/app/flight_app.hpp"
 #include "fsw/bus/bus_mapping.hpp"
+#include "fsw/computer/flight_computer.hpp"
 #include "fsw/executive/clock.hpp"
-#include "hal/lcm/codec.hpp"
-#include "hal/thruster_bank.hpp"
+#include "hal/lcm/lcm_ports.hpp"
+#include "wire/codec.hpp"
 
 namespace rocksteady::fsw::bus {
 
@@ -74,16 +75,17 @@ struct NodeStats {
   std::uint64_t commands{0};
   std::uint64_t chunks{0};
   std::uint64_t publish_errors{0};
-  hal::wire::RxCounters rx_sensors{};
-  hal::wire::RxCounters rx_commands{};
-  hal::wire::RxCounters rx_uplink{};
+  wire::RxCounters rx_sensors{};
+  wire::RxCounters rx_commands{};
+  wire::RxCounters rx_uplink{};
 };
 
 class FlightNode {
  public:
-  // All referenced objects must outlive the node; `app` initialised, `bank` configured.
-  FlightNode(lcm_t* lcm, FlightApp& app, const hal::ThrusterBank& bank, SensorFrontEnd& sensors,
-             const Clock& clock);
+  // All referenced objects must outlive the node; `computer` initialised and driven by `sensors`
+  // and `thrusters`, the ports on this node's bus.
+  FlightNode(lcm_t* lcm, FlightComputer& computer, hal::LcmSensorSource& sensors,
+             hal::LcmThrusterSink& thrusters, const Clock& clock);
   FlightNode(const FlightNode&) = delete;
   FlightNode& operator=(const FlightNode&) = delete;
   ~FlightNode();
@@ -93,7 +95,7 @@ class FlightNode {
   int run(const NodeOptions& options, const volatile std::sig_atomic_t* stop);
 
   const NodeStats& stats() const { return stats_; }
-  hal::wire::RxCounters rx_total() const;
+  wire::RxCounters rx_total() const;
 
   // Waits for the bus until `deadline_ns` (monotonic) or until one message was dispatched.
   // Returns false on a bus error.
@@ -107,31 +109,25 @@ class FlightNode {
   int run_lockstep(const NodeOptions& o, const volatile std::sig_atomic_t* stop);
   int run_realtime(const NodeOptions& o, const volatile std::sig_atomic_t* stop);
 
-  void tick(const Tick& tick, const rocksteady::sensor_frame_t* frame, const NodeOptions& o);
-  void publish_outputs(const Outputs& out, const NodeOptions& o);
-  void republish_command();
+  void tick(const Tick& tick, const NodeOptions& o);
+  void sync_sensor_stats();
+  void publish_telemetry(const NodeOptions& o);
   void drain_events();
   void bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::int32_t arg1,
                  const char* text);
-  void note_rx_reject(int channel, const hal::wire::RxCounters& c);
+  void note_rx_reject(int channel, const wire::RxCounters& c);
   template <class T> void publish(const char* channel, const T& msg);
   void status_line(const char* prefix) const;
   bool limits_reached(const NodeOptions& o, std::int64_t start_ns) const;
 
   lcm_t* lcm_;
-  FlightApp& app_;
-  const hal::ThrusterBank& bank_;
-  SensorFrontEnd& sensors_;
+  FlightComputer& computer_;
+  hal::LcmSensorSource& sensors_;
+  hal::LcmThrusterSink& thrusters_;
   const Clock& clock_;
   lcm_subscription_t* subs_[3]{nullptr, nullptr, nullptr};
-
-  // The newest valid frame not yet ticked.
-  rocksteady::sensor_frame_t scratch_frame_{};
-  rocksteady::sensor_frame_t pending_frame_{};
-  bool have_pending_{false};
-  bool have_seq_{false};
-  std::int64_t last_seq_seen_{-1};
-  bool restarted_{false};
+  std::uint64_t restarts_seen_{0};     // restarts reported as events
+  std::uint64_t restarts_handled_{0};  // restarts the lockstep numbering has followed
 
   rocksteady::ground_cmd_t scratch_cmd_{};
   rocksteady::trajectory_chunk_t scratch_chunk_{};
@@ -139,10 +135,6 @@ class FlightNode {
   rocksteady::cmd_ack_t ack_msg_{};
   rocksteady::event_t event_msg_{};
   rocksteady::gnc_telemetry_t tlm_msg_{};
-  rocksteady::thruster_cmd_t thr_msg_{};
-  hal::ThrusterOutputs thr_out_{};
-  bool have_thr_msg_{false};
-  std::int64_t echo_seq_{0};
   std::uint64_t gnc_cycles_{0};
   std::uint64_t bus_event_seq_{0};
   std::int64_t last_rx_event_ns_[3]{0, 0, 0};

@@ -21,12 +21,12 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
 
-#include "fsw/app/flight_app.hpp"
+#include "fsw/computer/flight_computer.hpp"
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/bus/flight_node.hpp"
 #include "fsw/executive/clock.hpp"
 #include "fsw/config/config_files.hpp"
-#include "hal/thruster_bank.hpp"
+#include "hal/lcm/lcm_ports.hpp"
 
 namespace {
 
@@ -161,32 +161,23 @@ int main(int argc, char** argv) {
   }
 
   fsw::MonotonicClock clock;
-  static fsw::FlightApp app;  // large: static storage, initialised once
-  const fsw::InitResult ir = app.init(fc, clock);
+  // The flight computer and its LCM ports (sensor frames in, thruster commands out; the frames are
+  // aligned with the body frame, so the devices' alignment is the identity).
+  const fsw::FlightComputerConfig cc = fsw::default_computer_config(fc);
+  hal::LcmSensorSource sensors;
+  hal::LcmThrusterSink thrusters(cc.thrusters);
+  static fsw::FlightComputer computer(sensors, thrusters);  // large: static storage, once
+  const fsw::InitResult ir = computer.init(cc, clock);
   if (!ir.ok) {
     std::fprintf(stderr, "rocksteady-fsw: configuration rejected: %s: %s\n", ir.field, ir.reason);
     return 2;
   }
-  hal::ThrusterBank bank;
-  const hal::BankConfigCheck bc =
-      bank.configure(hal::default_thruster_bank_config(fc.gnc.rcs.u_max), &fc.gnc.rcs);
-  if (!bc.ok()) {
-    std::fprintf(stderr, "rocksteady-fsw: thruster bank: %s (channel %d)\n",
-                 hal::to_string(bc.error), bc.channel);
-    return 2;
-  }
-  bus::SensorFrontEnd sensors;
-  const hal::SensorConfig identity{};  // sensor frames are aligned with the body frame
-  if (sensors.configure(identity, identity) != hal::SensorConfigError::kOk) {
-    std::fprintf(stderr, "rocksteady-fsw: sensor configuration rejected\n");
-    return 2;
-  }
-
   lcm_t* lcm = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
   if (lcm == nullptr) {
     std::fprintf(stderr, "rocksteady-fsw: cannot open the LCM bus\n");
     return 3;
   }
+  thrusters.attach(lcm);
   std::vector<std::int64_t> jitter_ns;
   if (jitter && opt.clock == bus::ClockMode::kRealtime) {
     const double base = fc.executive.base_rate_hz;
@@ -201,7 +192,7 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
   int rc = 0;
   {
-    bus::FlightNode node(lcm, app, bank, sensors, clock);
+    bus::FlightNode node(lcm, computer, sensors, thrusters, clock);
     if (!node.subscribe()) {
       std::fprintf(stderr, "rocksteady-fsw: cannot subscribe\n");
       lcm_destroy(lcm);

@@ -279,7 +279,7 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
       req.setup = &setups[c];
       req.model = setups[c].flight;
       plant::Plant probe(setups[c].truth);  // the flight software's first measurement
-      req.omega_init = probe.sample().gyro_rate;
+      req.omega_init = probe.read_sensors().gyro.rate;
       const PlanOutcome o = source.plan(req);
       plans[c] = Plan{o.table, o.note, o.wall_s};
     }

@@ -1,12 +1,16 @@
-// The flight software as the closed-loop runner sees it: one call per GNC tick with the sensor
-// sample, returning the thruster command and telemetry. The default adapter wraps gnc::Gnc; the full
-// flight application (executive + commanding + Gnc) can stand in for it without touching the runner.
+// The flight software as the closed-loop runner sees it: bound to a pair of HAL ports at setup, then
+// one call per GNC tick; it reads its sensors and fires its thrusters through the ports only. The
+// full flight computer (fsw::FlightComputer: devices + executive + commanding + Gnc) is the default;
+// the flight core alone behind the same HAL devices is kept for comparison (--flight core).
 #pragma once
 
 #include <memory>
 #include <string>
 
 #include "gnc/gnc.hpp"
+#include "hal/ports.hpp"
+#include "hal/sensors.hpp"
+#include "hal/thruster_bank.hpp"
 
 namespace rocksteady::campaign {
 
@@ -19,26 +23,40 @@ struct FlightSetup {
 class FlightSide {
  public:
   virtual ~FlightSide() = default;
-  // Before the first tick. Throws std::runtime_error when the flight side rejects the setup.
-  virtual void setup(const FlightSetup& setup) = 0;
-  // One GNC tick.
-  virtual void step(const gnc::SensorSample& sample, gnc::GncOutput& out) = 0;
+  // Before the first tick; the ports must outlive the run. Throws std::runtime_error when the
+  // flight side rejects the setup.
+  virtual void setup(const FlightSetup& setup, hal::SensorSource& sensors,
+                     hal::ThrusterSink& thrusters) = 0;
+  // One GNC tick through the ports.
+  virtual void step() = 0;
+  // The flight core's output of the last tick (telemetry for the runner's time series).
+  virtual const gnc::GncOutput& output() const = 0;
   virtual std::string name() const = 0;
 };
 
-// gnc::Gnc behind the FlightSide interface. It commands start_mode until the core has entered it
-// once (the core boots in IDLE and needs one valid sample first); after that, only the core's own
-// transitions (e.g. DETUMBLE -> HOLD) change the mode.
+// gnc::Gnc alone behind the same HAL devices (gyro, star tracker, thruster bank; no executive, no
+// commanding). It commands start_mode until the core has entered it once (the core boots in IDLE and
+// needs one valid sample first); after that, only the core's own transitions change the mode.
 class GncFlightSide final : public FlightSide {
  public:
   GncFlightSide();
-  void setup(const FlightSetup& setup) override;
-  void step(const gnc::SensorSample& sample, gnc::GncOutput& out) override;
+  void setup(const FlightSetup& setup, hal::SensorSource& sensors,
+             hal::ThrusterSink& thrusters) override;
+  void step() override;
+  const gnc::GncOutput& output() const override { return out_; }
   std::string name() const override { return "gnc::Gnc"; }
   const gnc::Gnc& core() const { return *gnc_; }
 
  private:
   std::unique_ptr<gnc::Gnc> gnc_;  // large (the trajectory table): on the heap, ground side
+  hal::SensorSource* sensors_{nullptr};
+  hal::ThrusterSink* thrusters_{nullptr};
+  hal::Gyro gyro_{};
+  hal::StarTracker star_{};
+  hal::ThrusterBank bank_{};
+  hal::RawSensors frame_{};
+  hal::ThrusterOutputs thruster_out_{};
+  gnc::GncOutput out_{};
   gnc::Mode start_mode_{gnc::Mode::kDetumble};
   bool started_{false};
   int attempts_{0};

@@ -5,29 +5,10 @@
 #include <cmath>
 #include <exception>
 
+#include "ground/campaign/plant_binding.hpp"
 #include "ground/plant/plant.hpp"
 
 namespace rocksteady::campaign {
-
-void ConvergenceTracker::add(double t, double value, double fuel_kg) {
-  const bool ok = value <= tol_;
-  if (ok && (!have_ || !last_ok_)) {  // start of a (possibly final) satisfied stretch
-    t_ = t;
-    fuel_ = fuel_kg;
-  }
-  last_ok_ = ok;
-  have_ = true;
-}
-
-std::optional<double> ConvergenceTracker::time() const {
-  if (!converged()) return std::nullopt;
-  return t_;
-}
-
-std::optional<double> ConvergenceTracker::fuel_kg() const {
-  if (!converged()) return std::nullopt;
-  return fuel_;
-}
 
 const char* to_string(RunStatus s) {
   switch (s) {
@@ -36,13 +17,6 @@ const char* to_string(RunStatus s) {
     case RunStatus::kError: return "error";
   }
   return "?";
-}
-
-double attitude_error(const Eigen::Vector3d& q, const Eigen::Vector3d& q_final) {
-  const double n = q_final.squaredNorm();
-  if (n == 0.0) return q.norm();
-  const Eigen::Vector3d shadow = -q_final / n;  // the same attitude, other MRP set
-  return std::min((q - q_final).norm(), (q - shadow).norm());
 }
 
 gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& strategy) {
@@ -66,11 +40,12 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   const auto wall0 = std::chrono::steady_clock::now();
 
   plant::Plant plant(setup.truth);
+  PlantBinding ports(plant);
   FlightSetup fs;
   fs.params = flight_params(setup, strategy);
   fs.start_mode = strategy.needs_trajectory() ? gnc::Mode::kTrack : gnc::Mode::kDetumble;
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;
-  flight.setup(fs);
+  flight.setup(fs, ports, ports);
 
   const double dt = setup.truth.control_period_s;
   const double duration = options.duration_s >= 0.0 ? options.duration_s : setup.duration_s;
@@ -85,8 +60,6 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
 
   ConvergenceTracker omega_conv(setup.omega_tol_rad_s);
   ConvergenceTracker q_conv(setup.q_tol);
-  gnc::GncOutput out;
-
   auto record = [&](const gnc::GncOutput& o) {
     TimeRow row;
     row.t = plant.t();
@@ -95,8 +68,9 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     row.omega_hat = o.telemetry.omega_hat;
     row.q_hat = o.telemetry.q_hat;
     row.torque_cmd = o.telemetry.alloc.torque_requested;
-    // Channel forces commanded at t (the plant applies them, clipped at u_max, until t + dt).
-    row.force = o.command.enabled ? o.command.force : gnc::Vec8::Zero();
+    // Channel forces of the thrusters fired at t (the plant applies them, clipped at u_max, until
+    // t + dt).
+    row.force = ports.channel_forces();
     row.fuel_kg = plant.fuel_kg();
     row.fuel_hat_kg = o.telemetry.fuel_kg;
     row.mode = o.telemetry.mode;
@@ -110,13 +84,13 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
 
   std::uint64_t pending_progress = 0;
   for (std::uint64_t k = 0; k < n_ticks; ++k) {
-    const gnc::SensorSample sample = plant.sample();
-    flight.step(sample, out);
+    flight.step();
+    const gnc::GncOutput& out = flight.output();
     if (log_every != 0 && k % log_every == 0) {
       // The row at time t_k: the state, the estimate and the command computed from it.
       record(out);
     }
-    plant.advance(out.command.force, out.command.enabled);
+    ports.advance();
     if (out.telemetry.alloc.saturated) ++r.saturated_ticks;
 
     const double w = plant.omega().norm();
@@ -138,6 +112,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   if (options.progress_ticks != nullptr) {
     options.progress_ticks->fetch_add(pending_progress, std::memory_order_relaxed);
   }
+  const gnc::GncOutput& out = flight.output();
   if (log_every != 0) record(out);  // the final state
 
   r.t_omega_conv_s = omega_conv.time();

@@ -13,25 +13,13 @@
 #include "ground/campaign/flight_side.hpp"
 #include "ground/campaign/strategy.hpp"
 #include "ground/config/config.hpp"
+#include "ground/merit/figures_of_merit.hpp"
 
 namespace rocksteady::campaign {
 
-// SPEC §7: the least time after which value(t) <= tol for all later t, and the fuel used by then.
-class ConvergenceTracker {
- public:
-  explicit ConvergenceTracker(double tol) : tol_(tol) {}
-  void add(double t, double value, double fuel_kg);
-  bool converged() const { return have_ && last_ok_; }  // NC otherwise
-  std::optional<double> time() const;
-  std::optional<double> fuel_kg() const;
-
- private:
-  double tol_;
-  bool have_{false};
-  bool last_ok_{false};
-  double t_{0.0};
-  double fuel_{0.0};
-};
+// The figures of merit live in ground/merit (the plant process uses them too).
+using merit::attitude_error;
+using merit::ConvergenceTracker;
 
 struct TimeRow {
   double t{0.0};
@@ -91,7 +79,5 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
 // The flight parameters of a strategy: the case's GncParams with the strategy's law.
 gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& strategy);
 
-// |q - q_final| with q_final expressed in the set nearest q (both MRPs), SPEC §1 and §7.
-double attitude_error(const Eigen::Vector3d& q, const Eigen::Vector3d& q_final);
 
 }  // namespace rocksteady::campaign

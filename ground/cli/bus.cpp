@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "ground/cli/dictionary.hpp"
-#include "hal/lcm/codec.hpp"
-#include "hal/lcm/uplink.hpp"
+#include "wire/codec.hpp"
+#include "wire/uplink.hpp"
 #include "lcmtypes/channels.hpp"
 
 namespace rocksteady::ground::cli {
 
-namespace wire = hal::wire;
+// (the bus library is rocksteady::wire)
 using Clock = std::chrono::steady_clock;
 
 namespace {

@@ -1,6 +1,6 @@
 // The CLI's bus procedures: send one command and wait for its acknowledgement, uplink a trajectory
 // table in chunks and wait until the flight has all of them, and the live monitor. Every inbound
-// message is decoded with hal::wire::safe_decode from a raw-buffer subscription.
+// message is decoded with wire::safe_decode from a raw-buffer subscription.
 #pragma once
 
 #include <cstdint>
@@ -27,7 +27,7 @@ struct SendResult {
   rocksteady::cmd_ack_t ack{};  // the matching acknowledgement (accepted / rejected)
   std::string error;            // kError: what failed
   std::uint64_t other_acks{0};  // acknowledgements of other commands seen meanwhile
-  hal::wire::RxCounters rx{};   // decode outcomes on RS_CMD_ACK
+  wire::RxCounters rx{};   // decode outcomes on RS_CMD_ACK
   int exit_code() const;
 };
 

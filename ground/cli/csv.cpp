@@ -10,7 +10,7 @@
 
 namespace rocksteady::ground::cli {
 
-namespace wire = hal::wire;
+// (the bus library is rocksteady::wire)
 
 namespace {
 

@@ -1,5 +1,5 @@
 // Bus messages as CSV rows, and log2csv: an LCM log (lcm-logger's format, read with lcm::LogFile)
-// converted one channel at a time. Every event is decoded with hal::wire::safe_decode; whatever
+// converted one channel at a time. Every event is decoded with wire::safe_decode; whatever
 // fails (truncated, wrong type, out-of-range fields) is counted and left out, never guessed at.
 // Columns: log_utime (the log's receive time, microseconds since the epoch), then every field of
 // the message in the order of its .lcm file; arrays are expanded as name_0, name_1, ... (two
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
 namespace rocksteady::ground::cli {
 
@@ -24,7 +24,7 @@ std::vector<std::string> csv_header(const std::string& channel);
 
 // One message's row, or false (and the reason in `status`) if it does not decode safely.
 bool csv_row(const std::string& channel, const void* data, int len, std::int64_t log_utime,
-             std::vector<std::string>& row, hal::wire::DecodeStatus& status);
+             std::vector<std::string>& row, wire::DecodeStatus& status);
 
 // CSV text of one row (quoted where needed), with the line break.
 std::string csv_line(const std::vector<std::string>& cells);
@@ -33,7 +33,7 @@ struct Log2CsvStats {
   std::uint64_t events{0};      // events in the log
   std::uint64_t on_channel{0};  // events of the chosen channel
   std::uint64_t written{0};     // rows written
-  hal::wire::RxCounters rx{};   // decode outcomes of the channel's events
+  wire::RxCounters rx{};   // decode outcomes of the channel's events
   std::uint64_t rejected() const { return on_channel - written; }
 };
 
@@ -42,6 +42,6 @@ struct Log2CsvStats {
 Log2CsvStats log2csv(const std::string& log_path, const std::string& channel, std::ostream& out);
 
 // "3 rejected: 2 too short, 1 bad fingerprint" (only the non-zero causes).
-std::string describe_rejections(const hal::wire::RxCounters& rx);
+std::string describe_rejections(const wire::RxCounters& rx);
 
 }  // namespace rocksteady::ground::cli

@@ -26,7 +26,7 @@
 #include "ground/cli/sequence_store.hpp"
 #include "ground/cli/trajectory_input.hpp"
 #include "ground/planner/planner.hpp"
-#include "hal/lcm/uplink.hpp"
+#include "wire/uplink.hpp"
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONFIG
 #include "ground/config/config.hpp"
 #endif
@@ -197,7 +197,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
                path.c_str(), loaded.file.case_name.c_str(), table->count, loaded.file.t_final,
                loaded.file.fuel_kg, id);
   if (a.dry_run || lcm == nullptr) {
-    std::printf("DRY RUN: %d chunks\n", rocksteady::hal::wire::chunk_count(table->count));
+    std::printf("DRY RUN: %d chunks\n", rocksteady::wire::chunk_count(table->count));
     return cli::kExitAccepted;
   }
   cli::UploadOptions options;

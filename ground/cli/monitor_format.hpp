@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
 namespace rocksteady::ground::cli {
 
@@ -15,7 +15,7 @@ struct MonitorCounts {
   std::uint64_t telemetry{0};
   std::uint64_t events{0};
   std::uint64_t acks{0};
-  hal::wire::RxCounters rx{};  // the monitor's own decode outcomes over the three channels
+  wire::RxCounters rx{};  // the monitor's own decode outcomes over the three channels
 };
 
 // Attitude error as an angle: 4 atan(|q|) for an MRP q, in degrees.

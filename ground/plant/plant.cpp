@@ -101,7 +101,7 @@ void Plant::reset() {
   disturbance_index_ = -1;
   have_sample_ = false;
   sample_tick_ = 0;
-  held_ = gnc::SensorSample{};
+  held_ = hal::RawSensors{};
   gyro_rng_.seed(stream_seed(p_.seed, kGyroStream));
   star_rng_.seed(stream_seed(p_.seed, kStarStream));
   dist_rng_.seed(stream_seed(p_.seed, kDisturbanceStream));
@@ -163,31 +163,62 @@ void Plant::advance(const Vec8& force, bool enabled) {
   ++ticks_;
 }
 
-gnc::SensorSample Plant::sample() {
-  if (have_sample_ && ticks_ - sample_tick_ < sensor_every_) return held_;
+void Plant::advance(const hal::ThrusterOutputs& thrusters) {
+  advance(channel_forces(thrusters), thrusters.enabled);
+}
+
+Vec8 Plant::channel_forces(const hal::ThrusterOutputs& thrusters) {
+  // The plant's own SPEC §4 wiring (not the flight software's bank): channel 2k = pod k positions
+  // 0 (+) and 1 (-), channel 2k+1 = positions 2 (+) and 3 (-); thruster = 4 pod + position.
+  Vec8 u = Vec8::Zero();
+  if (thrusters.enabled) {
+    auto f = [&](int pod, int position) {
+      const auto i = static_cast<std::size_t>(hal::thruster_index(pod, position));
+      return thrusters.on[i] ? thrusters.force[i] : 0.0;
+    };
+    for (int pod = 0; pod < gnc::kPods; ++pod) {
+      u(2 * pod) = f(pod, 0) - f(pod, 1);
+      u(2 * pod + 1) = f(pod, 2) - f(pod, 3);
+    }
+  }
+  return u;
+}
+
+hal::RawSensors Plant::read_sensors() {
+  hal::RawSensors frame;
+  frame.seq = static_cast<std::int64_t>(ticks_);
+  frame.t = t();
+  if (have_sample_ && ticks_ - sample_tick_ < sensor_every_) {
+    frame.gyro = held_.gyro;
+    frame.star = held_.star;
+    return frame;
+  }
   have_sample_ = true;
   sample_tick_ = ticks_;
   const double ts = p_.sensors.period_s;
   const double sigma_w = std::sqrt(p_.sensors.gyro_psd / ts);  // band-limited white noise
   const double sigma_q = std::sqrt(p_.sensors.star_psd / ts);
 
-  gnc::SensorSample s;
-  s.t = t();
-  s.gyro_rate = omega_;
+  // The sensors are aligned with the body frame and sample at the frame time.
+  hal::GyroReading& g = frame.gyro;
+  g.t = frame.t;
+  g.rate = omega_;
   if (sigma_w > 0.0) {
-    for (int a = 0; a < 3; ++a) s.gyro_rate(a) += sigma_w * gyro_normal_(gyro_rng_);
+    for (int a = 0; a < 3; ++a) g.rate(a) += sigma_w * gyro_normal_(gyro_rng_);
   }
-  s.gyro_valid = true;
+  g.valid = true;
+  hal::StarTrackerReading& st = frame.star;
+  st.t = frame.t;
   Vec3 q = mrp();
   if (sigma_q > 0.0) {
     for (int a = 0; a < 3; ++a) q(a) += sigma_q * star_normal_(star_rng_);
-    s.star_quat = att::mrp_to_quat(q);
+    st.quat = att::mrp_to_quat(q);
   } else {
-    s.star_quat = beta_(3) < 0.0 ? Vec4(-beta_) : beta_;
+    st.quat = beta_(3) < 0.0 ? Vec4(-beta_) : beta_;
   }
-  s.star_valid = true;
-  held_ = s;
-  return s;
+  st.valid = true;
+  held_ = frame;
+  return frame;
 }
 
 }  // namespace rocksteady::plant

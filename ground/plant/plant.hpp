@@ -17,10 +17,10 @@
 #include <cstdint>
 #include <random>
 
-#include "gnc/gnc.hpp"
 #include "gnc/model/mass_properties.hpp"
 #include "gnc/model/rcs.hpp"
 #include "ground/plant/attitude.hpp"
+#include "hal/readings.hpp"
 
 namespace rocksteady::plant {
 
@@ -66,9 +66,16 @@ class Plant {
   // (and the disturbance) for the period, RK4 with `substeps` steps, integrate fuel (Eq. 54).
   void advance(const Vec8& force, bool enabled);
 
-  // The sensor sample the flight software receives now: a fresh one at each sensor period, the
-  // held one in between. Its `t` is the time the sample was taken.
-  gnc::SensorSample sample();
+  // The same with the 16 physical thrusters as the flight computer fires them (the plant's own
+  // SPEC §4 wiring maps them onto the channels; nothing fires when !thrusters.enabled).
+  void advance(const hal::ThrusterOutputs& thrusters);
+  // That mapping: the signed channel forces of a thruster firing (zeros when disabled).
+  static Vec8 channel_forces(const hal::ThrusterOutputs& thrusters);
+
+  // The device readings the sensors deliver now, as one frame numbered by the control period: a
+  // fresh gyro and star-tracker reading at each sensor period, the held ones in between (their `t`
+  // is the time they were taken).
+  hal::RawSensors read_sensors();
 
   // Truth.
   double t() const { return static_cast<double>(ticks_) * p_.control_period_s; }
@@ -112,7 +119,7 @@ class Plant {
 
   bool have_sample_{false};
   std::uint64_t sample_tick_{0};
-  gnc::SensorSample held_{};
+  hal::RawSensors held_{};
 
   std::mt19937_64 gyro_rng_;
   std::mt19937_64 star_rng_;

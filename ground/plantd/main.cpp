@@ -10,7 +10,8 @@
 //   realtime: advance on wall-clock deadlines with the newest command received (zero-order hold).
 // The plant commands nothing itself: mode commands come from the operator, a test or a script.
 // At the end, --summary prints the study's figures of merit (SPEC §7), computed on the true state
-// exactly as the in-process runner does (campaign::ConvergenceTracker, attitude_error).
+// exactly as the in-process runner does (ground/merit). The plant links no flight software: it speaks
+// device readings (hal/readings.hpp) through the bus library (wire/).
 #include <poll.h>
 
 #include <algorithm>
@@ -28,10 +29,11 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
 
-#include "ground/campaign/runner.hpp"
 #include "ground/config/config.hpp"
+#include "ground/merit/figures_of_merit.hpp"
 #include "ground/plant/plant.hpp"
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
+#include "wire/convert.hpp"
 #include "lcmtypes/channels.hpp"
 
 namespace {
@@ -60,26 +62,13 @@ std::string case_file(const std::string& config_dir, const std::string& arg) {
 // Plant events on RS_EVENTS (ids from 1000).
 enum PlantEvent : std::int32_t { kRunStarted = 1000, kEchoTimeout = 1001, kRunFinished = 1002 };
 
-// SPEC §4 wiring, the plant's own: channel 2k = pod k positions 0 (+) and 1 (-), channel 2k+1 =
-// positions 2 (+) and 3 (-); physical thruster = 4 pod + position.
-plant::Vec8 channel_forces_from_thrusters(const rocksteady::thruster_cmd_t& m) {
-  plant::Vec8 u = plant::Vec8::Zero();
-  if (m.enabled == 0) return u;
-  auto f = [&](int i) { return m.thruster_on[i] != 0 ? m.thruster_force[i] : 0.0; };
-  for (int pod = 0; pod < 4; ++pod) {
-    u(2 * pod) = f(4 * pod + 0) - f(4 * pod + 1);
-    u(2 * pod + 1) = f(4 * pod + 2) - f(4 * pod + 3);
-  }
-  return u;
-}
-
 struct Bus {
   lcm_t* lcm{nullptr};
   rocksteady::thruster_cmd_t scratch{};
   rocksteady::gnc_telemetry_t tlm{};
   bool have_cmd{false};
   rocksteady::thruster_cmd_t latest{};  // newest valid command
-  hal::wire::RxCounters rx{};
+  wire::RxCounters rx{};
   std::uint64_t commands{0};
   bool have_tlm{false};
   int last_mode{-1};
@@ -89,7 +78,7 @@ struct Bus {
 
   static void on_cmd(const lcm_recv_buf_t* rbuf, const char* /*ch*/, void* self) {
     auto& b = *static_cast<Bus*>(self);
-    if (!hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.scratch, &b.rx)) {
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.scratch, &b.rx)) {
       return;  // counted, ignored
     }
     ++b.commands;
@@ -98,14 +87,14 @@ struct Bus {
   }
   static void on_tlm(const lcm_recv_buf_t* rbuf, const char* /*ch*/, void* self) {
     auto& b = *static_cast<Bus*>(self);
-    if (hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.tlm)) {
+    if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.tlm)) {
       b.have_tlm = true;
       b.last_mode = b.tlm.mode;
       b.fuel_hat = b.tlm.fuel_kg;
     }
   }
   template <class T> void publish(const char* channel, const T& msg) {
-    const int n = hal::wire::encode(msg, buf, static_cast<int>(sizeof buf));
+    const int n = wire::encode(msg, buf, static_cast<int>(sizeof buf));
     if (n > 0) lcm_publish(lcm, channel, buf, static_cast<unsigned int>(n));
   }
   // One message dispatched or the deadline passed. False on a bus error.
@@ -125,7 +114,7 @@ struct Bus {
   }
   void event(std::int8_t sev, std::int32_t id, std::int32_t a0, std::int32_t a1, double t,
              const std::string& text) {
-    auto e = hal::wire::make<rocksteady::event_t>();
+    auto e = wire::make<rocksteady::event_t>();
     e.t = t;
     e.seq = event_seq++;
     e.severity = sev;
@@ -137,22 +126,8 @@ struct Bus {
   }
 };
 
-rocksteady::sensor_frame_t make_frame(std::int64_t seq, double t, const gnc::SensorSample& s) {
-  auto m = hal::wire::make<rocksteady::sensor_frame_t>();
-  m.seq = seq;
-  m.t = t;
-  // The plant's sensors are aligned with the body frame (the fsw's alignment is the identity).
-  m.gyro_t = s.t;
-  for (int i = 0; i < 3; ++i) m.gyro_rate[i] = s.gyro_rate(i);
-  m.gyro_valid = s.gyro_valid ? 1 : 0;
-  m.star_t = s.t;
-  for (int i = 0; i < 4; ++i) m.star_quat[i] = s.star_quat(i);
-  m.star_valid = s.star_valid ? 1 : 0;
-  return m;
-}
-
 rocksteady::plant_truth_t make_truth(std::int64_t seq, const plant::Plant& p) {
-  auto m = hal::wire::make<rocksteady::plant_truth_t>();
+  auto m = wire::make<rocksteady::plant_truth_t>();
   m.seq = seq;
   m.t = p.t();
   for (int i = 0; i < 4; ++i) m.quat[i] = p.beta()(i);
@@ -266,18 +241,17 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
-  campaign::ConvergenceTracker omega_conv(setup.omega_tol_rad_s);
-  campaign::ConvergenceTracker q_conv(setup.q_tol);
+  merit::ConvergenceTracker omega_conv(setup.omega_tol_rad_s);
+  merit::ConvergenceTracker q_conv(setup.q_tol);
   omega_conv.add(0.0, plant.omega().norm(), 0.0);
-  q_conv.add(0.0, campaign::attitude_error(plant.mrp(), q_final), 0.0);
+  q_conv.add(0.0, merit::attitude_error(plant.mrp(), q_final), 0.0);
   double max_rate = plant.omega().norm();
 
   std::uint64_t timeouts = 0, resends = 0, holds = 0, stale = 0, wiring_mismatch = 0, applied = 0;
   std::uint64_t fresh_periods = 0;
   bool started = !lockstep;
   bool bus_error = false;
-  plant::Vec8 u = plant::Vec8::Zero();
-  bool enabled = false;
+  hal::ThrusterOutputs thrusters{};  // held over each period (zero-order hold)
   const auto timeout_ns = static_cast<std::int64_t>(timeout_ms * 1e6);
   const auto period_ns = static_cast<std::int64_t>(std::llround(dt * 1e9));
   bus.event(rocksteady::event_t::SEV_INFO, kRunStarted, 0, 0, 0.0,
@@ -293,8 +267,7 @@ int main(int argc, char** argv) {
   const std::int64_t rt_start = now_ns();
   std::uint64_t k = 0;
   for (; k < n_ticks && g_stop == 0; ++k) {
-    const gnc::SensorSample s = plant.sample();
-    const rocksteady::sensor_frame_t frame = make_frame(static_cast<std::int64_t>(k), plant.t(), s);
+    const rocksteady::sensor_frame_t frame = wire::to_message(plant.read_sensors());
     bus.publish(channels::kSensors, frame);
     if (truth_every > 0 && k % truth_every == 0) {
       bus.publish(channels::kPlantTruth, make_truth(static_cast<std::int64_t>(k), plant));
@@ -354,15 +327,15 @@ int main(int argc, char** argv) {
       }
       started = true;
       if (got) {
-        const plant::Vec8 from_thrusters = channel_forces_from_thrusters(bus.latest);
+        thrusters = wire::to_outputs(bus.latest);
+        const plant::Vec8 from_thrusters = plant::Plant::channel_forces(thrusters);
         for (int i = 0; i < 8; ++i) {
-          if (std::fabs(from_thrusters(i) - bus.latest.channel_force[i]) > 1e-9 * (1.0 + std::fabs(from_thrusters(i)))) {
+          if (std::fabs(from_thrusters(i) - bus.latest.channel_force[i]) >
+              1e-9 * (1.0 + std::fabs(from_thrusters(i)))) {
             ++wiring_mismatch;
             break;
           }
         }
-        u = from_thrusters;
-        enabled = bus.latest.enabled != 0;
         ++applied;
       } else if (g_stop == 0) {
         ++holds;
@@ -379,8 +352,7 @@ int main(int argc, char** argv) {
         }
         if (bus.have_cmd) {
           bus.have_cmd = false;
-          u = channel_forces_from_thrusters(bus.latest);
-          enabled = bus.latest.enabled != 0;
+          thrusters = wire::to_outputs(bus.latest);
           ++applied;
           if (bus.latest.seq == static_cast<std::int64_t>(k)) fresh = true;
         }
@@ -394,11 +366,11 @@ int main(int argc, char** argv) {
     }
     if (g_stop != 0) break;
 
-    plant.advance(u, enabled);
+    plant.advance(thrusters);
     const double w = plant.omega().norm();
     const double t = plant.t();
     omega_conv.add(t, w, plant.fuel_kg());
-    q_conv.add(t, campaign::attitude_error(plant.mrp(), q_final), plant.fuel_kg());
+    q_conv.add(t, merit::attitude_error(plant.mrp(), q_final), plant.fuel_kg());
     max_rate = std::max(max_rate, w);
     if (verbose && now_ns() - last_progress >= kNsPerS) {
       last_progress = now_ns();
@@ -430,7 +402,7 @@ int main(int argc, char** argv) {
     std::printf("  total fuel          %.3f kg (flight estimate %.3f kg)\n", plant.fuel_kg(),
                 bus.fuel_hat);
     std::printf("  max |omega|         %.5f rad/s, final %.3e rad/s, final |q - q_final| %.3e\n",
-                max_rate, plant.omega().norm(), campaign::attitude_error(plant.mrp(), q_final));
+                max_rate, plant.omega().norm(), merit::attitude_error(plant.mrp(), q_final));
     std::printf("  flight mode (last telemetry) %s\n", mode_name);
     std::printf("  bus: commands %" PRIu64 " applied %" PRIu64 ", echo timeouts %" PRIu64
                 ", resends %" PRIu64 ", held periods %" PRIu64 ", stale %" PRIu64
@@ -444,7 +416,7 @@ int main(int argc, char** argv) {
                 setup.case_number, mode.c_str(), plant.ticks(), exact(omega_conv.time()).c_str(),
                 exact(omega_conv.fuel_kg()).c_str(), exact(q_conv.time()).c_str(),
                 exact(q_conv.fuel_kg()).c_str(), plant.fuel_kg(), plant.omega().norm(),
-                campaign::attitude_error(plant.mrp(), q_final), mode_name, timeouts, resends, holds,
+                merit::attitude_error(plant.mrp(), q_final), mode_name, timeouts, resends, holds,
                 bus.rx.rejected(), fresh_periods, wall);
     std::fflush(stdout);
   }

@@ -1,16 +1,21 @@
 #include "hal/lcm/lcm_ports.hpp"
 
-#include "hal/lcm/convert.hpp"
+#include "lcmtypes/channels.hpp"
+#include "wire/convert.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::hal {
 
 bool LcmSensorSource::on_message(const void* buf, int len) {
-  if (!safe_decode(buf, len, scratch_, &counters_)) return false;
-  if (scratch_.seq <= last_seq_) {
-    ++out_of_order_;
-    return false;
+  if (!wire::safe_decode(buf, len, scratch_, &counters_)) return false;
+  ++frames_;
+  if (have_seq_ && scratch_.seq < last_seq_) {
+    ++restarts_;
+    restart_pending_ = true;  // carried by the next frame polled
   }
-  latest_ = to_raw(scratch_);
+  if (fresh_) ++superseded_;
+  latest_ = wire::to_raw(scratch_);
+  latest_.stream_restart = restart_pending_;
+  have_seq_ = true;
   last_seq_ = scratch_.seq;
   fresh_ = true;
   return true;
@@ -20,12 +25,25 @@ bool LcmSensorSource::poll(RawSensors& out) {
   if (!fresh_) return false;
   out = latest_;
   fresh_ = false;
+  restart_pending_ = false;
   return true;
 }
 
 void LcmThrusterSink::write(const ThrusterOutputs& outputs, std::int64_t seq, double t) {
-  const rocksteady::thruster_cmd_t msg = to_message(outputs, bank_.channel_forces(outputs), seq, t);
-  if (bus_.publish(channels::kThrusterCmd, &msg) != 0) ++publish_errors_;
+  msg_ = wire::to_message(outputs, channel_forces(wiring_, outputs), seq, t);
+  written_ = true;
+  publish();
 }
 
-}  // namespace rocksteady::hal::wire
+void LcmThrusterSink::republish() {
+  if (written_) publish();
+}
+
+void LcmThrusterSink::publish() {
+  const int n = wire::encode(msg_, buf_, static_cast<int>(sizeof buf_));
+  if (n < 0 || bus_ == nullptr || lcm_publish(bus_, channels::kThrusterCmd, buf_, static_cast<unsigned int>(n)) != 0) {
+    ++publish_errors_;
+  }
+}
+
+}  // namespace rocksteady::hal

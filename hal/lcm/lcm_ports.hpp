@@ -1,60 +1,76 @@
-// LCM back end, bus half: the HAL ports over LCM for processor-in-the-loop runs.
+// The HAL's LCM device back end (processor-in-the-loop): the two ports over the bus.
 // Subscribe with the raw-buffer handler and feed LcmSensorSource::on_message(): a malformed packet is
-// counted and dropped, never thrown through LCM's dispatcher (ENVIRONMENT.md). Example:
-//   LcmSensorSource sensors;
-//   bus.subscribe(channels::kSensors, &LcmSensorSource::handle, &sensors);
+// counted and dropped, never thrown through LCM's dispatcher (ENVIRONMENT.md). Decoding and the
+// message <-> reading mapping are the bus library's (wire/); this file only holds the devices' side.
 #pragma once
 
 #include <cstdint>
 
-#include <lcm/lcm-cpp.hpp>
+#include <lcm/lcm.h>
 
-#include "hal/lcm/codec.hpp"
 #include "hal/ports.hpp"
+#include "hal/thruster_bank.hpp"
+#include "wire/codec.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::hal {
 
 class LcmSensorSource final : public SensorSource {
  public:
-  // Raw bytes of one RS_SENSORS message. Returns true if it was accepted.
+  // Raw bytes of one RS_SENSORS message. Returns true if it was decoded and kept as the newest
+  // frame. A frame whose seq goes backwards is a restarted stream: it is kept, flagged
+  // stream_restart, and counted in restarts().
   bool on_message(const void* buf, int len);
-  // Signature of lcm::LCM::subscribe's raw-buffer handler.
-  void handle(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-    on_message(rbuf->data, static_cast<int>(rbuf->data_size));
-  }
 
-  // The newest accepted frame, if any arrived since the last poll. A frame whose seq is not newer
-  // than the last one delivered is dropped (counted in out_of_order()).
+  // The newest kept frame, if one arrived since the last poll (an older unpolled one is superseded,
+  // counted in superseded()).
   bool poll(RawSensors& out) override;
-  // Forget the last seq (a restarted plant counts from 0 again).
-  void reset() {
-    fresh_ = false;
-    last_seq_ = -1;
-  }
 
-  const RxCounters& counters() const { return counters_; }
-  std::uint64_t out_of_order() const { return out_of_order_; }
+  // For a lockstep loop: is a frame waiting, and which one.
+  bool pending() const { return fresh_; }
+  std::int64_t pending_seq() const { return latest_.seq; }
+  // Drop the waiting frame without ticking (a resent frame already answered).
+  void drop() { fresh_ = false; }
+
+  const wire::RxCounters& counters() const { return counters_; }
+  std::uint64_t frames() const { return frames_; }
+  std::uint64_t restarts() const { return restarts_; }
+  std::uint64_t superseded() const { return superseded_; }
 
  private:
   rocksteady::sensor_frame_t scratch_{};
   RawSensors latest_{};
   bool fresh_{false};
+  bool have_seq_{false};
   std::int64_t last_seq_{-1};
-  RxCounters counters_{};
-  std::uint64_t out_of_order_{0};
+  bool restart_pending_{false};
+  wire::RxCounters counters_{};
+  std::uint64_t frames_{0};
+  std::uint64_t restarts_{0};
+  std::uint64_t superseded_{0};
 };
 
 class LcmThrusterSink final : public ThrusterSink {
  public:
-  // `bank` converts the outputs back to channel forces for the message; both must outlive the sink.
-  LcmThrusterSink(lcm::LCM& bus, const ThrusterBank& bank) : bus_(bus), bank_(bank) {}
+  // `wiring` maps the thrusters back to the channel forces the message also carries. Publishes on
+  // `bus` once attached (before that, a write is counted as a publish error).
+  explicit LcmThrusterSink(const ThrusterBankConfig& wiring, lcm_t* bus = nullptr)
+      : bus_(bus), wiring_(wiring) {}
+  void attach(lcm_t* bus) { bus_ = bus; }
   void write(const ThrusterOutputs& outputs, std::int64_t seq, double t) override;
+  // Publish the last command again (lockstep: the plant resent a frame that was already answered).
+  void republish();
+  bool written() const { return written_; }
   std::uint64_t publish_errors() const { return publish_errors_; }
 
  private:
-  lcm::LCM& bus_;
-  const ThrusterBank& bank_;
+  void publish();
+
+  lcm_t* bus_;
+  ThrusterBankConfig wiring_;
+  rocksteady::thruster_cmd_t msg_{};
+  bool written_{false};
+  unsigned char buf_[1024]{};
   std::uint64_t publish_errors_{0};
 };
 
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::hal

@@ -137,24 +137,39 @@ TEST(ClosedLoop, SameSeedSameBits) {
   EXPECT_NE(c.total_fuel_kg, a.total_fuel_kg);
 }
 
-// A flight side that never fires: the plant coasts torque-free (no disturbance in this setup).
+// A flight side that never fires: the plant coasts torque-free (no disturbance in this setup). It
+// sees the plant only through the harness's ports.
 class SilentFlight final : public FlightSide {
  public:
-  void setup(const FlightSetup& s) override {
+  void setup(const FlightSetup& s, hal::SensorSource& sensors, hal::ThrusterSink& thrusters) override {
     ++setups;
     start = s.start_mode;
+    sensors_ = &sensors;
+    thrusters_ = &thrusters;
   }
-  void step(const gnc::SensorSample& sample, gnc::GncOutput& out) override {
-    EXPECT_NEAR(sample.t, 0.1 * steps, 1e-9);  // one sample per tick, in lockstep
+  void step() override {
+    hal::RawSensors frame;
+    EXPECT_TRUE(sensors_->poll(frame));  // one frame per tick, in lockstep
+    EXPECT_FALSE(sensors_->poll(frame));  // and only one
+    EXPECT_EQ(frame.seq, steps);
+    EXPECT_NEAR(frame.t, 0.1 * steps, 1e-9);
     ++steps;
-    out = gnc::GncOutput{};
-    out.command.force.setConstant(50.0);
-    out.command.enabled = false;  // inhibited: the plant must not fire
+    hal::ThrusterOutputs o;
+    o.on.fill(true);
+    o.force.fill(50.0);
+    o.enabled = false;  // inhibited: the plant must not fire
+    thrusters_->write(o, frame.seq, frame.t);
   }
+  const gnc::GncOutput& output() const override { return out_; }
   std::string name() const override { return "silent"; }
   int setups{0};
   int steps{0};
   gnc::Mode start{gnc::Mode::kIdle};
+
+ private:
+  hal::SensorSource* sensors_{nullptr};
+  hal::ThrusterSink* thrusters_{nullptr};
+  gnc::GncOutput out_{};
 };
 
 TEST(ClosedLoop, RunnerDrivesAnyFlightSideInLockstep) {

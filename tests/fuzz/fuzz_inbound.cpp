@@ -1,4 +1,4 @@
-// libFuzzer targets over every inbound bus decoder (hal/lcm/codec.hpp) and what consumes the decoded
+// libFuzzer targets over every inbound bus decoder (wire/codec.hpp) and what consumes the decoded
 // message next: the sensor layer, the thruster bank, the flight application's command validator and
 // trajectory uplink. One source, one target per build (ROCKSTEADY_FUZZ_TARGET):
 //   1 sensor_frame_t   2 thruster_cmd_t   3 ground_cmd_t   4 trajectory_chunk_t
@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "hal/lcm/codec.hpp"
-#include "hal/lcm/convert.hpp"
-#include "hal/lcm/uplink.hpp"
+#include "wire/codec.hpp"
+#include "wire/convert.hpp"
+#include "wire/uplink.hpp"
 #include "hal/sensors.hpp"
 #include "hal/thruster_bank.hpp"
 
@@ -28,7 +28,7 @@
 #endif
 
 namespace rs = rocksteady;
-namespace wire = rocksteady::hal::wire;
+namespace wire = rocksteady::wire;
 
 namespace {
 
@@ -85,9 +85,10 @@ void use_frame(const rs::sensor_frame_t& m) {
     configured = true;
   }
   const rs::hal::RawSensors raw = wire::to_raw(m);
-  const auto r = gyro.read(raw.gyro, raw.t);
-  const auto a = star.read(raw.star, raw.t);
-  const rs::gnc::SensorSample s = rs::hal::make_sample(raw.t, r, a);
+  rs::gnc::SensorSample s;
+  s.t = raw.t;
+  gyro.read(raw.gyro, raw.t, s);
+  star.read(raw.star, raw.t, s);
   require(!s.gyro_valid || s.gyro_rate.allFinite());
   require(!s.star_valid || s.star_quat.allFinite());
 }

@@ -18,7 +18,7 @@
 namespace rocksteady::ground::cli {
 namespace {
 
-namespace wire = hal::wire;
+// (the bus library is rocksteady::wire)
 
 // Field names of an .lcm struct in file order, arrays expanded (name_i, name_i_j); constants
 // skipped.

@@ -11,7 +11,7 @@
 namespace rocksteady::ground::cli {
 namespace {
 
-namespace wire = hal::wire;
+// (the bus library is rocksteady::wire)
 
 std::string joined(const std::vector<std::string>& lines) {
   std::string s;

@@ -21,9 +21,9 @@
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/commands/command_table.hpp"
 #include "fsw/uplink/trajectory_uplink.hpp"
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
-namespace wire = rocksteady::hal::wire;
+namespace wire = rocksteady::wire;
 namespace fsw = rocksteady::fsw;
 
 namespace {

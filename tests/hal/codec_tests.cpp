@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 namespace {
 
 using Bytes = std::vector<unsigned char>;
@@ -285,4 +285,4 @@ TEST(Channels, EachTypeHasItsOwnChannel) {
 }
 
 }  // namespace
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

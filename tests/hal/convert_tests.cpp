@@ -4,12 +4,20 @@
 #include <vector>
 
 #include "gnc/model/rcs.hpp"
-#include "hal/lcm/codec.hpp"
-#include "hal/lcm/convert.hpp"
+#include "wire/codec.hpp"
+#include "wire/convert.hpp"
 #include "hal/lcm/lcm_ports.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 namespace {
+
+using hal::GyroReading;
+using hal::LcmSensorSource;
+using hal::RawSensors;
+using hal::StarTrackerReading;
+using hal::ThrusterBank;
+using hal::ThrusterOutputs;
+using hal::default_thruster_bank_config;
 
 template <class T> std::vector<unsigned char> bytes(const T& m) {
   std::vector<unsigned char> b(static_cast<std::size_t>(m.getEncodedSize()));
@@ -105,25 +113,41 @@ TEST(Convert, GncOutputFillsTelemetryThatPassesTheChecks) {
   EXPECT_EQ(m.sensor_rejects, 4);
 }
 
-TEST(LcmSensorSource, DeliversNewestFrameCountsGarbageAndDropsOldFrames) {
+TEST(LcmSensorSource, DeliversNewestFrameCountsGarbageAndFlagsARestartedStream) {
   LcmSensorSource source;
   RawSensors s;
   EXPECT_FALSE(source.poll(s));
   const auto f3 = bytes(to_message(sample_raw(3)));
-  const auto f2 = bytes(to_message(sample_raw(2)));
+  const auto f4 = bytes(to_message(sample_raw(4)));
+  const auto f0 = bytes(to_message(sample_raw(0)));
+  const auto f1 = bytes(to_message(sample_raw(1)));
   std::vector<unsigned char> junk(f3.begin(), f3.begin() + 20);
   EXPECT_TRUE(source.on_message(f3.data(), static_cast<int>(f3.size())));
   EXPECT_FALSE(source.on_message(junk.data(), static_cast<int>(junk.size())));
-  EXPECT_FALSE(source.on_message(f2.data(), static_cast<int>(f2.size())));
+  EXPECT_TRUE(source.on_message(f4.data(), static_cast<int>(f4.size())));
+  EXPECT_TRUE(source.pending());
+  EXPECT_EQ(source.pending_seq(), 4);
   ASSERT_TRUE(source.poll(s));
-  EXPECT_EQ(s.seq, 3);
+  EXPECT_EQ(s.seq, 4);  // the newest; frame 3 was superseded before the tick
+  EXPECT_FALSE(s.stream_restart);
   EXPECT_FALSE(source.poll(s));
+  EXPECT_EQ(source.superseded(), 1u);
   EXPECT_EQ(source.counters().ok, 2u);
   EXPECT_EQ(source.counters().too_short, 1u);
-  EXPECT_EQ(source.out_of_order(), 1u);
-  source.reset();
-  EXPECT_TRUE(source.on_message(f2.data(), static_cast<int>(f2.size())));
+  // The numbering goes backwards: a restarted stream, flagged on the next frame polled only.
+  EXPECT_TRUE(source.on_message(f0.data(), static_cast<int>(f0.size())));
+  EXPECT_EQ(source.restarts(), 1u);
+  ASSERT_TRUE(source.poll(s));
+  EXPECT_EQ(s.seq, 0);
+  EXPECT_TRUE(s.stream_restart);
+  EXPECT_TRUE(source.on_message(f1.data(), static_cast<int>(f1.size())));
+  ASSERT_TRUE(source.poll(s));
+  EXPECT_FALSE(s.stream_restart);
+  // A waiting frame can be dropped unticked (a lockstep resend).
+  EXPECT_TRUE(source.on_message(f1.data(), static_cast<int>(f1.size())));
+  source.drop();
+  EXPECT_FALSE(source.poll(s));
 }
 
 }  // namespace
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <memory>
 
-#include "hal/lcm/codec.hpp"
-#include "hal/lcm/uplink.hpp"
+#include "wire/codec.hpp"
+#include "wire/uplink.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 namespace {
 
 using Chunk = rocksteady::trajectory_chunk_t;
@@ -114,4 +114,4 @@ TEST(Uplink, OutOfRangeChunksFailTheChecks) {
 }
 
 }  // namespace
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

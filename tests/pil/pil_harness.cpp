@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 #include "lcmtypes/channels.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
 
@@ -144,7 +144,7 @@ TestBus::~TestBus() {
 void TestBus::on_tlm(const lcm_recv_buf_t* rbuf, const char*, void* self) {
   auto& b = *static_cast<TestBus*>(self);
   rocksteady::gnc_telemetry_t m;
-  if (hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) {
+  if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) {
     b.tlm = m;
     b.have_tlm = true;
     ++b.tlm_count;
@@ -153,17 +153,17 @@ void TestBus::on_tlm(const lcm_recv_buf_t* rbuf, const char*, void* self) {
 void TestBus::on_ack(const lcm_recv_buf_t* rbuf, const char*, void* self) {
   auto& b = *static_cast<TestBus*>(self);
   rocksteady::cmd_ack_t m;
-  if (hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) b.acks.push_back(m);
+  if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) b.acks.push_back(m);
 }
 void TestBus::on_event(const lcm_recv_buf_t* rbuf, const char*, void* self) {
   auto& b = *static_cast<TestBus*>(self);
   rocksteady::event_t m;
-  if (hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) b.events.push_back(m);
+  if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) b.events.push_back(m);
 }
 void TestBus::on_thruster(const lcm_recv_buf_t* rbuf, const char*, void* self) {
   auto& b = *static_cast<TestBus*>(self);
   rocksteady::thruster_cmd_t m;
-  if (hal::wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) {
+  if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) {
     b.thruster = m;
     b.have_thruster = true;
     ++b.thruster_count;
@@ -187,7 +187,7 @@ void TestBus::spin_for(double seconds) {
 
 void TestBus::send_command(std::int64_t seq, std::int32_t opcode, const std::vector<double>& args,
                            std::int32_t sender) {
-  auto m = hal::wire::make<rocksteady::ground_cmd_t>();
+  auto m = wire::make<rocksteady::ground_cmd_t>();
   m.seq = seq;
   m.sender_id = sender;
   m.opcode = opcode;

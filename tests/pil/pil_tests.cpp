@@ -18,7 +18,7 @@
 #include "ground/campaign/runner.hpp"
 #include "ground/campaign/strategy.hpp"
 #include "ground/config/config.hpp"
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 #include "lcmtypes/channels.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
@@ -267,7 +267,7 @@ std::vector<std::vector<std::uint8_t>> bad_variants(const T& valid, const T& out
   std::vector<std::uint8_t> garbage(v.size());
   for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = static_cast<std::uint8_t>(37 * i + 11);
   out.push_back(garbage);
-  out.push_back(encode(hal::wire::make<rocksteady::plant_truth_t>()));  // another type
+  out.push_back(encode(wire::make<rocksteady::plant_truth_t>()));  // another type
   T k = valid;
   k.kind = 99;
   out.push_back(encode(k));
@@ -285,24 +285,24 @@ TEST(PilProtection, MalformedMessagesOnEveryInputChannelAreCountedAndIgnored) {
       << rig.logs();
   ASSERT_EQ(bus.tlm.rx_malformed + bus.tlm.rx_bad_kind + bus.tlm.rx_out_of_range, 0);
 
-  auto frame = hal::wire::make<rocksteady::sensor_frame_t>();
+  auto frame = wire::make<rocksteady::sensor_frame_t>();
   frame.seq = 5;
   frame.t = 0.5;
   frame.star_quat[3] = 1.0;
   auto frame_bad = frame;
   frame_bad.t = std::nan("");
-  auto cmd = hal::wire::make<rocksteady::ground_cmd_t>();
+  auto cmd = wire::make<rocksteady::ground_cmd_t>();
   cmd.seq = 1;
   cmd.sender_id = 3;
   auto cmd_bad = cmd;
   cmd_bad.nargs = 100;
-  auto chunk = hal::wire::make<rocksteady::trajectory_chunk_t>();
+  auto chunk = wire::make<rocksteady::trajectory_chunk_t>();
   chunk.total_samples = 40;
   chunk.total_chunks = 2;
   chunk.count = 32;
   auto chunk_bad = chunk;
   chunk_bad.count = 31;
-  auto thr = hal::wire::make<rocksteady::thruster_cmd_t>();
+  auto thr = wire::make<rocksteady::thruster_cmd_t>();
   auto thr_bad = thr;
   thr_bad.thruster_force[3] = -1.0;
 

@@ -172,9 +172,9 @@ NoiseStats measure_noise(const PlantParams& p, int n) {
   Vec3 sw = Vec3::Zero(), sw2 = Vec3::Zero(), sq = Vec3::Zero(), sq2 = Vec3::Zero();
   const auto every = static_cast<int>(std::llround(p.sensors.period_s / p.control_period_s));
   for (int k = 0; k < n; ++k) {
-    const gnc::SensorSample s = plant.sample();
-    const Vec3 ew = s.gyro_rate - plant.omega();
-    Vec3 eq = att::quat_to_mrp(s.star_quat) - plant.mrp();
+    const hal::RawSensors s = plant.read_sensors();
+    const Vec3 ew = s.gyro.rate - plant.omega();
+    Vec3 eq = att::quat_to_mrp(s.star.quat) - plant.mrp();
     sw += ew;
     sw2 += ew.cwiseProduct(ew);
     sq += eq;
@@ -215,12 +215,14 @@ TEST(PlantSensors, NoiseStandardDeviationIsSqrtPowerOverPeriod) {
 TEST(PlantSensors, PerfectSensorsDeliverTheTruth) {
   PlantParams p = quiet_params();
   Plant plant(p);
-  const gnc::SensorSample s = plant.sample();
-  EXPECT_TRUE(s.gyro_valid);
-  EXPECT_TRUE(s.star_valid);
-  EXPECT_EQ(s.gyro_rate, p.omega0);
-  EXPECT_NEAR(std::fabs(s.star_quat.dot(p.beta0)), 1.0, 1e-15);
-  EXPECT_NEAR(s.star_quat.norm(), 1.0, 1e-15);
+  const hal::RawSensors s = plant.read_sensors();
+  EXPECT_EQ(s.seq, 0);
+  EXPECT_EQ(s.t, 0.0);
+  EXPECT_TRUE(s.gyro.valid);
+  EXPECT_TRUE(s.star.valid);
+  EXPECT_EQ(s.gyro.rate, p.omega0);
+  EXPECT_NEAR(std::fabs(s.star.quat.dot(p.beta0)), 1.0, 1e-15);
+  EXPECT_NEAR(s.star.quat.norm(), 1.0, 1e-15);
 }
 
 TEST(PlantSensors, SampleIsHeldBetweenSensorPeriods) {
@@ -228,16 +230,18 @@ TEST(PlantSensors, SampleIsHeldBetweenSensorPeriods) {
   p.sensors.period_s = 0.3;  // three control periods
   p.sensors.gyro_psd = 1e-10;
   Plant plant(p);
-  const gnc::SensorSample s0 = plant.sample();
+  const hal::RawSensors s0 = plant.read_sensors();
   plant.advance(Vec8::Zero(), false);
-  const gnc::SensorSample s1 = plant.sample();
-  EXPECT_EQ(s1.t, s0.t);
-  EXPECT_EQ(s1.gyro_rate, s0.gyro_rate);
+  const hal::RawSensors s1 = plant.read_sensors();
+  EXPECT_EQ(s1.seq, 1);                // a frame every control period
+  EXPECT_NEAR(s1.t, 0.1, 1e-12);
+  EXPECT_EQ(s1.gyro.t, s0.gyro.t);     // carrying the held readings
+  EXPECT_EQ(s1.gyro.rate, s0.gyro.rate);
   plant.advance(Vec8::Zero(), false);
   plant.advance(Vec8::Zero(), false);
-  const gnc::SensorSample s3 = plant.sample();
-  EXPECT_NEAR(s3.t, 0.3, 1e-12);
-  EXPECT_NE(s3.gyro_rate, s0.gyro_rate);
+  const hal::RawSensors s3 = plant.read_sensors();
+  EXPECT_NEAR(s3.gyro.t, 0.3, 1e-12);
+  EXPECT_NE(s3.gyro.rate, s0.gyro.rate);
 }
 
 // A noisy, disturbed, actuated run; returns every sample and state as raw doubles.
@@ -251,11 +255,11 @@ std::vector<double> noisy_run(std::uint64_t seed) {
   Plant plant(p);
   std::vector<double> out;
   for (int k = 0; k < 2000; ++k) {
-    const gnc::SensorSample s = plant.sample();
-    out.insert(out.end(), s.gyro_rate.data(), s.gyro_rate.data() + 3);
-    out.insert(out.end(), s.star_quat.data(), s.star_quat.data() + 4);
+    const hal::RawSensors s = plant.read_sensors();
+    out.insert(out.end(), s.gyro.rate.data(), s.gyro.rate.data() + 3);
+    out.insert(out.end(), s.star.quat.data(), s.star.quat.data() + 4);
     Vec8 u = Vec8::Zero();
-    u(k % 8) = -1e4 * s.gyro_rate(k % 3);
+    u(k % 8) = -1e4 * s.gyro.rate(k % 3);
     plant.advance(u, true);
     out.insert(out.end(), plant.beta().data(), plant.beta().data() + 4);
     out.insert(out.end(), plant.omega().data(), plant.omega().data() + 3);
@@ -275,10 +279,43 @@ TEST(PlantSensors, SameSeedSameBitsOtherSeedOtherBits) {
   PlantParams p = quiet_params();
   p.sensors.gyro_psd = 1e-10;
   Plant plant(p);
-  const Vec3 first = plant.sample().gyro_rate;
+  const Vec3 first = plant.read_sensors().gyro.rate;
   plant.advance(Vec8::Zero(), false);
   plant.reset();
-  EXPECT_EQ(plant.sample().gyro_rate, first);
+  EXPECT_EQ(plant.read_sensors().gyro.rate, first);
+}
+
+// The thruster input: each physical thruster lands on its channel by the SPEC §4 wiring, written
+// out here independently (pod k: tangential pair at positions 0 (+) and 1 (-) is channel 2k, axial
+// pair at positions 2 (+) and 3 (-) is channel 2k+1).
+TEST(PlantThrusters, PhysicalThrustersMapOntoTheirChannels) {
+  for (int pod = 0; pod < 4; ++pod) {
+    for (int pos = 0; pos < 4; ++pos) {
+      hal::ThrusterOutputs o;
+      o.enabled = true;
+      const int i = 4 * pod + pos;
+      o.on[static_cast<std::size_t>(i)] = true;
+      o.force[static_cast<std::size_t>(i)] = 37.5;
+      Vec8 expect = Vec8::Zero();
+      expect(2 * pod + pos / 2) = pos % 2 == 0 ? 37.5 : -37.5;
+      EXPECT_EQ(Plant::channel_forces(o), expect) << "thruster " << i;
+      o.enabled = false;
+      EXPECT_EQ(Plant::channel_forces(o), Vec8::Zero());
+    }
+  }
+  // advance(thrusters) is advance(channel forces): same bits.
+  PlantParams p = quiet_params();
+  Plant a(p), b(p);
+  hal::ThrusterOutputs o;
+  o.enabled = true;
+  o.on[0] = o.on[7] = o.on[13] = true;
+  o.force[0] = 120.0;
+  o.force[7] = 200.0;
+  o.force[13] = 55.0;
+  a.advance(o);
+  b.advance(Plant::channel_forces(o), true);
+  EXPECT_EQ(a.omega(), b.omega());
+  EXPECT_EQ(a.fuel_kg(), b.fuel_kg());
 }
 
 TEST(PlantParams, RejectsBadValuesNamingTheField) {

@@ -1,8 +1,8 @@
-#include "hal/lcm/uplink.hpp"
+#include "wire/uplink.hpp"
 
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 
 namespace {
 using Chunk = rocksteady::trajectory_chunk_t;
@@ -34,4 +34,4 @@ bool make_chunk(const gnc::TrajectoryTable& table, std::int32_t upload_id, int i
   return true;
 }
 
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

@@ -1,8 +1,8 @@
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
 #include <cmath>
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 
 namespace {
 
@@ -155,4 +155,4 @@ DecodeStatus check(const rocksteady::trajectory_chunk_t& m) {
   return DecodeStatus::kOk;
 }
 
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

@@ -1,8 +1,8 @@
-#include "hal/lcm/convert.hpp"
+#include "wire/convert.hpp"
 
-#include "hal/lcm/codec.hpp"
+#include "wire/codec.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 
 namespace {
 
@@ -15,8 +15,8 @@ template <int N, class Vec> void get(const double (&a)[N], Vec& v) {
 
 }  // namespace
 
-RawSensors to_raw(const rocksteady::sensor_frame_t& m) {
-  RawSensors s{};
+hal::RawSensors to_raw(const rocksteady::sensor_frame_t& m) {
+  hal::RawSensors s{};
   s.seq = m.seq;
   s.t = m.t;
   s.gyro.t = m.gyro_t;
@@ -28,7 +28,7 @@ RawSensors to_raw(const rocksteady::sensor_frame_t& m) {
   return s;
 }
 
-rocksteady::sensor_frame_t to_message(const RawSensors& s) {
+rocksteady::sensor_frame_t to_message(const hal::RawSensors& s) {
   auto m = make<rocksteady::sensor_frame_t>();
   m.seq = s.seq;
   m.t = s.t;
@@ -41,14 +41,14 @@ rocksteady::sensor_frame_t to_message(const RawSensors& s) {
   return m;
 }
 
-rocksteady::thruster_cmd_t to_message(const ThrusterOutputs& outputs, const gnc::Vec8& channel_force,
+rocksteady::thruster_cmd_t to_message(const hal::ThrusterOutputs& outputs, const gnc::Vec8& channel_force,
                                       std::int64_t seq, double t) {
   auto m = make<rocksteady::thruster_cmd_t>();
   m.seq = seq;
   m.t = t;
   m.enabled = outputs.enabled ? 1 : 0;
   put(channel_force, m.channel_force);
-  for (int i = 0; i < kThrusters; ++i) {
+  for (int i = 0; i < hal::kThrusters; ++i) {
     const auto k = static_cast<std::size_t>(i);
     m.thruster_on[i] = outputs.on[k] ? 1 : 0;
     m.thruster_force[i] = outputs.on[k] ? outputs.force[k] : 0.0;
@@ -56,10 +56,10 @@ rocksteady::thruster_cmd_t to_message(const ThrusterOutputs& outputs, const gnc:
   return m;
 }
 
-ThrusterOutputs to_outputs(const rocksteady::thruster_cmd_t& m) {
-  ThrusterOutputs o{};
+hal::ThrusterOutputs to_outputs(const rocksteady::thruster_cmd_t& m) {
+  hal::ThrusterOutputs o{};
   o.enabled = m.enabled != 0;
-  for (int i = 0; i < kThrusters; ++i) {
+  for (int i = 0; i < hal::kThrusters; ++i) {
     const auto k = static_cast<std::size_t>(i);
     o.on[k] = o.enabled && m.thruster_on[i] != 0;
     o.force[k] = o.on[k] ? m.thruster_force[i] : 0.0;
@@ -100,4 +100,4 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   m.sensor_rejects = g.sensor_rejects;
 }
 
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

@@ -8,7 +8,7 @@
 #include "gnc/guidance/trajectory.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 
 static_assert(gnc::kMaxTrajectorySamples == rocksteady::trajectory_chunk_t::MAX_TABLE_SAMPLES,
               "trajectory_chunk_t.lcm and gnc::kMaxTrajectorySamples disagree");
@@ -20,4 +20,4 @@ int chunk_count(int samples);
 bool make_chunk(const gnc::TrajectoryTable& table, std::int32_t upload_id, int index,
                 rocksteady::trajectory_chunk_t& out);
 
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire

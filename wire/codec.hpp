@@ -24,7 +24,7 @@
 #include "rocksteady/thruster_cmd_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
-namespace rocksteady::hal::wire {
+namespace rocksteady::wire {
 
 // Messages stay well below LCM's ~65 KB fragmentation limit; anything longer is not ours.
 inline constexpr int kMaxMessageBytes = 60000;
@@ -166,4 +166,4 @@ template <class T> int encode(const T& msg, void* buf, int cap) {
   return msg.encode(buf, 0, cap) == size ? size : -1;
 }
 
-}  // namespace rocksteady::hal::wire
+}  // namespace rocksteady::wire
