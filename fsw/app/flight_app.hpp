@@ -1,7 +1,9 @@
-// The flight application: the executive's rate groups (GNC, housekeeping), the command dispatcher,
-// the parameter tables, the trajectory uplink and the event queue around one gnc::Gnc. The same
-// object flies in rocksteady-fsw (over the bus) and in the in-process campaign (lockstep), so every
-// closed-loop run exercises this code.
+// The flight application: one gnc::Gnc inside the executive's rate groups (GNC, housekeeping),
+// composed of parts that each own their counters: the frame time base (executive/time_base), the
+// command dispatcher with its action queue (commands/dispatcher), the parameter and uplink life
+// cycles (params/param_lifecycle, uplink/uplink_lifecycle), the event log and the table-driven
+// translation of the core's mode events (events/). The flight computer (fsw/computer) wraps it with
+// the HAL devices; every harness flies that.
 //
 // Threading: not thread-safe. submit(), receive_chunk() and the ticks are called from one thread
 // (the bus loop or the campaign). Nothing here allocates after init(), throws or does I/O; init()
@@ -12,14 +14,16 @@
 #include <array>
 #include <cstdint>
 
-#include "fsw/commands/command_table.hpp"
-#include "fsw/events/event_queue.hpp"
+#include "fsw/commands/dispatcher.hpp"
+#include "fsw/events/event_log.hpp"
+#include "fsw/events/event_translator.hpp"
 #include "fsw/executive/clock.hpp"
 #include "fsw/executive/executive.hpp"
 #include "fsw/executive/tick_source.hpp"
+#include "fsw/executive/time_base.hpp"
 #include "fsw/interface.hpp"
-#include "fsw/params/param_table.hpp"
-#include "fsw/uplink/trajectory_uplink.hpp"
+#include "fsw/params/param_lifecycle.hpp"
+#include "fsw/uplink/uplink_lifecycle.hpp"
 #include "gnc/gnc.hpp"
 
 namespace rocksteady::fsw {
@@ -53,7 +57,7 @@ struct Outputs {
   HealthTelemetry health{};
 };
 
-class FlightApp {
+class FlightApp final : private BoundaryActions {
  public:
   FlightApp() = default;
   FlightApp(const FlightApp&) = delete;
@@ -76,122 +80,64 @@ class FlightApp {
   // nullptr. A GNC cycle without a fresh frame runs with an invalid sample at the scheduled time,
   // so the flight core's sensor timeout (-> SAFE, thrusters off) works without frames.
   void tick(const Tick& tick, const gnc::SensorSample* frame, Outputs& out);
-  // Lockstep convenience (in-process campaign): one sensor sample = one base tick (with the
-  // default gnc_divider of 1, one GNC tick).
+  // Lockstep convenience (tests): one sensor sample = one base tick (with the default gnc_divider
+  // of 1, one GNC tick).
   void gnc_tick(const gnc::SensorSample& sample, Outputs& out);
   // One base tick without a frame; the GNC cycle (if due) runs at time t with an invalid sample.
   void gnc_tick_without_frame(double t, Outputs& out);
 
   // --- Outputs besides Outputs ------------------------------------------------------------------
   bool pop_event(Event& e) { return events_.pop(e); }
-  int pending_events() const { return events_.size(); }
+  int pending_events() const { return events_.pending(); }
   HealthTelemetry health() const;  // the counters now (housekeeping publishes the same)
 
   // --- Inspection -------------------------------------------------------------------------------
   gnc::Mode mode() const { return gnc_.mode(); }
   // On-board time: the sample time of the last GNC cycle (for acknowledgement time stamps).
-  double onboard_time() const { return last_gnc_t_; }
+  double onboard_time() const { return time_base_.onboard_time(); }
   const gnc::Gnc& core() const { return gnc_; }
   // The flight core's output of the last GNC cycle, with its raw mode events (gnc::ModeEvents).
   const gnc::GncOutput& core_output() const { return gout_; }
   const gnc::GncParams& active_params() const { return gnc_.params(); }
-  const ParamTable& param_table() const { return table_; }
+  const ParamTable& param_table() const { return params_.table(); }
   const Executive& executive() const { return exec_; }
-  const TrajectoryUplink& uplink() const { return uplink_; }
+  const TrajectoryUplink& uplink() const { return uplink_.uplink(); }
   bool trajectory_loaded() const { return trajectory_loaded_; }
-  int pending_commands() const { return action_count_; }
+  int pending_commands() const { return commands_.pending(); }
 
  private:
-  enum class ActionKind : std::uint8_t {
-    kMode,
-    kLaw,
-    kTarget,
-    kActivateParams,
-    kLoadTrajectory,
-    kResetCounters,
-  };
-  struct Action {
-    ActionKind kind{ActionKind::kMode};
-    gnc::Mode mode{gnc::Mode::kIdle};
-    gnc::LawId law{gnc::LawId::kNtcl};
-    gnc::Vec3 target{gnc::Vec3::Zero()};
-    std::int32_t upload_id{0};
-  };
-  static constexpr int kActionCapacity = 16;
+  // BoundaryActions: what the dispatcher's queue runs at the tick boundary.
+  void activate_params() override { params_.activate(gnc_, events_); }
+  void load_trajectory(std::int32_t upload_id) override;
+  void reset_counters() override;
 
-  void reset_state();
+  DispatchContext dispatch_context();
   void run_tick(const Tick& tick, const gnc::SensorSample* frame, const double* t_frameless,
                 Outputs& out);
   void run_gnc(const Tick& tick, const double* t_frameless, Outputs& out);
   void run_housekeeping(const Tick& tick, Outputs& out);
   void report_slip(GroupId g, const SlipReport& s);
-  bool accept_frame_time(double t);
-  double scheduled_time() const;
-  void translate_core_events();
-
-  // Commands.
-  CommandCheck execute(const GroundCommand& cmd);
-  CommandCheck execute_set_law(const GroundCommand& cmd);
-  CommandCheck execute_load_trajectory(const GroundCommand& cmd);
-  bool queue_has_room(int n) const { return action_count_ + n <= kActionCapacity; }
-  void enqueue(const Action& a);
-  void apply_pending(gnc::GncCommands& cmds);
-  void apply_pre_step(const Action& a);
-  gnc::Mode projected_mode() const;
-  gnc::LawId projected_law() const;
-  bool projected_trajectory() const;
-  void reset_counters();
-
-  void emit(Severity sev, EventId id, std::int32_t arg0, std::int32_t arg1, const char* fmt, ...)
-      __attribute__((format(printf, 6, 7)));
 
   const Clock* clock_{nullptr};
   FlightConfig config_{};
   gnc::Gnc gnc_{};
   gnc::GncCommands cmds_{};
   gnc::GncOutput gout_{};
-  gnc::GncParams activation_{};
   Executive exec_{};
-  SequenceTracker seqs_{};
-  ParamTable table_{};
-  TrajectoryUplink uplink_{};
-  EventQueue events_{};
-  std::array<Action, kActionCapacity> actions_{};
-  int action_head_{0};
-  int action_count_{0};
+  FrameTimeBase time_base_{};
+  CommandDispatcher commands_{};
+  ParamLifecycle params_{};
+  UplinkLifecycle uplink_{};
+  EventLog events_{};
+  EventTranslator translator_{};
 
-  // Time base.
   gnc::SensorSample latest_frame_{};
   bool fresh_frame_{false};
-  bool have_frame_t_{false};
-  double last_frame_t_{0.0};
-  std::uint32_t consecutive_frame_rejects_{0};
-  bool have_gnc_t_{false};
-  double last_gnc_t_{0.0};
-  std::uint32_t gnc_cycles_missed_{0};  // GNC cycles skipped since the last one ran
   std::uint32_t consecutive_slips_{0};
   bool overrun_request_{false};  // this tick's SAFE request is the overrun protection's
   std::uint64_t next_index_{0};  // for the lockstep conveniences
-
-  // Counters (telemetry).
-  std::uint32_t cmd_accepted_{0};
-  std::uint32_t cmd_rejected_{0};
-  std::int64_t last_cmd_seq_{0};
-  std::int32_t last_cmd_opcode_{-1};
-  RejectReason last_reject_{RejectReason::kNone};
-  std::uint64_t event_seq_{0};
-  std::uint32_t frames_accepted_{0};
-  std::uint32_t frames_rejected_{0};
-  std::uint32_t frameless_ticks_{0};
   std::uint32_t sensor_rejects_base_{0};
-  std::uint32_t table_loads_{0};
-  std::uint32_t table_activations_{0};
-  std::uint32_t chunks_rejected_{0};
-  std::uint32_t trajectories_loaded_{0};
   bool trajectory_loaded_{false};
-
-  Throttle sensor_throttle_{};
-  Throttle frame_throttle_{};
   Throttle missed_throttle_{};
 };
 

@@ -1,0 +1,93 @@
+#include "fsw/events/event_translator.hpp"
+
+#include <array>
+#include <cstdio>
+
+namespace rocksteady::fsw {
+
+namespace {
+
+// How a row fills arg0/arg1 and the text's third field.
+enum class Args : std::uint8_t {
+  kFromTo,          // arg0 = from, arg1 = to
+  kToReason,        // arg0 = requested mode, arg1 = gnc::TransitionCheck
+  kRejectsThrottled  // arg0 = rejects so far, arg1 = suppressed reports; throttled
+};
+enum class Detail : std::uint8_t { kNone, kCause, kTimeout, kReason, kRejects };
+
+struct Row {
+  gnc::EventId gnc_id;
+  EventId id;
+  Severity severity;
+  Args args;
+  Detail detail;
+  const char* text;  // printf with %s: from, to, detail (in that order; each may be unused)
+};
+
+constexpr std::array<Row, 6> kRows{{
+    {gnc::EventId::kModeChanged, EventId::kModeChanged, Severity::kInfo, Args::kFromTo,
+     Detail::kCause, "mode %s -> %s (%s)"},
+    {gnc::EventId::kAutoHold, EventId::kAutoHold, Severity::kInfo, Args::kFromTo, Detail::kNone,
+     "mode %s -> %s: |omega| <= omega_switch%s"},
+    {gnc::EventId::kSensorTimeout, EventId::kSensorTimeout, Severity::kError, Args::kFromTo,
+     Detail::kTimeout, "mode %s -> %.0sSAFE: no valid sensor sample for %s s, thrusters off"},
+    {gnc::EventId::kNonFiniteState, EventId::kNonFiniteState, Severity::kError, Args::kFromTo,
+     Detail::kNone, "mode %s -> %.0sSAFE: non-finite estimate or command, thrusters off%s"},
+    {gnc::EventId::kRequestRejected, EventId::kModeRequestRejected, Severity::kWarning,
+     Args::kToReason, Detail::kReason, "mode request %.0s%s rejected at the tick: %s"},
+    {gnc::EventId::kSensorRejected, EventId::kSensorRejected, Severity::kWarning,
+     Args::kRejectsThrottled, Detail::kRejects,
+     "sensor sample rejected: invalid, non-finite or out of range (%.0s%.0s%s so far)"},
+}};
+
+const Row* find_row(gnc::EventId id) {
+  for (const Row& r : kRows) {
+    if (r.gnc_id == id) return &r;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+void EventTranslator::configure(std::int64_t sensor_event_interval_ns) {
+  sensor_throttle_.configure(sensor_event_interval_ns);
+  sensor_throttle_.reset();
+}
+
+void EventTranslator::translate(const gnc::ModeEvents& events, const TranslationContext& ctx,
+                                EventLog& log) {
+  for (int i = 0; i < events.count; ++i) {
+    const gnc::ModeEvent& e = events.items[i];
+    const Row* row = find_row(e.id);
+    if (row == nullptr) continue;
+    auto arg0 = static_cast<std::int32_t>(e.from);
+    auto arg1 = static_cast<std::int32_t>(e.to);
+    if (row->args == Args::kToReason) {
+      arg0 = static_cast<std::int32_t>(e.to);
+      arg1 = static_cast<std::int32_t>(e.reason);
+    } else if (row->args == Args::kRejectsThrottled) {
+      std::uint32_t suppressed = 0;
+      if (!sensor_throttle_.allow(ctx.now_ns, suppressed)) continue;
+      arg0 = static_cast<std::int32_t>(ctx.sensor_rejects);
+      arg1 = static_cast<std::int32_t>(suppressed);
+    }
+    char detail[32] = "";
+    switch (row->detail) {
+      case Detail::kNone: break;
+      case Detail::kCause:
+        std::snprintf(detail, sizeof detail, "%s",
+                      ctx.overrun_request ? "overrun protection" : "ground request");
+        break;
+      case Detail::kTimeout: std::snprintf(detail, sizeof detail, "%.3g", ctx.sensor_timeout_s); break;
+      case Detail::kReason: std::snprintf(detail, sizeof detail, "%s", gnc::to_string(e.reason)); break;
+      case Detail::kRejects: std::snprintf(detail, sizeof detail, "%u", ctx.sensor_rejects); break;
+    }
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+    log.emit(row->severity, row->id, arg0, arg1, row->text, gnc::to_string(e.from),
+             gnc::to_string(e.to), detail);
+#pragma GCC diagnostic pop
+  }
+}
+
+}  // namespace rocksteady::fsw

@@ -1,0 +1,75 @@
+#include "fsw/executive/time_base.hpp"
+
+#include <cinttypes>
+#include <cmath>
+
+namespace rocksteady::fsw {
+
+void FrameTimeBase::configure(const TimeBaseConfig& c) {
+  config_ = c;
+  throttle_.configure(c.event_interval_ns);
+  reset();
+}
+
+void FrameTimeBase::reset() {
+  throttle_.reset();
+  have_frame_t_ = false;
+  last_frame_t_ = 0.0;
+  consecutive_rejects_ = 0;
+  have_gnc_t_ = false;
+  last_gnc_t_ = 0.0;
+  cycles_missed_ = 0;
+  frames_accepted_ = 0;
+  frames_rejected_ = 0;
+  frameless_ticks_ = 0;
+}
+
+double FrameTimeBase::scheduled_time() const {
+  if (!have_gnc_t_) return 0.0;
+  return last_gnc_t_ + config_.gnc_period_s * (1.0 + static_cast<double>(cycles_missed_));
+}
+
+bool FrameTimeBase::accept(double t, std::int64_t now_ns, EventLog& log) {
+  bool ok = std::isfinite(t);
+  const char* why = "non-finite time";
+  if (ok && have_frame_t_) {
+    if (!(t > last_frame_t_)) {
+      ok = false;
+      why = "time not after the previous frame";
+    } else if (t - scheduled_time() > config_.max_frame_time_jump_s) {
+      ok = false;
+      why = "time jumps ahead of the on-board time";
+    }
+    if (!ok && std::isfinite(t) && consecutive_rejects_ >= config_.frame_resync_count) {
+      log.emit(Severity::kWarning, EventId::kFrameRejected, 0, 0,
+               "frame time base re-synchronised at t=%.6g s after %" PRIu32 " rejected frames", t,
+               consecutive_rejects_);
+      ok = true;
+    }
+  }
+  if (!ok) {
+    ++frames_rejected_;
+    ++consecutive_rejects_;
+    std::uint32_t suppressed = 0;
+    if (throttle_.allow(now_ns, suppressed)) {
+      log.emit(Severity::kWarning, EventId::kFrameRejected,
+               static_cast<std::int32_t>(frames_rejected_), static_cast<std::int32_t>(suppressed),
+               "sensor frame rejected: %s (%" PRIu32 " so far)", why, frames_rejected_);
+    }
+    return false;
+  }
+  have_frame_t_ = true;
+  last_frame_t_ = t;
+  consecutive_rejects_ = 0;
+  ++frames_accepted_;
+  return true;
+}
+
+void FrameTimeBase::cycle_ran(double t, bool with_frame) {
+  if (!with_frame) ++frameless_ticks_;
+  last_gnc_t_ = t;
+  have_gnc_t_ = true;
+  cycles_missed_ = 0;
+}
+
+}  // namespace rocksteady::fsw
