@@ -44,7 +44,9 @@ inline constexpr int kThrustersPerPod = 4;
 inline constexpr int kThrusters = gnc::kPods * kThrustersPerPod;  // 16
 
 // Physical thruster number: 4 * pod + position in the pod (0..3).
-constexpr int thruster_index(int pod, int position) { return pod * kThrustersPerPod + position; }
+constexpr int thruster_index(int pod, int position) {
+  return pod * kThrustersPerPod + position;
+}
 
 // What the thruster bank drives: 16 on/off thrusters with their force.
 struct ThrusterOutputs {

@@ -7,7 +7,9 @@ namespace rocksteady::fsw {
 
 namespace {
 
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+std::int64_t to_ns(double s) {
+  return static_cast<std::int64_t>(std::llround(s * 1e9));
+}
 
 }  // namespace
 
@@ -128,14 +130,15 @@ void FlightApp::run_gnc(const Tick& tick, const double* t_frameless, Outputs& ou
     cmds_.has_mode_request = true;
     cmds_.mode_request = gnc::Mode::kSafe;
     overrun_request_ = true;
-    events_.emit(Severity::kError, EventId::kOverrunSafe,
-                 static_cast<std::int32_t>(consecutive_slips_), 0,
-                 "%" PRIu32 " consecutive GNC overruns: -> SAFE, thrusters off", consecutive_slips_);
+    events_.emit(
+        Severity::kError, EventId::kOverrunSafe, static_cast<std::int32_t>(consecutive_slips_), 0,
+        "%" PRIu32 " consecutive GNC overruns: -> SAFE, thrusters off", consecutive_slips_);
   }
 
   // 2. The sample: the fresh frame if its time is sane, otherwise an invalid sample at the
   //    scheduled time (the flight core counts the sensor age and goes to SAFE on timeout).
-  const bool have_frame = fresh_frame_ && time_base_.accept(latest_frame_.t, clock_->now_ns(), events_);
+  const bool have_frame =
+      fresh_frame_ && time_base_.accept(latest_frame_.t, clock_->now_ns(), events_);
   fresh_frame_ = false;
   if (!have_frame) {
     latest_frame_ = gnc::SensorSample{};  // invalid readings
@@ -153,11 +156,11 @@ void FlightApp::run_gnc(const Tick& tick, const double* t_frameless, Outputs& ou
                  static_cast<std::int32_t>(gnc_.params().law), "control law %s -> %s",
                  gnc::to_string(law_before), gnc::to_string(gnc_.params().law));
   }
-  translator_.translate(gout_.events,
-                        TranslationContext{overrun_request_, gnc_.params().mode.sensor_timeout_s,
-                                           gout_.telemetry.sensor_rejects - sensor_rejects_base_,
-                                           clock_->now_ns()},
-                        events_);
+  translator_.translate(
+      gout_.events,
+      TranslationContext{overrun_request_, gnc_.params().mode.sensor_timeout_s,
+                         gout_.telemetry.sensor_rejects - sensor_rejects_base_, clock_->now_ns()},
+      events_);
 
   out.command = gout_.command;
   out.telemetry = gout_.telemetry;

@@ -1,6 +1,7 @@
 // The flight computer: the flight application (fsw::FlightApp) with its HAL devices (hal::Gyro,
-// hal::StarTracker, hal::ThrusterBank), driven only through a pair of HAL ports. Every harness flies
-// this object and supplies nothing but the ports (DESIGN.md, "one flight path, three ways to run it"):
+// hal::StarTracker, hal::ThrusterBank), driven only through a pair of HAL ports. Every harness
+// flies this object and supplies nothing but the ports (DESIGN.md, "one flight path, three ways to
+// run it"):
 //
 //   harness                 SensorSource                 ThrusterSink
 //   in-process campaign     ground's plant binding       ground's plant binding
@@ -10,8 +11,8 @@
 // One base tick: poll the sensor source for the newest frame -> the devices check each reading and
 // write the body-frame values into the flight core's gnc::SensorSample -> FlightApp (executive,
 // commands, Gnc) -> the thruster bank turns the channel forces into the 16 physical thrusters ->
-// the thruster sink, echoing the frame's sequence number. Ground commands, uplink chunks, events and
-// telemetry go through the methods below (the bus layer moves them; it never touches a device).
+// the thruster sink, echoing the frame's sequence number. Ground commands, uplink chunks, events
+// and telemetry go through the methods below (the bus layer moves them; it never touches a device).
 //
 // Not thread-safe; no heap, no exceptions, no I/O after init(). Large (the application holds two
 // trajectory tables): give it static storage or allocate it once at start-up.
@@ -38,8 +39,8 @@ FlightComputerConfig default_computer_config(const FlightConfig& app);
 
 // What one tick did.
 struct TickReport {
-  bool frame{false};          // a sensor frame was polled for this tick
-  bool gnc_ran{false};        // the GNC cycle ran, and the thrusters were written
+  bool frame{false};    // a sensor frame was polled for this tick
+  bool gnc_ran{false};  // the GNC cycle ran, and the thrusters were written
   bool housekeeping_ran{false};
 };
 

@@ -9,8 +9,8 @@ namespace {
 
 // How a row fills arg0/arg1 and the text's third field.
 enum class Args : std::uint8_t {
-  kFromTo,          // arg0 = from, arg1 = to
-  kToReason,        // arg0 = requested mode, arg1 = gnc::TransitionCheck
+  kFromTo,           // arg0 = from, arg1 = to
+  kToReason,         // arg0 = requested mode, arg1 = gnc::TransitionCheck
   kRejectsThrottled  // arg0 = rejects so far, arg1 = suppressed reports; throttled
 };
 enum class Detail : std::uint8_t { kNone, kCause, kTimeout, kReason, kRejects };
@@ -73,14 +73,21 @@ void EventTranslator::translate(const gnc::ModeEvents& events, const Translation
     }
     char detail[32] = "";
     switch (row->detail) {
-      case Detail::kNone: break;
+      case Detail::kNone:
+        break;
       case Detail::kCause:
         std::snprintf(detail, sizeof detail, "%s",
                       ctx.overrun_request ? "overrun protection" : "ground request");
         break;
-      case Detail::kTimeout: std::snprintf(detail, sizeof detail, "%.3g", ctx.sensor_timeout_s); break;
-      case Detail::kReason: std::snprintf(detail, sizeof detail, "%s", gnc::to_string(e.reason)); break;
-      case Detail::kRejects: std::snprintf(detail, sizeof detail, "%u", ctx.sensor_rejects); break;
+      case Detail::kTimeout:
+        std::snprintf(detail, sizeof detail, "%.3g", ctx.sensor_timeout_s);
+        break;
+      case Detail::kReason:
+        std::snprintf(detail, sizeof detail, "%s", gnc::to_string(e.reason));
+        break;
+      case Detail::kRejects:
+        std::snprintf(detail, sizeof detail, "%u", ctx.sensor_rejects);
+        break;
     }
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wformat-nonliteral"

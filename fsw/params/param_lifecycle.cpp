@@ -25,13 +25,16 @@ CommandCheck ParamLifecycle::load(const GroundCommand& cmd, EventLog& log) {
 }
 
 CommandCheck ParamLifecycle::check_stage() const {
-  if (table_.staged()) return CommandCheck{RejectReason::kBusy, 0, "an activation is already pending"};
-  if (!table_.loaded()) return CommandCheck{RejectReason::kNothingToActivate, 0, "no parameter load"};
+  if (table_.staged())
+    return CommandCheck{RejectReason::kBusy, 0, "an activation is already pending"};
+  if (!table_.loaded())
+    return CommandCheck{RejectReason::kNothingToActivate, 0, "no parameter load"};
   return CommandCheck{};
 }
 
 CommandCheck ParamLifecycle::discard(const gnc::GncParams& active, EventLog& log) {
-  if (!table_.loaded()) return CommandCheck{RejectReason::kNothingToActivate, 0, "no parameter load"};
+  if (!table_.loaded())
+    return CommandCheck{RejectReason::kNothingToActivate, 0, "no parameter load"};
   table_.discard(active);
   log.emit(Severity::kInfo, EventId::kTableDiscarded, 0, 0,
            "inactive parameter table discarded (copy of the active one)");

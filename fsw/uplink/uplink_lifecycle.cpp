@@ -22,7 +22,8 @@ ChunkStatus UplinkLifecycle::receive(const TrajectoryChunk& chunk, EventLog& log
   }
   if (r.abandoned) {
     log.emit(Severity::kWarning, EventId::kUplinkAbandoned, r.abandoned_id, r.abandoned_received,
-             "trajectory uplink %" PRId32 " abandoned for %" PRId32 " (%" PRId32 " chunks received)",
+             "trajectory uplink %" PRId32 " abandoned for %" PRId32 " (%" PRId32
+             " chunks received)",
              r.abandoned_id, chunk.upload_id, r.abandoned_received);
   }
   if (r.started) {

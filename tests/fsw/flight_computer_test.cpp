@@ -69,7 +69,9 @@ class FakePorts final : public hal::SensorSource, public hal::ThrusterSink {
   std::int64_t polled_{-1};
 };
 
-M3 gyro_mounting() { return Eigen::AngleAxisd(0.9, V3(1, 2, -1).normalized()).toRotationMatrix(); }
+M3 gyro_mounting() {
+  return Eigen::AngleAxisd(0.9, V3(1, 2, -1).normalized()).toRotationMatrix();
+}
 
 struct Rig {
   FakeClock clock{0};
@@ -147,18 +149,24 @@ TEST(FlightComputer, AGyroWithoutValidReadingsTakesItToSafeWithThrustersOff) {
 
 // A harness reaches the devices only through the ports: the flight computer exposes no device,
 // not even a const one, and takes no readings or thruster commands any other way.
-template <class T, class = void> struct HasGyro : std::false_type {};
-template <class T> struct HasGyro<T, std::void_t<decltype(std::declval<T&>().gyro())>> : std::true_type {};
-template <class T, class = void> struct HasStarTracker : std::false_type {};
+template <class T, class = void>
+struct HasGyro : std::false_type {};
 template <class T>
-struct HasStarTracker<T, std::void_t<decltype(std::declval<T&>().star_tracker())>> : std::true_type {};
-template <class T, class = void> struct HasBank : std::false_type {};
+struct HasGyro<T, std::void_t<decltype(std::declval<T&>().gyro())>> : std::true_type {};
+template <class T, class = void>
+struct HasStarTracker : std::false_type {};
+template <class T>
+struct HasStarTracker<T, std::void_t<decltype(std::declval<T&>().star_tracker())>>
+    : std::true_type {};
+template <class T, class = void>
+struct HasBank : std::false_type {};
 template <class T>
 struct HasBank<T, std::void_t<decltype(std::declval<T&>().thruster_bank())>> : std::true_type {};
-template <class T, class = void> struct TakesSamples : std::false_type {};
+template <class T, class = void>
+struct TakesSamples : std::false_type {};
 template <class T>
-struct TakesSamples<T, std::void_t<decltype(std::declval<T&>().tick(std::declval<const Tick&>(),
-                                                                     std::declval<const gnc::SensorSample*>()))>>
+struct TakesSamples<T, std::void_t<decltype(std::declval<T&>().tick(
+                           std::declval<const Tick&>(), std::declval<const gnc::SensorSample*>()))>>
     : std::true_type {};
 
 TEST(FlightComputer, AHarnessCannotReachTheDevicesExceptThroughPorts) {
@@ -190,7 +198,7 @@ TEST(FlightComputer, AHarnessCannotReachTheDevicesExceptThroughPorts) {
   }
   EXPECT_EQ(computer->health().frames_accepted, 0u);
   EXPECT_EQ(silent.writes, 40);
-  EXPECT_FALSE(silent.any_on);  // no estimate, nothing to fire on
+  EXPECT_FALSE(silent.any_on);                    // no estimate, nothing to fire on
   EXPECT_EQ(computer->mode(), gnc::Mode::kSafe);  // the sensor timeout, from frameless ticks
 }
 
