@@ -54,7 +54,7 @@ BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
 void BM_LawAlone(benchmark::State& state, LawId law) {
   const GncParams p = study_gnc_params(200.0);
   ControlLaws laws;
-  laws.configure(p, total_inertia(p.mass_hat));
+  laws.configure(law_gains(p), total_inertia(p.mass_hat), p.dt);
   laws.reset_state();
   LawInput in;
   in.omega = Vec3(1e-3, -2e-3, 5e-4);

@@ -2,6 +2,9 @@
 // kinematics, Eq. (3), integrated by classical RK4 with the torque held over the step. Independent of
 // gnc/math (its own quaternion algebra), so the loop is closed against a separately written model.
 // Header-only and allocation-free: used by the bare-metal image and by the aarch64 tick benchmark.
+// Why a copy of the one truth model (ground/plant/attitude.*, which the plant and the gnc/fsw tests
+// share): the bare-metal image builds only gnc/ and firmware/ for a freestanding target (no ground
+// code, no out-of-line library), so it keeps this self-contained header.
 #pragma once
 
 #include <cmath>

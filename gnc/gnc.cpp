@@ -15,7 +15,7 @@ void Gnc::configure_components() {
   filter_.configure(params_.estimator, j_hat, params_.dt);
   modes_.configure(params_.mode, params_.guidance.omega_switch);
   refs_.configure(params_.guidance, params_.dt);
-  laws_.configure(params_, j_hat);
+  laws_.configure(law_gains(params_), j_hat, params_.dt);
   // B_hat from the estimated r_SO/BCM (SPEC §4); validate() has checked its rank.
   alloc_.configure(torque_matrix(params_.rcs, params_.mass_hat.r_so_bcm), params_.rcs.u_max,
                    params_.allocator);
@@ -106,8 +106,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   }
   const TransitionContext ctx{filter_.initialised(), trajectory_valid_, params_.law};
   const bool finite = omega_hat.allFinite() && q_hat.allFinite();
-  modes_.update(commands.has_mode_request, commands.mode_request, ctx, omega_hat.norm(),
-                t - last_good_t_, finite, out.events);
+  modes_.update(ModeInputs{commands.has_mode_request, commands.mode_request, ctx, omega_hat.norm(),
+                           t - last_good_t_, finite},
+                out.events);
   const Mode mode = modes_.mode();
   if (actuating(mode) && !actuating(before)) laws_.reset_state();
 
@@ -124,7 +125,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     if (!u_c.allFinite()) {
       u_c.setZero();
       rr = RateReference{};
-      modes_.update(false, mode, ctx, omega_hat.norm(), 0.0, false, out.events);  // -> SAFE
+      modes_.update(ModeInputs{false, mode, ctx, omega_hat.norm(), 0.0, false},
+                    out.events);  // -> SAFE
     }
   }
 

@@ -8,35 +8,15 @@
 
 namespace rocksteady::gnc {
 
-const char* to_string(Mode m) {
-  switch (m) {
-    case Mode::kIdle: return "IDLE";
-    case Mode::kDetumble: return "DETUMBLE";
-    case Mode::kHold: return "HOLD";
-    case Mode::kTrack: return "TRACK";
-    case Mode::kSafe: return "SAFE";
-  }
-  return "?";
-}
-
-const char* to_string(LawId l) {
-  switch (l) {
-    case LawId::kNtcl: return "ntcl";
-    case LawId::kNtclEl: return "el";
-    case LawId::kIntegral: return "integral";
-    case LawId::kAdaptive: return "adaptive";
-    case LawId::kSo3: return "so3";
-    case LawId::kDpd: return "dpd";
-    case LawId::kFeedforward: return "feedforward";
-  }
-  return "?";
-}
-
 GncParams study_gnc_params(double u_max) {
   GncParams p;
   p.mass_hat = study_true_mass_properties();
   p.rcs = study_rcs_layout(u_max);
   return p;
+}
+
+LawGains law_gains(const GncParams& p) {
+  return LawGains{p.ntcl, p.el, p.feedforward, p.integral, p.adaptive, p.so3, p.dpd};
 }
 
 bool all_finite(const Mat3& m) { return m.allFinite(); }

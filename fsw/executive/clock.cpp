@@ -3,11 +3,11 @@
 #include <cerrno>
 #include <ctime>
 
+#include "gnc/units.hpp"
+
 namespace rocksteady::fsw {
 
-namespace {
-constexpr std::int64_t kNsPerS = 1000000000;
-}  // namespace
+using gnc::kNsPerS;
 
 std::int64_t MonotonicClock::now_ns() const {
   timespec ts{};

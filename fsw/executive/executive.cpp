@@ -2,11 +2,9 @@
 
 #include <cmath>
 
-namespace rocksteady::fsw {
+#include "gnc/units.hpp"
 
-namespace {
-constexpr double kNsPerS = 1e9;
-}  // namespace
+namespace rocksteady::fsw {
 
 ConfigCheck validate(const ExecutiveConfig& c) {
   if (!std::isfinite(c.base_rate_hz) || c.base_rate_hz <= 0.0 || c.base_rate_hz > 10000.0) {
@@ -102,9 +100,10 @@ ConfigCheck Executive::configure(const ExecutiveConfig& c) {
   const ConfigCheck check = validate(c);
   if (!check.ok) return check;
   config_ = c;
-  base_period_ns_ = static_cast<std::int64_t>(std::llround(kNsPerS / c.base_rate_hz));
+  const auto ns_per_s = static_cast<double>(gnc::kNsPerS);  // exactly 1e9
+  base_period_ns_ = static_cast<std::int64_t>(std::llround(ns_per_s / c.base_rate_hz));
   const auto interval_ns =
-      static_cast<std::int64_t>(std::llround(c.slip_event_interval_s * kNsPerS));
+      static_cast<std::int64_t>(std::llround(c.slip_event_interval_s * ns_per_s));
   group(GroupId::kGnc).configure(c.gnc_divider, interval_ns);
   group(GroupId::kHousekeeping).configure(c.housekeeping_divider, interval_ns);
   have_tick_ = false;

@@ -12,6 +12,7 @@
 
 #include "fsw/executive/tick_source.hpp"
 #include "fsw/interface.hpp"
+#include "gnc/check.hpp"
 
 namespace rocksteady::fsw {
 
@@ -22,11 +23,7 @@ struct ExecutiveConfig {
   double slip_event_interval_s{10.0};      // throttle of the slip / missed-tick warnings
 };
 
-struct ConfigCheck {
-  bool ok{true};
-  const char* field{""};
-  const char* reason{""};
-};
+using ConfigCheck = gnc::Check;  // the one {ok, field, reason} result (gnc/check.hpp)
 ConfigCheck validate(const ExecutiveConfig& c);
 
 // The executive of a lockstep run: base tick = GNC tick = one sensor frame every `gnc_dt` seconds,

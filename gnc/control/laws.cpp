@@ -122,14 +122,14 @@ Mat3 project_inertia(const Mat3& j, double lo, double hi) {
   return v * lam.asDiagonal() * v.transpose();
 }
 
-void ControlLaws::configure(const GncParams& p, const Mat3& j_hat) {
-  p_ = p;
+void ControlLaws::configure(const LawGains& g, const Mat3& j_hat, double dt) {
+  g_ = g;
   j_hat_ = j_hat;
-  dt_ = p.dt;
+  dt_ = dt;
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   es.computeDirect(j_hat, Eigen::EigenvaluesOnly);
-  eig_lo_ = p.adaptive.eig_floor_ratio * es.eigenvalues().minCoeff();
-  eig_hi_ = p.adaptive.eig_ceiling_ratio * es.eigenvalues().maxCoeff();
+  eig_lo_ = g.adaptive.eig_floor_ratio * es.eigenvalues().minCoeff();
+  eig_hi_ = g.adaptive.eig_ceiling_ratio * es.eigenvalues().maxCoeff();
 }
 
 void ControlLaws::reset_state() {
@@ -140,42 +140,42 @@ void ControlLaws::reset_state() {
 Vec3 ControlLaws::compute(LawId law, const LawInput& in, RateReference& rr) {
   switch (law) {
     case LawId::kNtcl:
-      rr = mrp_rate_reference(in.q, in.omega, in.ref, p_.ntcl.lambda);
-      return ntcl_torque(j_hat_, p_.ntcl.k, in.omega, rr);
+      rr = mrp_rate_reference(in.q, in.omega, in.ref, g_.ntcl.lambda);
+      return ntcl_torque(j_hat_, g_.ntcl.k, in.omega, rr);
     case LawId::kNtclEl:
-      rr = mrp_rate_reference(in.q, in.omega, in.ref, p_.el.lambda);
-      return el_torque(j_hat_, p_.el.k, in.q, in.omega, rr);
+      rr = mrp_rate_reference(in.q, in.omega, in.ref, g_.el.lambda);
+      return el_torque(j_hat_, g_.el.k, in.q, in.omega, rr);
     case LawId::kFeedforward:
-      rr = mrp_rate_reference(in.q, in.omega, in.ref, p_.feedforward.lambda);
-      return feedforward_torque(j_hat_, p_.feedforward.k, in.omega, rr);
+      rr = mrp_rate_reference(in.q, in.omega, in.ref, g_.feedforward.lambda);
+      return feedforward_torque(j_hat_, g_.feedforward.k, in.omega, rr);
     case LawId::kIntegral: {
-      rr = mrp_rate_reference(in.q, in.omega, in.ref, p_.integral.lambda);
+      rr = mrp_rate_reference(in.q, in.omega, in.ref, g_.integral.lambda);
       const Vec3 s = in.omega - rr.omega_r;
       // Eq. (19) with anti-windup: conditional integration (frozen while the allocator saturates)
       // and a per-axis clamp.
       if (!in.saturated_last) {
-        integral_ += dt_ * (p_.integral.k_i * s);
-        const double lim = p_.integral.integral_limit_nm;
+        integral_ += dt_ * (g_.integral.k_i * s);
+        const double lim = g_.integral.integral_limit_nm;
         for (int i = 0; i < 3; ++i) integral_[i] = std::clamp(integral_[i], -lim, lim);
       }
-      return ntcl_torque(j_hat_, p_.integral.k, in.omega, rr) - integral_;
+      return ntcl_torque(j_hat_, g_.integral.k, in.omega, rr) - integral_;
     }
     case LawId::kAdaptive: {
-      rr = mrp_rate_reference(in.q, in.omega, in.ref, p_.adaptive.lambda);
+      rr = mrp_rate_reference(in.q, in.omega, in.ref, g_.adaptive.lambda);
       const Vec3 s = in.omega - rr.omega_r;
       const Mat36 y = regressor(in.omega, rr.omega_r, rr.omega_r_dot);
-      const Vec3 u = y * a_hat_ - p_.adaptive.k * s;  // Eq. (34)
+      const Vec3 u = y * a_hat_ - g_.adaptive.k * s;  // Eq. (34)
       // a_hat_dot = -Gamma Proj(a_hat, Y' s): Euler step, then projection onto the convex set.
-      const Vec6 a_next = a_hat_ - dt_ * p_.adaptive.gamma * (y.transpose() * s);
+      const Vec6 a_next = a_hat_ - dt_ * g_.adaptive.gamma * (y.transpose() * s);
       a_hat_ = inertia_to_params(project_inertia(params_to_inertia(a_next), eig_lo_, eig_hi_));
       return u;
     }
     case LawId::kSo3:
-      rr = so3_rate_reference(in.q, in.omega, in.ref, p_.so3.lambda);
-      return ntcl_torque(j_hat_, p_.so3.k, in.omega, rr);  // Eq. (37)
+      rr = so3_rate_reference(in.q, in.omega, in.ref, g_.so3.lambda);
+      return ntcl_torque(j_hat_, g_.so3.k, in.omega, rr);  // Eq. (37)
     case LawId::kDpd:
       rr = RateReference{};
-      return dpd_torque(p_.dpd, in.omega, in.q, in.ref);
+      return dpd_torque(g_.dpd, in.omega, in.q, in.ref);
   }
   rr = RateReference{};
   return Vec3::Zero();

@@ -3,10 +3,59 @@
 #pragma once
 
 #include "gnc/guidance/references.hpp"
-#include "gnc/params.hpp"
+#include "gnc/io.hpp"
 #include "gnc/types.hpp"
 
 namespace rocksteady::gnc {
+
+struct TrackingGains {  // K (N m s) and Lambda (1/s) of Eqs. (9), (17), feed-forward law
+  Mat3 k{1e4 * Mat3::Identity()};
+  Mat3 lambda{1e-3 * Mat3::Identity()};
+};
+
+struct IntegralGains {  // Eq. (19)
+  Mat3 k{1e4 * Mat3::Identity()};
+  Mat3 lambda{1e-3 * Mat3::Identity()};
+  // [Rocksteady choice] K_I: the study gives no value. K_I = 1 N m/(rad) puts the integral
+  // corner (K_I/K = 1e-4 1/s) a factor ~3 below the contraction rate lambda_min(K)/lambda_max(J).
+  Mat3 k_i{1.0 * Mat3::Identity()};
+  // [Rocksteady choice] anti-windup: |integral| clamped per axis, frozen while the allocator
+  // saturates.
+  double integral_limit_nm{500.0};
+};
+
+struct AdaptiveGains {  // Eq. (34)
+  Mat3 k{1e4 * Mat3::Identity()};
+  Mat3 lambda{1e-3 * Mat3::Identity()};
+  double gamma{1e12};
+  // [Rocksteady choice] projection set: the eigenvalues of J(a_hat) stay within
+  // [floor_ratio * lambda_min(J_hat0), ceiling_ratio * lambda_max(J_hat0)].
+  double eig_floor_ratio{0.5};
+  double eig_ceiling_ratio{2.0};
+};
+
+struct So3Gains {  // Eq. (37)
+  Mat3 k{1e4 * Mat3::Identity()};
+  // [Rocksteady choice] Lambda_e = 4 Lambda_r: near the goal e_R ~ theta/2 and E ~ I/2, so this
+  // gives the MRP law's small-angle attitude bandwidth (q ~ theta/4, Z ~ I/4).
+  Mat3 lambda{4e-3 * Mat3::Identity()};
+};
+
+struct DpdGains {  // Eqs. (49)-(50)
+  Mat3 k_d{1e4 * Mat3::Identity()};
+  double k_p{10.0};
+};
+
+// The gains of every law (GncParams holds them under the same names).
+struct LawGains {
+  TrackingGains ntcl{};
+  TrackingGains el{};
+  TrackingGains feedforward{};
+  IntegralGains integral{};
+  AdaptiveGains adaptive{};
+  So3Gains so3{};
+  DpdGains dpd{};
+};
 
 // omega_r and its analytic time derivative.
 struct RateReference {
@@ -53,7 +102,7 @@ struct LawInput {
 
 class ControlLaws {
  public:
-  void configure(const GncParams& p, const Mat3& j_hat);
+  void configure(const LawGains& g, const Mat3& j_hat, double dt);
   void reset_state();  // integral to zero, a_hat to J_hat
   // One tick of law `law`. Writes omega_r for telemetry.
   Vec3 compute(LawId law, const LawInput& in, RateReference& rr);
@@ -62,7 +111,7 @@ class ControlLaws {
   const Vec6& a_hat() const { return a_hat_; }
 
  private:
-  GncParams p_{};
+  LawGains g_{};
   Mat3 j_hat_{Mat3::Identity()};
   double dt_{0.1};
   double eig_lo_{0.0};

@@ -3,10 +3,23 @@
 // the estimate is the measurement (pass-through).
 #pragma once
 
-#include "gnc/params.hpp"
+#include <cstdint>
+
 #include "gnc/types.hpp"
 
 namespace rocksteady::gnc {
+
+enum class EstimatorKind : std::uint8_t { kPassThrough = 0, kFilter = 1 };
+
+struct EstimatorParams {  // SPEC §6
+  EstimatorKind kind{EstimatorKind::kPassThrough};
+  double omega_c{0.02 * 3.14159265358979323846};  // rad/s
+  int predict_substeps{1};                         // RK4 steps per tick in the prediction
+  // Sample acceptance: a gyro rate above this, or a star-tracker quaternion whose norm is off by
+  // more than the tolerance, is rejected (counted, and the model carries the estimate).
+  double gyro_max_rate{1.0};          // rad/s
+  double quat_norm_tolerance{0.01};
+};
 
 struct Measurement {
   Vec3 omega{Vec3::Zero()};  // gyro, rad/s

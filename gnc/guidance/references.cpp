@@ -4,17 +4,6 @@
 
 namespace rocksteady::gnc {
 
-const char* to_string(ReferencePhase p) {
-  switch (p) {
-    case ReferencePhase::kNone: return "none";
-    case ReferencePhase::kDamping: return "damping";
-    case ReferencePhase::kHold: return "hold";
-    case ReferencePhase::kTrack: return "track";
-    case ReferencePhase::kTrackAugmented: return "track_augmented";
-  }
-  return "?";
-}
-
 void References::configure(const GuidanceParams& g, double dt) {
   g_ = g;
   dt_ = dt;

@@ -2,23 +2,22 @@
 // HOLD phases, the constant-attitude hold, and the fuel-optimal reference (Eqs. 45-48) for TRACK.
 #pragma once
 
-#include <cstdint>
-
 #include "gnc/guidance/trajectory.hpp"
+#include "gnc/io.hpp"
 #include "gnc/math/rotation.hpp"
-#include "gnc/params.hpp"
 #include "gnc/types.hpp"
 
 namespace rocksteady::gnc {
 
-enum class ReferencePhase : std::uint8_t {
-  kNone = 0,            // IDLE, SAFE: no reference, thrusters inhibited
-  kDamping = 1,         // Eq. (51) phase 1: omega_r = 0 (rate damping)
-  kHold = 2,            // Eq. (51) phase 2 / hold: q_d = q_final, qdot_d = 0
-  kTrack = 3,           // Eq. (45): follow omega_d(t)
-  kTrackAugmented = 4,  // Eqs. (46)-(48): omega_d plus convergence to q_final
+struct GuidanceParams {
+  double omega_switch{5e-4};  // rad/s: D+PD-based switch (51), fuel-optimal augmentation (46)-(48)
+  double k_qd{1e-4};          // 1/s, Eq. (46)-(48)
+  Vec3 q_final{Vec3::Zero()};  // MRP, the commanded final attitude (ground can change it)
+  // [Rocksteady choice] period of the TRACK reference reset from the current estimate; 0: only at
+  // activation.
+  double track_reset_period_s{0.0};
+  double eps_trans{0.5 * 2.0 * 3.14159265358979323846 / 60.0};  // 0.5 rpm in rad/s (SPEC §5)
 };
-const char* to_string(ReferencePhase p);
 
 struct ReferenceSample {
   ReferencePhase phase{ReferencePhase::kNone};

@@ -2,31 +2,6 @@
 
 namespace rocksteady::gnc {
 
-const char* to_string(TransitionCheck c) {
-  switch (c) {
-    case TransitionCheck::kOk: return "ok";
-    case TransitionCheck::kSameMode: return "already in that mode";
-    case TransitionCheck::kNotAllowed: return "transition not allowed";
-    case TransitionCheck::kNoTrajectory: return "no valid trajectory loaded";
-    case TransitionCheck::kLawCannotTrack: return "the D+PD law cannot track a trajectory";
-    case TransitionCheck::kNoEstimate: return "no valid state estimate";
-    case TransitionCheck::kInvalidMode: return "unknown mode";
-  }
-  return "?";
-}
-
-const char* to_string(EventId e) {
-  switch (e) {
-    case EventId::kModeChanged: return "mode_changed";
-    case EventId::kAutoHold: return "auto_hold";
-    case EventId::kSensorTimeout: return "sensor_timeout";
-    case EventId::kNonFiniteState: return "non_finite_state";
-    case EventId::kRequestRejected: return "request_rejected";
-    case EventId::kSensorRejected: return "sensor_rejected";
-  }
-  return "?";
-}
-
 namespace {
 // Rows: from; columns: to (IDLE, DETUMBLE, HOLD, TRACK, SAFE).
 // SAFE is left only for IDLE or DETUMBLE, by ground command.
@@ -70,30 +45,28 @@ void ModeManager::go(Mode to, EventId why, ModeEvents& events) {
   entered_ = true;
 }
 
-void ModeManager::update(bool has_request, Mode request, const TransitionContext& ctx,
-                         double omega_norm, double sensor_age_s, bool state_finite,
-                         ModeEvents& events) {
+void ModeManager::update(const ModeInputs& in, ModeEvents& events) {
   entered_ = false;
-  if (has_request) {
-    const TransitionCheck c = check_transition(mode_, request, ctx);
+  if (in.has_request) {
+    const TransitionCheck c = check_transition(mode_, in.request, in.ctx);
     if (c == TransitionCheck::kOk) {
-      go(request, EventId::kModeChanged, events);
+      go(in.request, EventId::kModeChanged, events);
     } else {
-      events.push(ModeEvent{EventId::kRequestRejected, mode_, request, c});
+      events.push(ModeEvent{EventId::kRequestRejected, mode_, in.request, c});
     }
   }
   // Faults first: they override everything but SAFE itself.
   if (mode_ != Mode::kSafe) {
-    if (!state_finite) {
+    if (!in.state_finite) {
       go(Mode::kSafe, EventId::kNonFiniteState, events);
       return;
     }
-    if (sensor_age_s > p_.sensor_timeout_s) {
+    if (in.sensor_age_s > p_.sensor_timeout_s) {
       go(Mode::kSafe, EventId::kSensorTimeout, events);
       return;
     }
   }
-  if (mode_ == Mode::kDetumble && p_.auto_hold && omega_norm <= omega_switch_) {
+  if (mode_ == Mode::kDetumble && p_.auto_hold && in.omega_norm <= omega_switch_) {
     go(Mode::kHold, EventId::kAutoHold, events);  // Eq. (51): the D+PD-based switch
   }
 }

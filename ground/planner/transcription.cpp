@@ -6,19 +6,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "gnc/math/rotation.hpp"
+
 namespace rocksteady::ground::planner {
 
-namespace {
-
-Mat3 skew(const Vec3& v) {
-  Mat3 s;
-  s << 0.0, -v.z(), v.y(),  //
-      v.z(), 0.0, -v.x(),   //
-      -v.y(), v.x(), 0.0;
-  return s;
-}
-
-}  // namespace
+using gnc::skew;  // S(v), the flight core's one cross-product matrix
 
 HermiteSimpsonNlp::HermiteSimpsonNlp(const TranscriptionModel& model)
     : model_(model), nodes_(model.nodes), points_(2 * model.nodes - 1) {

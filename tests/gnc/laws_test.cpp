@@ -9,6 +9,7 @@
 
 #include "gnc/control/laws.hpp"
 #include "gnc/math/rotation.hpp"
+#include "gnc/params.hpp"
 #include "rigid_body.hpp"
 
 namespace rocksteady::gnc {
@@ -139,7 +140,7 @@ TEST_P(NtclFamily, ConvergesAtLeastAtContractionRateWithPerfectModel) {
   const double k = 5.0, lambda = 0.5;
   const GncParams p = test_params(k, lambda);
   ControlLaws laws;
-  laws.configure(p, test_inertia());
+  laws.configure(law_gains(p), test_inertia(), p.dt);
   laws.reset_state();
   test::RigidBody body = tumbling_body();
   const Trace tr = run(laws, GetParam(), p, body, 40.0, track_sample);
@@ -157,7 +158,7 @@ TEST(NtclDiscreteFloor, HalvingTheStepHalvesTheResidual) {
     GncParams p = test_params(5.0, 0.5);
     p.dt = k == 0 ? 2e-3 : 1e-3;
     ControlLaws laws;
-    laws.configure(p, test_inertia());
+    laws.configure(law_gains(p), test_inertia(), p.dt);
     laws.reset_state();
     test::RigidBody body = tumbling_body();
     const Trace tr = run(laws, LawId::kNtcl, p, body, 40.0, track_sample);
@@ -177,13 +178,13 @@ TEST(IntegralNtcl, RejectsConstantDisturbanceTorque) {
   auto hold = [&](double, const Vec3& q) { return hold_sample(target, q); };
 
   ControlLaws plain;
-  plain.configure(p, test_inertia());
+  plain.configure(law_gains(p), test_inertia(), p.dt);
   plain.reset_state();
   test::RigidBody b1 = tumbling_body();
   const Trace without = run(plain, LawId::kNtcl, p, b1, 150.0, hold, d);
 
   ControlLaws integral;
-  integral.configure(p, test_inertia());
+  integral.configure(law_gains(p), test_inertia(), p.dt);
   integral.reset_state();
   test::RigidBody b2 = tumbling_body();
   const Trace with = run(integral, LawId::kIntegral, p, b2, 150.0, hold, d);
@@ -198,7 +199,7 @@ TEST(IntegralNtcl, RejectsConstantDisturbanceTorque) {
 TEST(IntegralNtcl, AntiWindupFreezesIntegratorWhileSaturated) {
   GncParams p = test_params(5.0, 0.5);
   ControlLaws laws;
-  laws.configure(p, test_inertia());
+  laws.configure(law_gains(p), test_inertia(), p.dt);
   laws.reset_state();
   LawInput in{Vec3(0.1, 0.2, -0.1), Vec3::Zero(), hold_sample(Vec3::Zero(), Vec3::Zero()), true};
   RateReference rr;
@@ -213,7 +214,7 @@ TEST(IntegralNtcl, AntiWindupFreezesIntegratorWhileSaturated) {
 TEST(So3Ntcl, ConvergesFrom170Degrees) {
   const GncParams p = test_params(5.0, 0.5);
   ControlLaws laws;
-  laws.configure(p, test_inertia());
+  laws.configure(law_gains(p), test_inertia(), p.dt);
   laws.reset_state();
   test::RigidBody body;
   body.j = test_inertia();
@@ -232,7 +233,7 @@ TEST(AdaptiveNtcl, StaysBoundedAndKeepsInertiaPositiveDefinite) {
   Mat3 j_hat = 1.4 * j_true;  // 40 % model error
   j_hat(0, 1) = j_hat(1, 0) = -2.0;
   ControlLaws laws;
-  laws.configure(p, j_hat);
+  laws.configure(law_gains(p), j_hat, p.dt);
   laws.reset_state();
   Eigen::SelfAdjointEigenSolver<Mat3> es(j_hat);
   const double lo = p.adaptive.eig_floor_ratio * es.eigenvalues().minCoeff();
@@ -275,7 +276,7 @@ TEST(AdaptiveNtcl, ProjectionIsANearestPointMapIntoTheEigenvalueBox) {
 TEST(Dpd, DampsThenHoldsTargetAttitude) {
   const GncParams p = test_params(5.0, 0.5);
   ControlLaws laws;
-  laws.configure(p, test_inertia());
+  laws.configure(law_gains(p), test_inertia(), p.dt);
   laws.reset_state();
   test::RigidBody body = tumbling_body();
   ReferenceSample damp;

@@ -1,0 +1,14 @@
+// The one result type of a validation across gnc, fsw and the configuration loaders: ok, or the
+// first bad field and why. Plain data (string literals only), so flight code can return it from a
+// tick-free configure() without exceptions or heap.
+#pragma once
+
+namespace rocksteady::gnc {
+
+struct Check {
+  bool ok{true};
+  const char* field{""};   // the first offending field, e.g. "mode.sensor_timeout"
+  const char* reason{""};  // why it was rejected
+};
+
+}  // namespace rocksteady::gnc
