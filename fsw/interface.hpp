@@ -6,7 +6,8 @@
 #include <array>
 #include <cstdint>
 
-#include "gnc/gnc.hpp"
+#include "gnc/guidance/trajectory.hpp"
+#include "gnc/io.hpp"
 
 namespace rocksteady::fsw {
 

@@ -14,17 +14,27 @@ bool is_rotation(const gnc::Mat3& r) {
   return orth <= 1e-9 && std::fabs(r.determinant() - 1.0) <= 1e-9;
 }
 
+struct ReadingInput {
+  bool configured;
+  bool device_valid;
+  bool finite;    // the reading's values
+  double t;       // the reading's time
+  double t_tick;  // the tick it is read at
+  double max_age;
+};
+
 // Common timestamp / validity rules; updates the "last usable" time on success.
-ReadingStatus check_reading(bool configured, bool device_valid, bool finite, double t, double t_tick,
-                            double max_age, bool& have_last, double& last_t) {
-  if (!configured) return ReadingStatus::kNotConfigured;
-  if (!device_valid) return ReadingStatus::kDeviceInvalid;
-  if (!finite || !std::isfinite(t) || !std::isfinite(t_tick)) return ReadingStatus::kNonFinite;
-  const double age = t_tick - t;
-  if (age > max_age || age < -max_age) return ReadingStatus::kStale;
-  if (have_last && t <= last_t) return ReadingStatus::kNotAdvancing;
-  have_last = true;
-  last_t = t;
+ReadingStatus check_reading(const ReadingInput& in, ReadingClock& clock) {
+  if (!in.configured) return ReadingStatus::kNotConfigured;
+  if (!in.device_valid) return ReadingStatus::kDeviceInvalid;
+  if (!in.finite || !std::isfinite(in.t) || !std::isfinite(in.t_tick)) {
+    return ReadingStatus::kNonFinite;
+  }
+  const double age = in.t_tick - in.t;
+  if (age > in.max_age || age < -in.max_age) return ReadingStatus::kStale;
+  if (clock.have_last && in.t <= clock.last_t) return ReadingStatus::kNotAdvancing;
+  clock.have_last = true;
+  clock.last_t = in.t;
   return ReadingStatus::kOk;
 }
 
@@ -52,14 +62,14 @@ SensorConfigError Gyro::configure(const SensorConfig& config) {
   if (e == SensorConfigError::kOk) {
     config_ = config;
     configured_ = true;
-    have_last_ = false;
+    clock_ = ReadingClock{};
   }
   return e;
 }
 
 ReadingStatus Gyro::read(const GyroReading& r, double t_tick, gnc::SensorSample& out) {
-  const ReadingStatus status = check_reading(configured_, r.valid, r.rate.allFinite(), r.t, t_tick,
-                                             config_.max_age_s, have_last_, last_t_);
+  const ReadingStatus status = check_reading(
+      {configured_, r.valid, r.rate.allFinite(), r.t, t_tick, config_.max_age_s}, clock_);
   out.gyro_valid = status == ReadingStatus::kOk;
   if (out.gyro_valid) {
     out.gyro_rate = config_.body_from_sensor * r.rate;
@@ -76,15 +86,15 @@ SensorConfigError StarTracker::configure(const SensorConfig& config) {
     // quat::from_dcm(C_BS) is beta_BS; its conjugate is beta_SB.
     beta_sb_ = gnc::quat::conjugate(gnc::quat::from_dcm(config.body_from_sensor));
     configured_ = true;
-    have_last_ = false;
+    clock_ = ReadingClock{};
   }
   return e;
 }
 
 ReadingStatus StarTracker::read(const StarTrackerReading& r, double t_tick,
                                 gnc::SensorSample& out) {
-  const ReadingStatus status = check_reading(configured_, r.valid, r.quat.allFinite(), r.t, t_tick,
-                                             config_.max_age_s, have_last_, last_t_);
+  const ReadingStatus status = check_reading(
+      {configured_, r.valid, r.quat.allFinite(), r.t, t_tick, config_.max_age_s}, clock_);
   out.star_valid = status == ReadingStatus::kOk;
   if (out.star_valid) {
     out.star_quat = gnc::quat::multiply(r.quat, beta_sb_);

@@ -9,7 +9,7 @@
 
 #include <cstdint>
 
-#include "gnc/gnc.hpp"
+#include "gnc/io.hpp"
 #include "gnc/types.hpp"
 #include "hal/readings.hpp"
 
@@ -35,10 +35,16 @@ enum class ReadingStatus : std::uint8_t {
   kNotConfigured,
 };
 
+// The time of the last usable reading (a frozen sensor repeats itself).
+struct ReadingClock {
+  bool have_last{false};
+  double last_t{0.0};
+};
+
 class Gyro {
  public:
   SensorConfigError configure(const SensorConfig& config);
-  void reset() { have_last_ = false; }
+  void reset() { clock_ = ReadingClock{}; }
   // omega_B = C_BS omega_S into out.gyro_rate / out.gyro_valid (the rate is left untouched when
   // the reading is not usable). Returns why it was not.
   ReadingStatus read(const GyroReading& r, double t_tick, gnc::SensorSample& out);
@@ -47,15 +53,14 @@ class Gyro {
  private:
   SensorConfig config_{};
   bool configured_{false};
-  bool have_last_{false};
-  double last_t_{0.0};
+  ReadingClock clock_{};
   std::uint32_t rejects_{0};
 };
 
 class StarTracker {
  public:
   SensorConfigError configure(const SensorConfig& config);
-  void reset() { have_last_ = false; }
+  void reset() { clock_ = ReadingClock{}; }
   // R_IB = R_IS C_SB, i.e. beta_IB = beta_IS (x) beta_SB with beta_SB the conjugate of C_BS's, into
   // out.star_quat / out.star_valid.
   ReadingStatus read(const StarTrackerReading& r, double t_tick, gnc::SensorSample& out);
@@ -65,8 +70,7 @@ class StarTracker {
   SensorConfig config_{};
   gnc::Vec4 beta_sb_{0.0, 0.0, 0.0, 1.0};
   bool configured_{false};
-  bool have_last_{false};
-  double last_t_{0.0};
+  ReadingClock clock_{};
   std::uint32_t rejects_{0};
 };
 

@@ -7,7 +7,7 @@
 #include <array>
 #include <cstdint>
 
-#include "gnc/gnc.hpp"
+#include "gnc/io.hpp"
 #include "hal/readings.hpp"
 #include "gnc/model/rcs.hpp"
 #include "gnc/types.hpp"

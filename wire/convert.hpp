@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "gnc/gnc.hpp"
+#include "gnc/io.hpp"
 #include "hal/readings.hpp"
 #include "rocksteady/gnc_telemetry_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"

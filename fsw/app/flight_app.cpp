@@ -3,12 +3,14 @@
 #include <cinttypes>
 #include <cmath>
 
+#include "gnc/units.hpp"
+
 namespace rocksteady::fsw {
 
 namespace {
 
 std::int64_t to_ns(double s) {
-  return static_cast<std::int64_t>(std::llround(s * 1e9));
+  return static_cast<std::int64_t>(std::llround(s * static_cast<double>(gnc::kNsPerS)));
 }
 
 }  // namespace

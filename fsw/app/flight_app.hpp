@@ -24,6 +24,7 @@
 #include "fsw/interface.hpp"
 #include "fsw/params/param_lifecycle.hpp"
 #include "fsw/uplink/uplink_lifecycle.hpp"
+#include "gnc/check.hpp"
 #include "gnc/gnc.hpp"
 
 namespace rocksteady::fsw {
@@ -42,11 +43,8 @@ struct FlightConfig {
   std::uint32_t overrun_safe_slips{10};
 };
 
-struct InitResult {
-  bool ok{true};
-  const char* field{""};
-  const char* reason{""};
-};
+// {ok, field, reason}: the project's one check result (gnc/check.hpp).
+using InitResult = gnc::Check;
 
 // What one base tick produced. Events are not here: drain them with pop_event().
 struct Outputs {

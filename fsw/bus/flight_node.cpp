@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <ctime>
 
+#include "gnc/units.hpp"
 #include "lcmtypes/channels.hpp"
 #include "wire/convert.hpp"
 
@@ -15,12 +16,14 @@ namespace rocksteady::fsw::bus {
 
 namespace {
 
-constexpr std::int64_t kNsPerS = 1000000000;
+using gnc::kNsPerS;
 constexpr std::int64_t kNsPerMs = 1000000;
 // Bus-layer events number their own sequence from here (the application's events count from 0).
 constexpr std::uint64_t kBusEventSeqBase = 1000000000000ULL;
 
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+std::int64_t to_ns(double s) {
+  return static_cast<std::int64_t>(std::llround(s * static_cast<double>(kNsPerS)));
+}
 
 void accumulate(wire::RxCounters& a, const wire::RxCounters& b) {
   a.ok += b.ok;

@@ -1,5 +1,5 @@
 // rocksteady-fsw: the flight application on the LCM bus (processor-in-the-loop, or the flight
-// board's Linux process). Configuration is read once at start-up (YAML, through fsw/config's
+// board's Linux process). Configuration is read once at start-up (YAML, through config/'s
 // strict loader: the flight side's estimates only, never the truth); after that the loop is the
 // FlightNode's, whose tick path does not allocate.
 //
@@ -25,7 +25,7 @@
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/bus/flight_node.hpp"
 #include "fsw/executive/clock.hpp"
-#include "fsw/config/config_files.hpp"
+#include "config/config_files.hpp"
 #include "hal/lcm/lcm_ports.hpp"
 
 namespace {

@@ -13,7 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ground/campaign/campaign.hpp"
-#include "fsw/config/config_error.hpp"
+#include "config/config_error.hpp"
 
 namespace {
 

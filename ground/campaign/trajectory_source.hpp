@@ -7,7 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "gnc/gnc.hpp"
+#include "gnc/guidance/trajectory.hpp"
+#include "gnc/params.hpp"
 #include "ground/config/config.hpp"
 
 namespace rocksteady::campaign {

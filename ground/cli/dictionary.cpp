@@ -5,7 +5,8 @@
 #include <cctype>
 #include <cstdlib>
 
-#include "gnc/gnc.hpp"
+#include "gnc/guidance/trajectory.hpp"
+#include "gnc/io.hpp"
 
 namespace rocksteady::ground::cli {
 

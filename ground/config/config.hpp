@@ -1,11 +1,11 @@
 // The configuration files assembled for a closed-loop run: the flight software's parameters
-// (fsw/config) and the plant's truth (true mass properties, thrusters, disturbance, sensor noise,
+// (config/) and the plant's truth (true mass properties, thrusters, disturbance, sensor noise,
 // initial state), SPEC Eq. (6).
 #pragma once
 
 #include <string>
 
-#include "fsw/config/config_files.hpp"
+#include "config/config_files.hpp"
 #include "ground/plant/plant.hpp"
 
 namespace rocksteady::config {

@@ -80,4 +80,21 @@ Mat3 rotation_exp(const Vec3& v) {
   return Mat3::Identity() + std::sin(a) * k + (1.0 - std::cos(a)) * k * k;
 }
 
+void rk4_step(const Mat3& j, const Mat3& j_inv, const Vec3& torque, double h, Vec4& beta,
+              Vec3& omega) {
+  auto derivative = [&](const Vec4& b, const Vec3& w, Vec4& b_dot, Vec3& w_dot) {
+    b_dot = quat_rate(b, w);                      // Eq. (3)
+    w_dot = j_inv * ((j * w).cross(w) + torque);  // Eq. (2)
+  };
+  Vec4 k1b, k2b, k3b, k4b;
+  Vec3 k1w, k2w, k3w, k4w;
+  derivative(beta, omega, k1b, k1w);
+  derivative(beta + 0.5 * h * k1b, omega + 0.5 * h * k1w, k2b, k2w);
+  derivative(beta + 0.5 * h * k2b, omega + 0.5 * h * k2w, k3b, k3w);
+  derivative(beta + h * k3b, omega + h * k3w, k4b, k4w);
+  beta += (h / 6.0) * (k1b + 2.0 * k2b + 2.0 * k3b + k4b);
+  omega += (h / 6.0) * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+  beta.normalize();
+}
+
 }  // namespace rocksteady::plant::att

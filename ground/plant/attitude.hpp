@@ -31,5 +31,11 @@ Vec4 mrp_to_quat(const Vec3& q);
 // Rotation by angle |v| about v/|v| (Rodrigues' formula): exp(S(v)).
 Mat3 rotation_exp(const Vec3& v);
 
+// One classical RK4 step of length h of SPEC Eq. (2), J w' = (J w) x w + tau, and Eq. (3), with the
+// torque held over the step (zero-order hold); beta is renormalised after the step. The plant and
+// the flight-side tests' truth model (tests/common/rigid_body.hpp) both integrate with this.
+void rk4_step(const Mat3& j, const Mat3& j_inv, const Vec3& torque, double h, Vec4& beta,
+              Vec3& omega);
+
 }  // namespace att
 }  // namespace rocksteady::plant

@@ -115,12 +115,6 @@ void Plant::set_state(const Vec4& beta, const Vec3& omega) {
   omega_ = omega;
 }
 
-void Plant::derivative(const Vec4& beta, const Vec3& omega, const Vec3& torque, Vec4& beta_dot,
-                       Vec3& omega_dot) const {
-  beta_dot = att::quat_rate(beta, omega);                  // Eq. (3)
-  omega_dot = j_inv_ * ((j_ * omega).cross(omega) + torque);  // Eq. (2)
-}
-
 void Plant::advance(const Vec8& force, bool enabled) {
   // Per-channel saturation at the true u_max; zero-order hold over the period.
   clipped_ = false;
@@ -147,17 +141,7 @@ void Plant::advance(const Vec8& force, bool enabled) {
 
   const Vec3 torque = b_ * applied_ + disturbance_ + p_.disturbance.bias_nm;  // Eq. (2): B u + d
   const double h = p_.control_period_s / p_.substeps;
-  for (int s = 0; s < p_.substeps; ++s) {
-    Vec4 k1b, k2b, k3b, k4b;
-    Vec3 k1w, k2w, k3w, k4w;
-    derivative(beta_, omega_, torque, k1b, k1w);
-    derivative(beta_ + 0.5 * h * k1b, omega_ + 0.5 * h * k1w, torque, k2b, k2w);
-    derivative(beta_ + 0.5 * h * k2b, omega_ + 0.5 * h * k2w, torque, k3b, k3w);
-    derivative(beta_ + h * k3b, omega_ + h * k3w, torque, k4b, k4w);
-    beta_ += (h / 6.0) * (k1b + 2.0 * k2b + 2.0 * k3b + k4b);
-    omega_ += (h / 6.0) * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
-    beta_.normalize();
-  }
+  for (int s = 0; s < p_.substeps; ++s) att::rk4_step(j_, j_inv_, torque, h, beta_, omega_);
   // Eq. (54): exact for forces held over the period.
   fuel_kg_ += applied_.lpNorm<1>() / (p_.isp_s * p_.g0) * p_.control_period_s;
   ++ticks_;

@@ -97,9 +97,6 @@ class Plant {
   void set_state(const Vec4& beta, const Vec3& omega);
 
  private:
-  void derivative(const Vec4& beta, const Vec3& omega, const Vec3& torque, Vec4& beta_dot,
-                  Vec3& omega_dot) const;
-
   PlantParams p_;
   Mat3 j_{Mat3::Identity()};
   Mat3 j_inv_{Mat3::Identity()};

@@ -29,6 +29,7 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
 
+#include "gnc/units.hpp"
 #include "ground/config/config.hpp"
 #include "ground/merit/figures_of_merit.hpp"
 #include "ground/plant/plant.hpp"
@@ -43,7 +44,7 @@ using namespace rocksteady;
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int /*sig*/) { g_stop = 1; }
 
-constexpr std::int64_t kNsPerS = 1000000000;
+using gnc::kNsPerS;
 
 std::int64_t now_ns() {
   timespec ts{};
@@ -252,8 +253,8 @@ int main(int argc, char** argv) {
   bool started = !lockstep;
   bool bus_error = false;
   hal::ThrusterOutputs thrusters{};  // held over each period (zero-order hold)
-  const auto timeout_ns = static_cast<std::int64_t>(timeout_ms * 1e6);
-  const auto period_ns = static_cast<std::int64_t>(std::llround(dt * 1e9));
+  const auto timeout_ns = static_cast<std::int64_t>(timeout_ms * 1e6);  // ms -> ns
+  const auto period_ns = static_cast<std::int64_t>(std::llround(dt * static_cast<double>(kNsPerS)));
   bus.event(rocksteady::event_t::SEV_INFO, kRunStarted, 0, 0, 0.0,
             "plant run started: " + setup.case_name + " (" + mode + ")");
   if (verbose) {
@@ -280,7 +281,7 @@ int main(int argc, char** argv) {
       int attempts = 0;
       std::int64_t deadline = now_ns() + timeout_ns;
       const std::int64_t startup_deadline =
-          now_ns() + static_cast<std::int64_t>(startup_timeout_s * 1e9);
+          now_ns() + static_cast<std::int64_t>(startup_timeout_s * static_cast<double>(kNsPerS));
       bus.have_cmd = false;
       while (!got && g_stop == 0) {
         if (!bus.wait_once(deadline)) {

@@ -12,7 +12,8 @@
 #include <Eigen/Dense>
 
 #include "fsw/app/flight_app.hpp"
-#include "gnc/gnc.hpp"
+#include "gnc/guidance/trajectory.hpp"
+#include "gnc/params.hpp"
 #include "rigid_body.hpp"
 
 namespace rocksteady::fsw::test {

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "gnc/params.hpp"
-#include "fsw/config/config_error.hpp"
+#include "config/config_error.hpp"
 
 namespace rocksteady::config {
 

@@ -1,4 +1,4 @@
-#include "fsw/config/yaml_reader.hpp"
+#include "config/yaml_reader.hpp"
 
 #include <cmath>
 #include <fstream>

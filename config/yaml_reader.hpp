@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
-#include "fsw/config/config_error.hpp"
+#include "config/config_error.hpp"
 
 namespace rocksteady::config {
 

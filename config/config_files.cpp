@@ -1,4 +1,4 @@
-#include "fsw/config/config_files.hpp"
+#include "config/config_files.hpp"
 
 #include <cmath>
 #include <string>
@@ -6,7 +6,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "fsw/config/yaml_reader.hpp"
+#include "config/yaml_reader.hpp"
 
 namespace rocksteady::config {
 
