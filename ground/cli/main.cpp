@@ -30,6 +30,9 @@
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONFIG
 #include "ground/config/config.hpp"
 #endif
+#ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
+#include "ground/console/server.hpp"
+#endif
 
 namespace cli = rocksteady::ground::cli;
 namespace planner = rocksteady::ground::planner;
@@ -331,6 +334,28 @@ int main(int argc, char** argv) {
 
   CLI::App* params = app.add_subcommand("params", "list the loadable parameters (set-gain)");
 
+#ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
+  rocksteady::ground::console::ServeOptions so;
+  CLI::App* serve = app.add_subcommand(
+      "serve", "the browser console (NASA Open MCT): telemetry, events, commands over HTTP");
+  serve->add_option("--bind", so.bind, "address to listen on (default 127.0.0.1, loopback only)");
+  serve->add_option("--port", so.port, "TCP port (default 8090; 0: any free port, printed)")
+      ->check(CLI::Range(0, 65535));
+  serve->add_option("--web-root", so.web_root,
+                    "folder with app/ and openmct/ (default: next to this program)");
+  serve->add_option("--sender", so.sender, "sender id of the console's commands (default 2)")
+      ->check(CLI::NonNegativeNumber);
+  serve->add_option("--state-dir", so.state_dir, "sequence state directory (as for send)");
+  serve
+      ->add_option("--timeout", so.ack_timeout_s,
+                   "seconds to wait for a command's acknowledgement (default 3)")
+      ->check(CLI::PositiveNumber);
+  serve
+      ->add_option("--stale-after", so.stale_after_s,
+                   "seconds without a message before a channel is flagged stale (default 3)")
+      ->check(CLI::PositiveNumber);
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -381,6 +406,13 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+
+#ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
+  if (*serve) {
+    so.lcm_url = url;
+    return rocksteady::ground::console::serve(so);
+  }
+#endif
 
   if (*params) {
     for (const cli::ParamEntry& p : cli::param_dictionary()) {

@@ -235,6 +235,30 @@ int run(int argc, char** argv) {
   if (!severity_of.empty()) {
     fail(yaml_path, "events." + severity_of.begin()->first + ": the flight defines no such event");
   }
+  if (const YAML::Node pe = root["plant_events"]) {
+    if (!pe.IsMap()) fail(yaml_path, "plant_events: must map ids to [name, severity]");
+    for (const auto& e : pe) {
+      const std::string where = "plant_events." + e.first.as<std::string>();
+      int id = 0;
+      try {
+        id = e.first.as<int>();
+      } catch (const YAML::Exception&) {
+        fail(yaml_path, where + ": the id must be an integer");
+      }
+      if (id < 1000) fail(yaml_path, where + ": plant event ids start at 1000");
+      if (!e.second.IsSequence() || e.second.size() != 2)
+        fail(yaml_path, where + ": must be [name, severity]");
+      const std::string name = e.second[0].as<std::string>();
+      const std::string sev = e.second[1].as<std::string>();
+      bool known_sev = false;
+      for (const auto& [i, s] : enums["severity"]) known_sev = known_sev || s == sev;
+      if (!known_sev)
+        fail(yaml_path, where + ": severity '" + sev + "' is not one of enums.severity");
+      if (enums["event"].count(id) != 0) fail(yaml_path, where + ": the id is the flight's");
+      enums["event"][id] = name;
+      events.push_back({{"id", id}, {"name", name}, {"severity", sev}});
+    }
+  }
 
   // --- Channels: every field of every type, and nothing else ----------------------------------
   const YAML::Node ty = root["types"];
@@ -258,6 +282,14 @@ int run(int argc, char** argv) {
     if (!tn["channel"]) fail(yaml_path, tw + ".channel: missing");
     const std::string channel = tn["channel"].as<std::string>();
     const std::string title = tn["title"] ? tn["title"].as<std::string>() : t.name;
+    bool periodic = false;
+    if (tn["periodic"]) {
+      try {
+        periodic = tn["periodic"].as<bool>();
+      } catch (const YAML::Exception&) {
+        fail(yaml_path, tw + ".periodic: must be true or false");
+      }
+    }
     const YAML::Node fields = tn["fields"];
     if (!fields || !fields.IsMap()) fail(yaml_path, tw + ".fields: missing or not a map");
     std::set<std::string> lcm_fields;
@@ -325,6 +357,7 @@ int run(int argc, char** argv) {
     channels.push_back({{"channel", channel},
                         {"type", t.name},
                         {"title", title},
+                        {"periodic", periodic},
                         {"points", points},
                         {"text_fields", text_fields}});
   }
