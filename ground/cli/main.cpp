@@ -23,6 +23,7 @@
 #include "ground/cli/commands.hpp"
 #include "ground/cli/csv.hpp"
 #include "ground/cli/dictionary.hpp"
+#include "ground/cli/sequence.hpp"
 #include "ground/cli/sequence_store.hpp"
 #include "ground/cli/trajectory_input.hpp"
 #include "ground/planner/planner.hpp"
@@ -334,6 +335,31 @@ int main(int argc, char** argv) {
 
   CLI::App* params = app.add_subcommand("params", "list the loadable parameters (set-gain)");
 
+  std::string seq_file;
+  bool seq_check = false;
+  cli::GateOptions run_gate;
+  CLI::App* run = app.add_subcommand(
+      "run", "run a command sequence: sends with acks, waits on telemetry conditions");
+  run->footer(
+      "A sequence is YAML:\n"
+      "  name: hold-after-detumble\n"
+      "  steps:\n"
+      "    - send: set-mode DETUMBLE\n"
+      "    - wait: mode == HOLD, timeout 600 s\n"
+      "    - sleep: 5 s\n"
+      "    - send: set-target 0.1 0 0\n"
+      "The whole file is checked before the first command is sent; the run stops at the first\n"
+      "rejection, missing acknowledgement or timeout.\n"
+      "Exit status: 0 completed, 1 aborted (rejected, timeout), 2 invalid sequence or usage.");
+  run->add_option("sequence", seq_file, "the sequence file (YAML)")->required();
+  run->add_flag("--check", seq_check, "validate only, send nothing");
+  run->add_option("--sender", run_gate.sender, "sender id (default 1, the operator console)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--timeout", run_gate.timeout_s,
+                  "seconds to wait for each acknowledgement (default 3)")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--state-dir", run_gate.state_dir, "sequence state directory (as for send)");
+
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
   rocksteady::ground::console::ServeOptions so;
   CLI::App* serve = app.add_subcommand(
@@ -401,6 +427,28 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(st.written),
                    cli::describe_rejections(st.rx).c_str());
       return strict && st.rejected() > 0 ? 1 : 0;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+  }
+
+  if (*run) {
+    const cli::SequenceParse parsed = cli::load_sequence(seq_file);
+    if (!parsed.ok) {
+      for (const std::string& e : parsed.errors) std::fprintf(stderr, "error: %s\n", e.c_str());
+      std::fprintf(stderr, "%s: %zu error(s); nothing was sent\n", seq_file.c_str(),
+                   parsed.errors.size());
+      return 2;
+    }
+    std::fprintf(stderr, "%s: %zu steps, valid\n", seq_file.c_str(), parsed.sequence.steps.size());
+    if (seq_check) return 0;
+    try {
+      run_gate.lcm_url = url;
+      cli::CommandGate gate(run_gate);
+      std::unique_ptr<lcm::LCM> lcm = open_bus(url);
+      const cli::SequenceReport r = cli::run_sequence(parsed.sequence, gate, *lcm, stdout);
+      return r.outcome == cli::SequenceReport::Outcome::kCompleted ? 0 : 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "error: %s\n", e.what());
       return 2;

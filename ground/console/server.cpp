@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -18,6 +19,7 @@
 
 #include "ground/cli/command_gate.hpp"
 #include "ground/cli/commands.hpp"
+#include "ground/cli/sequence.hpp"
 #include "ground/console/telemetry_store.hpp"
 #include "ground/dictionary/dictionary.hpp"
 
@@ -291,6 +293,36 @@ int serve(const ServeOptions& o) {
     }
     res.set_content(out.dump(), "application/json");
   });
+  // A sequence from the browser: validated completely, then run on a bus of its own, one at a time.
+  std::mutex sequence_mutex;
+  svr.Post("/api/sequence", [&](const httplib::Request& req, httplib::Response& res) {
+    json out;
+    const cli::SequenceParse parsed = cli::parse_sequence(req.body, "sequence");
+    if (!parsed.ok) {
+      std::string report;
+      for (const std::string& e : parsed.errors) report += e + "\n";
+      report += std::to_string(parsed.errors.size()) + " error(s); nothing was sent";
+      out = {{"outcome", "invalid"}, {"errors", parsed.errors}, {"report", report}};
+      res.status = 400;
+    } else {
+      std::unique_lock<std::mutex> lock(sequence_mutex, std::try_to_lock);
+      if (!lock.owns_lock()) {
+        out = {{"outcome", "busy"}, {"report", "another sequence is running"}};
+        res.status = 409;
+      } else {
+        lcm::LCM lcm(o.lcm_url);
+        const cli::SequenceReport r = cli::run_sequence(parsed.sequence, gate, lcm, nullptr);
+        const bool done = r.outcome == cli::SequenceReport::Outcome::kCompleted;
+        out = {{"outcome", done ? "completed" : "aborted"},
+               {"failed_step", r.failed_step},
+               {"lines", r.lines},
+               {"summary", r.summary},
+               {"report", r.text()}};
+      }
+    }
+    res.set_content(out.dump(), "application/json");
+  });
+
   int port = o.port;
   if (port == 0) {
     port = svr.bind_to_any_port(o.bind);

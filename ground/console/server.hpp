@@ -10,6 +10,8 @@
 //   POST /api/command           {"command": "set-mode", "args": ["HOLD"]}: encoded and checked as
 //                               `rocksteady-ground send` does, sent, and answered with the flight's
 //                               acknowledgement (accepted, or the reason it was rejected)
+//   POST /api/sequence          a command sequence (YAML, as for `rocksteady-ground run`):
+//                               validated completely, then run; the report
 // It listens on loopback unless told otherwise.
 #pragma once
 

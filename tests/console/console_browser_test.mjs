@@ -4,6 +4,7 @@
 // Checks, each with a screenshot in the artefact folder:
 //   1. plots receive data: an Open MCT plot of omega_hat_0 has points, and the status view is LIVE;
 //   2. a SET_MODE HOLD from the command form is acknowledged (ACCEPTED) and telemetry shows HOLD;
+//      a refused command shows the flight's reason; a command sequence run from the browser completes;
 //   3. an ERROR event turns red: the plant is stopped, the flight raises sensor_timeout (ERROR) and
 //      its row in the events view is red;
 //   4. stale telemetry is flagged after the flight software is killed.
@@ -100,6 +101,16 @@ try {
   await shot('3-command-ack');
   await go('rocksteady:spacecraft/rocksteady:status');
   check(await waitText('#rs-tile-mode .rs-tile-value', /^HOLD$/, 10000), 'telemetry shows mode HOLD');
+
+  // A command sequence from the browser: a command, then a wait on telemetry.
+  await go('rocksteady:spacecraft/rocksteady:commands');
+  await page.waitForSelector('#rs-sequence', { timeout: 10000 });
+  await page.$eval('#rs-sequence', (e) => {
+    e.value = 'name: browser-check\nsteps:\n  - send: noop\n  - wait: mode == HOLD, timeout 10 s\n';
+  });
+  await page.click('#rs-run-sequence');
+  check(await waitText('#rs-sequence-result', /COMPLETED: 2 steps of 'browser-check'/, 20000),
+    'a sequence run from the browser completes');
 
   // 3. Stop the plant: the flight times out its sensors, goes SAFE and raises an ERROR event.
   process.kill(Number(plantPid), 'SIGTERM');
