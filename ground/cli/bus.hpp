@@ -61,6 +61,7 @@ struct MonitorOptions {
   double seconds{-1.0};  // stop after this long (< 0: no limit)
   bool ansi{false};      // redraw a status block (terminal) instead of one line per message
   int event_lines{10};   // events kept under the status block (ansi)
+  double stale_after_s{3.0};  // no telemetry this long: flag it STALE (<= 0: never)
 };
 
 // Runs until a limit is reached; returns what it saw.

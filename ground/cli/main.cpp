@@ -319,6 +319,10 @@ int main(int argc, char** argv) {
   monitor->add_option("--seconds", mon.seconds, "exit after S seconds")
       ->check(CLI::NonNegativeNumber);
   monitor->add_flag("--plain", plain, "one line per message even on a terminal");
+  monitor
+      ->add_option("--stale-after", mon.stale_after_s,
+                   "flag telemetry STALE after this many silent seconds (default 3, 0: never)")
+      ->check(CLI::NonNegativeNumber);
   monitor->add_flag("--ansi", ansi, "redraw a status block even when not on a terminal");
 
   std::string log_path;

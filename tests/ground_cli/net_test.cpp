@@ -126,6 +126,16 @@ TEST(GroundCliNet, MonitorPrintsOneLinePerTelemetryMessage) {
   EXPECT_NE(r.err.find("monitor: 3 telemetry"), std::string::npos) << r.err;
 }
 
+TEST(GroundCliNet, MonitorFlagsSilenceAsStale) {
+  test::TempDir dir;
+  // Nobody publishes: the monitor says so instead of staying blank, once, in plain mode.
+  const test::Run r =
+      in_namespace(dir, "", ground(17607, "monitor --seconds 1.5 --plain --stale-after 0.5"));
+  EXPECT_NE(r.out.find("STALE: no telemetry on RS_GNC_TLM for"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(none received yet)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("STALE", r.out.find("STALE") + 1), std::string::npos) << r.out;
+}
+
 // A real plan (case 1, coarse grid) uplinked in chunks: the responder reassembles it with the
 // flight's TrajectoryUplink, announces uplink_complete, and accepts LOAD_TRAJECTORY only when the
 // reassembled table validates (CRC-32 included).
