@@ -8,8 +8,10 @@
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -23,6 +25,7 @@
 #include "ground/cli/commands.hpp"
 #include "ground/cli/csv.hpp"
 #include "ground/cli/dictionary.hpp"
+#include "ground/cli/plot.hpp"
 #include "ground/cli/sequence.hpp"
 #include "ground/cli/sequence_store.hpp"
 #include "ground/cli/trajectory_input.hpp"
@@ -364,6 +367,25 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   run->add_option("--state-dir", run_gate.state_dir, "sequence state directory (as for send)");
 
+  std::string plot_in;
+  std::string plot_out;
+  std::vector<double> plot_q_final;
+  CLI::App* plot = app.add_subcommand(
+      "plot", "the Figure-3 plot of a run (PIL LCM log or run CSV) as PNG, with gnuplot");
+  plot->footer(
+      "Panels: body rate, attitude (MRP) and fuel; truth solid, on-board estimate dashed, "
+      "reference dotted (when the input has them); t_omega,conv and t_q,conv (SPEC 7) marked, or "
+      "NC.\nExit status: 0 written, 1 gnuplot failed, 2 unreadable input or usage.");
+  plot->add_option("input", plot_in,
+                   "LCM log (RS_PLANT_TRUTH, RS_GNC_TLM) or CSV (campaign timeseries.csv, plant "
+                   "--out)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  plot->add_option("-o,--output", plot_out, "PNG file (default: INPUT with .png)");
+  plot->add_option("--q-final", plot_q_final,
+                   "target MRP for t_q,conv (default: from telemetry, else 0 0 0)")
+      ->expected(3);
+
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
   rocksteady::ground::console::ServeOptions so;
   CLI::App* serve = app.add_subcommand(
@@ -431,6 +453,29 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(st.written),
                    cli::describe_rejections(st.rx).c_str());
       return strict && st.rejected() > 0 ? 1 : 0;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+  }
+
+  if (*plot) {
+    try {
+      const cli::PlotData d = cli::load_plot_data(plot_in);
+      cli::PlotOptions po;
+      po.output = plot_out.empty()
+                      ? std::filesystem::path(plot_in).replace_extension(".png").string()
+                      : plot_out;
+      if (plot_q_final.size() == 3) {
+        po.q_final = std::array<double, 3>{plot_q_final[0], plot_q_final[1], plot_q_final[2]};
+      }
+      const std::string error = cli::write_plot(d, po);
+      if (!error.empty()) {
+        std::fprintf(stderr, "error: %s\n", error.c_str());
+        return 1;
+      }
+      std::printf("%s\n", po.output.c_str());
+      return 0;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "error: %s\n", e.what());
       return 2;
