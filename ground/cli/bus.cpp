@@ -217,9 +217,9 @@ int SendResult::exit_code() const {
       return kExitRejected;
     case Outcome::kTimeout:
     case Outcome::kError:
-      return kExitTimeoutOrUsage;
+      return kExitRunFailed;
   }
-  return kExitTimeoutOrUsage;
+  return kExitRunFailed;
 }
 
 SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s) {

@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <exception>
@@ -33,6 +34,7 @@
 #include "hal/lcm/uplink.hpp"
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONFIG
 #include "ground/config/config.hpp"
+#include "ground/config/config_dir.hpp"
 #endif
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
 #include "ground/console/server.hpp"
@@ -62,7 +64,7 @@ struct SendArgs {
   double u_max{200.0};
   double delta_j{0.0};
   double delta_r{0.0};
-  std::string mission, gnc, case_file;
+  std::string mission, gnc, case_file, config_dir;
 };
 
 // The sequence number of the next command: --seq (recorded in the state file when there is one), or
@@ -155,12 +157,24 @@ int send_one(lcm::LCM* lcm, rocksteady::ground_cmd_t cmd, const std::string& des
 planner::PlanModel expected_model(const SendArgs& a) {
   if (!a.mission.empty() || !a.gnc.empty() || !a.case_file.empty()) {
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONFIG
-    if (a.mission.empty() || a.gnc.empty() || a.case_file.empty()) {
-      throw std::runtime_error("--mission, --gnc and --case go together");
+    if (a.case_file.empty()) {
+      throw std::runtime_error(std::string(a.mission.empty() ? "--gnc" : "--mission") +
+                               " needs --case (the case whose model the plan must match)");
     }
-    const auto mission = rocksteady::config::load_mission(a.mission);
-    const auto run = rocksteady::config::assemble(mission, rocksteady::config::load_gnc(a.gnc),
-                                                  rocksteady::config::load_case(a.case_file));
+    std::string dir;
+    if (a.mission.empty() || a.gnc.empty() ||
+        std::all_of(a.case_file.begin(), a.case_file.end(), ::isdigit)) {
+      const rocksteady::config::ConfigDir d = rocksteady::config::find_config_dir(a.config_dir);
+      if (d.path.empty()) throw std::runtime_error(d.error);
+      dir = d.path;
+    }
+    const std::string case_path = rocksteady::config::case_file(dir, a.case_file, "--case");
+    const auto mission = rocksteady::config::load_mission(
+        a.mission.empty() ? rocksteady::config::mission_file(dir) : a.mission);
+    const auto run = rocksteady::config::assemble(
+        mission,
+        rocksteady::config::load_gnc(a.gnc.empty() ? rocksteady::config::gnc_file(dir) : a.gnc),
+        rocksteady::config::load_case(case_path));
     planner::PlanModel m;
     m.j_hat = rocksteady::gnc::total_inertia(run.flight.mass_hat);
     m.b_hat = rocksteady::gnc::torque_matrix(run.flight.rcs, run.flight.mass_hat.r_so_bcm);
@@ -181,7 +195,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
     std::fprintf(stderr,
                  "error: upload-trajectory takes 1 argument (the trajectory file), got %zu\n",
                  a.args.size());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   const std::string& path = a.args[0];
   planner::LoadResult loaded;
@@ -190,11 +204,11 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
                           : cli::load_trajectory(path, expected_model(a));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   if (!loaded.ok) {
     std::fprintf(stderr, "error: %s\n", loaded.error.c_str());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   const auto table = std::make_unique<rocksteady::gnc::TrajectoryTable>(loaded.file.to_table());
   // The upload id: --upload-id, else a fresh sequence number (unique per sender and state file).
@@ -216,7 +230,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   std::fprintf(stderr, "%s\n", r.message.c_str());
   if (!r.complete) {
     std::printf("TIMEOUT: %s\n", r.message.c_str());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitRunFailed;
   }
   if (a.no_load) {
     std::printf("UPLOADED: upload id %d (load it with: send load-trajectory %d)\n", id, id);
@@ -225,7 +239,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   const cli::Encoded e = cli::encode_command("load-trajectory", {std::to_string(id)});
   if (!e.ok) {
     std::fprintf(stderr, "error: %s\n", e.error.c_str());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   return send_one(lcm, e.cmd, e.description, seqs, a);
 }
@@ -236,7 +250,7 @@ int run_send(const SendArgs& a, const std::string& url) {
     if (a.command == "upload-trajectory") {
       if (a.quat) {
         std::fprintf(stderr, "error: --quat applies to set-target only\n");
-        return cli::kExitTimeoutOrUsage;
+        return cli::kExitUsage;
       }
       std::unique_ptr<lcm::LCM> lcm = a.dry_run ? nullptr : open_bus(url);
       return upload(lcm.get(), seqs, a);
@@ -246,13 +260,13 @@ int run_send(const SendArgs& a, const std::string& url) {
     const cli::Encoded e = cli::encode_command(a.command, a.args, options);
     if (!e.ok) {
       std::fprintf(stderr, "error: %s\n", e.error.c_str());
-      return cli::kExitTimeoutOrUsage;
+      return cli::kExitUsage;
     }
     std::unique_ptr<lcm::LCM> lcm = a.dry_run ? nullptr : open_bus(url);
     return send_one(lcm.get(), e.cmd, e.description, seqs, a);
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "error: %s\n", ex.what());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
 }
 
@@ -261,7 +275,8 @@ std::string send_footer() {
   for (const cli::CommandHelp& h : cli::command_help()) {
     s += std::string("  ") + h.usage + "\n      " + h.what + "\n";
   }
-  s += "Exit status: 0 accepted, 1 rejected, 2 timeout or usage error.\n"
+  s += "Exit status: 0 accepted, 1 rejected or not acknowledged (timeout), 2 usage or "
+       "configuration error.\n"
        "Negative numbers are arguments, e.g. set-target -0.1 0 0.2 (or put them after --).";
   return s;
 }
@@ -270,6 +285,9 @@ std::string send_footer() {
 
 int main(int argc, char** argv) {
   CLI::App app{"Rocksteady operator console: commands, live telemetry, log conversion"};
+  app.footer(
+      "Exit status (every subcommand): 0 ok, 1 the run failed (command rejected or not "
+      "acknowledged, sequence aborted, gnuplot failed), 2 usage or configuration error.");
   app.require_subcommand(1);
   std::string url;
   app.add_option("--lcm-url", url,
@@ -308,10 +326,15 @@ int main(int argc, char** argv) {
   send->add_option("--u-max", s.u_max, "upload-trajectory: study-case model, u_max (N)");
   send->add_option("--delta-j", s.delta_j, "upload-trajectory: study-case model, ||dJ_ast||_2");
   send->add_option("--delta-r", s.delta_r, "upload-trajectory: study-case model, ||dr||_2 (m)");
+  send->add_option("--case", s.case_file,
+                   "upload-trajectory: check the plan against study case N (<config dir>/cases/"
+                   "caseN.yaml) or a case file");
+  send->add_option("--config-dir", s.config_dir,
+                   "upload-trajectory: folder with mission.yaml, gnc.yaml, cases/ (default: "
+                   "$ROCKSTEADY_CONFIG_DIR, else next to this program, else ./configs)");
   send->add_option("--mission", s.mission,
-                   "upload-trajectory: model from mission YAML (with --gnc, --case)");
-  send->add_option("--gnc", s.gnc, "upload-trajectory: GNC YAML");
-  send->add_option("--case", s.case_file, "upload-trajectory: case YAML");
+                   "upload-trajectory: mission YAML (default: <config dir>/mission.yaml)");
+  send->add_option("--gnc", s.gnc, "upload-trajectory: GNC YAML (default: <config dir>/gnc.yaml)");
 
   cli::MonitorOptions mon;
   bool plain = false;
@@ -416,7 +439,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
 
   if (*send) return run_send(s, url);

@@ -92,10 +92,12 @@ TEST(GroundCliNet, CommandNotAllowedInTheFlightModeIsRejectedWithExitOne) {
   EXPECT_EQ(r.out.rfind("REJECTED: not allowed in this mode", 0), 0u) << r.out;
 }
 
-TEST(GroundCliNet, NoAcknowledgementIsATimeoutWithExitTwo) {
+// One exit convention for every tool: a command that is never acknowledged is a failed run (1),
+// not a usage error (2).
+TEST(GroundCliNet, NoAcknowledgementIsATimeoutWithExitOne) {
   test::TempDir dir;
   const test::Run r = in_namespace(dir, "", ground(17604, "send noop --timeout 0.3 --seq 1"));
-  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_EQ(r.out.rfind("TIMEOUT: no acknowledgement of seq 1", 0), 0u) << r.out;
 }
 
