@@ -83,6 +83,15 @@ try {
   check(history.n >= 5 && history.finite, 'historical telemetry: ' + history.n + ' finite samples of omega_hat_0');
   await new Promise((r) => setTimeout(r, 1500));
   await shot('2-plot-omega');
+  // The overlay plot of the three rate components (Open MCT's plot type over our points).
+  await go('rocksteady:spacecraft/rocksteady:plot-rate');
+  const series = await page.waitForFunction(() => {
+    const items = document.querySelectorAll('.plot-legend-item, .c-plot-legend__item');
+    return items.length >= 3 && document.querySelector('.js-series-data-loaded') ? items.length : 0;
+  }, { timeout: 30000, polling: 500 }).then((h) => h.jsonValue(), () => 0);
+  check(series >= 3, 'the body-rate overlay plot has its ' + series + ' series');
+  await new Promise((r) => setTimeout(r, 1500));
+  await shot('2b-plot-rate-overlay');
 
   // 2. SET_MODE HOLD from the command form.
   await go('rocksteady:spacecraft/rocksteady:commands');

@@ -17,6 +17,7 @@ exec unshare -rn bash -c '
   url="udpm://239.255.76.67:7667?ttl=0"
   state=$(mktemp -d)
   cd "$RS_SRC"
+  rm -f "$RS_OUT"/*.log "$RS_OUT"/*.png   # nothing of an earlier run is read or kept
   "$RS_BUILD/fsw/main/rocksteady-fsw" --lcm-url "$url" --case 1 --clock realtime \
       --start-mode DETUMBLE --tlm-every 2 > "$RS_OUT/fsw.log" 2>&1 & fsw=$!
   "$RS_BUILD/ground/plantd/rocksteady-plant" --lcm-url "$url" --case 1 --mode realtime \

@@ -9,6 +9,13 @@ function RocksteadyDictionaryPlugin(client) {
     { key: 'events', name: 'Events', type: 'rocksteady.events' },
     { key: 'commands', name: 'Commands', type: 'rocksteady.commands' }
   ];
+  // Overlay plots of the quantities an operator watches (Open MCT's own plot type, composed of our
+  // points): the study's Figure 3 live.
+  const PLOTS = [
+    { key: 'plot-rate', name: 'Body rate ω̂ (rad/s)', points: ['RS_GNC_TLM.omega_hat_0', 'RS_GNC_TLM.omega_hat_1', 'RS_GNC_TLM.omega_hat_2'] },
+    { key: 'plot-attitude', name: 'Attitude q̂ (MRP)', points: ['RS_GNC_TLM.q_hat_0', 'RS_GNC_TLM.q_hat_1', 'RS_GNC_TLM.q_hat_2'] },
+    { key: 'plot-fuel', name: 'Fuel used (kg)', points: ['RS_GNC_TLM.fuel_kg', 'RS_PLANT_TRUTH.fuel_used_kg'] }
+  ];
 
   function valueMetadata(channel, p) {
     const value = {
@@ -50,9 +57,21 @@ function RocksteadyDictionaryPlugin(client) {
     };
   }
 
+  // Open MCT keeps view settings (a plot's series colours, ...) in the object itself: the plots'
+  // objects are kept in memory for the session, so their views can mutate them.
+  const edited = new Map();
   const objectProvider = {
+    update: function (domainObject) {
+      edited.set(domainObject.identifier.key, domainObject);
+      return Promise.resolve(true);
+    },
+    create: function (domainObject) {
+      edited.set(domainObject.identifier.key, domainObject);
+      return Promise.resolve(true);
+    },
     get: function (identifier) {
       const k = identifier.key;
+      if (edited.has(k)) return Promise.resolve(edited.get(k));
       if (k === 'spacecraft') {
         return Promise.resolve({
           identifier: identifier, name: 'Rocksteady', type: 'folder', location: 'ROOT'
@@ -62,6 +81,17 @@ function RocksteadyDictionaryPlugin(client) {
       if (view) {
         return Promise.resolve({
           identifier: identifier, name: view.name, type: view.type, location: NS + ':spacecraft'
+        });
+      }
+      const plot = PLOTS.find((p) => p.key === k);
+      if (plot) {
+        return Promise.resolve({
+          identifier: identifier,
+          name: plot.name,
+          type: 'telemetry.plot.overlay',
+          location: NS + ':spacecraft',
+          composition: plot.points.map((key) => ({ namespace: NS, key: key })),
+          configuration: { series: [] }
         });
       }
       if (client.channels[k]) {
@@ -84,7 +114,7 @@ function RocksteadyDictionaryPlugin(client) {
       const k = domainObject.identifier.key;
       if (k === 'spacecraft') {
         return Promise.resolve(
-          VIEWS.map((v) => ({ namespace: NS, key: v.key })).concat(
+          VIEWS.concat(PLOTS).map((v) => ({ namespace: NS, key: v.key })).concat(
             client.dictionary.channels.map((c) => ({ namespace: NS, key: c.channel }))));
       }
       const c = client.channels[k];
