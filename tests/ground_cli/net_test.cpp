@@ -132,7 +132,7 @@ TEST(GroundCliNet, MonitorFlagsSilenceAsStale) {
   test::TempDir dir;
   // Nobody publishes: the monitor says so instead of staying blank, once, in plain mode.
   const test::Run r =
-      in_namespace(dir, "", ground(17607, "monitor --seconds 1.5 --plain --stale-after 0.5"));
+      in_namespace(dir, "", ground(17608, "monitor --seconds 1.5 --plain --stale-after 0.5"));
   EXPECT_NE(r.out.find("STALE: no telemetry on RS_GNC_TLM for"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(none received yet)"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("STALE", r.out.find("STALE") + 1), std::string::npos) << r.out;
