@@ -165,5 +165,34 @@ TEST(GroundCliNet, UploadTrajectoryChunksCompleteAndLoad) {
   EXPECT_NE(r.err.find("responder=0"), std::string::npos) << r.err;
 }
 
+// --case N is checked against study case N's model, whose configs are found next to the program
+// even when run from a folder without them; a case that does not exist is named as typed.
+TEST(GroundCliConfigs, UploadCaseNumberFromAnyDirectory) {
+  test::TempDir dir;
+  planner::PlanProblem problem;
+  problem.case_name = "cli-case";
+  problem.model = planner::study_case_model(200.0, 0.0, 0.0);
+  problem.settings.nodes = 51;
+  problem.settings.verify_refinement = false;
+  const planner::PlanResult plan = planner::plan(problem);
+  ASSERT_TRUE(plan.ok) << plan.error;
+  const std::string file = dir.file("plan.yaml");
+  planner::write_trajectory_file(file, problem, plan);
+  const std::string g = "cd " + test::quote(dir.str()) + " && env -u ROCKSTEADY_CONFIG_DIR " +
+                        test::quote(ROCKSTEADY_GROUND_EXE) + " send upload-trajectory " +
+                        test::quote(file) + " --dry-run --seq 1 ";
+  const test::Run missing = test::run(g + "--case 9", dir);
+  EXPECT_EQ(missing.exit_code, 2) << missing.err;
+  EXPECT_NE(missing.err.find("--case 9: no case file"), std::string::npos) << missing.err;
+  // Case 1's configured model: the file (planned for the nominal study model) is checked against
+  // it, so the outcome is the loader's verdict, not "cannot read configs/mission.yaml".
+  const test::Run one = test::run(g + "--case 1", dir);
+  EXPECT_EQ(one.err.find("cannot read file"), std::string::npos) << one.err;
+  EXPECT_EQ(one.err.find("no configuration folder"), std::string::npos) << one.err;
+  const test::Run alone = test::run(g + "--mission x.yaml", dir);
+  EXPECT_EQ(alone.exit_code, 2);
+  EXPECT_NE(alone.err.find("--mission needs --case"), std::string::npos) << alone.err;
+}
+
 }  // namespace
 }  // namespace rocksteady::ground::cli
