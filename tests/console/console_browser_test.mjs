@@ -105,9 +105,13 @@ try {
   await page.$eval('#rs-args', (e) => { e.value = ''; });
   await page.type('#rs-args', 'TRACK');
   await page.click('#rs-send');
-  check(await waitText('#rs-command-result', /REJECTED — REJECTED: not allowed in this mode/, 10000),
+  check(await waitText('#rs-command-result', /SET_MODE TRACK \(seq \d+\): REJECTED: not allowed in this mode/, 10000),
     'SET_MODE TRACK (no trajectory) is rejected with the flight\'s reason');
   await shot('3-command-ack');
+  // Bad input is refused on the ground, before anything is sent, with the same message as send.
+  const invalid = await page.evaluate(() => window.rocksteadyClient.send('set-mode', ['CRUISE']));
+  check(invalid.outcome === 'invalid' && /unknown mode 'CRUISE'/.test(invalid.message) && !invalid.seq,
+    'an invalid command is refused before sending: ' + invalid.message);
   await go('rocksteady:spacecraft/rocksteady:status');
   check(await waitText('#rs-tile-mode .rs-tile-value', /^HOLD$/, 10000), 'telemetry shows mode HOLD');
 

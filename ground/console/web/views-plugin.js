@@ -162,8 +162,12 @@ function RocksteadyViewsPlugin(client) {
       try {
         const r = await client.send(select.value, words);
         result.className = 'rs-result rs-outcome-' + r.outcome;
-        result.textContent = (r.description || select.value) + (r.seq ? ' (seq ' + r.seq + ')' : '') + ': ' +
-          r.outcome.toUpperCase() + (r.outcome === 'accepted' ? '' : ' — ' + r.message);
+        // The flight's verdict as `send` prints it ("ACCEPTED", "REJECTED: <reason> ..."), or what
+        // went wrong on the ground ("TIMEOUT — no acknowledgement ...").
+        const outcome = r.outcome.toUpperCase();
+        const verdict = r.outcome === 'accepted' ? 'ACCEPTED'
+          : (r.message || '').startsWith(outcome) ? r.message : outcome + ' — ' + r.message;
+        result.textContent = (r.description || select.value) + (r.seq ? ' (seq ' + r.seq + ')' : '') + ': ' + verdict;
         log.prepend(el('li', { class: 'rs-outcome-' + r.outcome }, new Date().toISOString().slice(11, 19) + ' ' + result.textContent));
       } catch (e) {
         result.className = 'rs-result rs-outcome-error';
