@@ -16,3 +16,10 @@ echo
 echo "Same case in one process:  build/release/ground/campaign/rocksteady-campaign run --case 1 --strategy ntcl+dpd_ref"
 echo "Whole study table (7 cases x 6 strategies):  build/release/ground/campaign/rocksteady-campaign campaign"
 echo "Live with lcm-spy, replaying the log:  fsw/main/README.md"
+ground=build/release/ground/cli/rocksteady-ground
+log=out/pil/case1.lcmlog
+if [[ -f "$log" ]] && png=$("$ground" plot "$log" -o out/pil/case1.png 2>/dev/null); then
+  echo "Figure 3 of this run:  $png"
+fi
+echo "Operations console (NASA Open MCT in the browser):  $ground serve   then open http://127.0.0.1:8090/"
+echo "  (on this bus: live telemetry and events, commands, sequences; see ground/console/README.md)"

@@ -14,27 +14,50 @@
 #   --build DIR          build tree with the programs (default build/release)
 #   --out DIR            output folder (default out/pil): <case>.lcmlog, <case>.csv, <case>.*.log
 #   --port P             LCM port inside the namespace (default 7667)
+# Exit status: 0 ok, 1 the run failed (the children's last lines are printed), 2 usage error.
 # Live on a workstation with lcm-spy instead: see fsw/main/README.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 case_arg=1 law=ntcl duration="" mode=lockstep tlm_every=100 log_all=0 build=build/release out=out/pil
 port=7667
+usage_error() { echo "pil.sh: $*  (scripts/pil.sh --help)" >&2; exit 2; }
+# The value of option $1, which must be there.
+value() { [[ $# -ge 2 && -n "$2" && "$2" != --* ]] || usage_error "$1 needs a value"; }
 while (($#)); do
   case "$1" in
-    --law) law="$2"; shift 2 ;;
-    --duration) duration="$2"; shift 2 ;;
-    --mode) mode="$2"; shift 2 ;;
-    --tlm-every) tlm_every="$2"; shift 2 ;;
+    --law) value "$@"; law="$2"; shift 2 ;;
+    --duration) value "$@"; duration="$2"; shift 2 ;;
+    --mode) value "$@"; mode="$2"; shift 2 ;;
+    --tlm-every) value "$@"; tlm_every="$2"; shift 2 ;;
     --log-all) log_all=1; shift ;;
-    --build) build="$2"; shift 2 ;;
-    --out) out="$2"; shift 2 ;;
-    --port) port="$2"; shift 2 ;;
+    --build) value "$@"; build="$2"; shift 2 ;;
+    --out) value "$@"; out="$2"; shift 2 ;;
+    --port) value "$@"; port="$2"; shift 2 ;;
     -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    -*) echo "pil.sh: unknown option $1" >&2; exit 2 ;;
+    -*) usage_error "unknown option $1" ;;
     *) case_arg="$1"; shift ;;
   esac
 done
+
+# Every argument is checked before anything starts, and the message names it.
+laws="ntcl el integral adaptive so3 dpd feedforward"
+[[ " $laws " == *" $law "* ]] || usage_error "--law $law: not a control law (one of: ${laws// /, })"
+[[ "$mode" == lockstep || "$mode" == realtime ]] || usage_error "--mode $mode: lockstep or realtime"
+if [[ -n "$duration" ]]; then
+  [[ "$duration" =~ ^[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?$ ]] && awk "BEGIN{exit !($duration > 0)}" ||
+    usage_error "--duration $duration: a positive number of simulated seconds"
+fi
+[[ "$tlm_every" =~ ^[1-9][0-9]*$ ]] || usage_error "--tlm-every $tlm_every: a positive whole number of ticks"
+[[ "$port" =~ ^[0-9]+$ ]] && ((port >= 1 && port <= 65535)) || usage_error "--port $port: 1..65535"
+if [[ "$case_arg" =~ ^[0-9]+$ ]]; then
+  if [[ ! -f "configs/cases/case$case_arg.yaml" ]]; then
+    have=$(ls configs/cases 2>/dev/null | sed -n 's/^case\([0-9]*\)\.yaml$/\1/p' | sort -n | tr '\n' ' ')
+    usage_error "case $case_arg: no configs/cases/case$case_arg.yaml (cases: ${have% })"
+  fi
+elif [[ ! -f "$case_arg" ]]; then
+  usage_error "case file $case_arg: not found"
+fi
 
 fsw="$build/fsw/main/rocksteady-fsw"
 plant="$build/ground/plantd/rocksteady-plant"
@@ -77,6 +100,15 @@ unshare -rn bash -c '
   exit $rc
 ' || rc=$?
 echo
+if ((rc != 0)); then
+  # The reason is in the children's output: show it here rather than leave it in a file.
+  echo "pil.sh: the run failed (exit $rc). The plant said:" >&2
+  tail -n 15 "$out/$name.plant.err" 2>/dev/null | sed 's/^/  plant: /' >&2
+  echo "The flight software's last lines ($out/$name.fsw.log):" >&2
+  tail -n 15 "$out/$name.fsw.log" 2>/dev/null | sed 's/^/  fsw: /' >&2
+  exit 1
+fi
 echo "LCM log:      $log ($(du -h "$log" | cut -f1)); flight software log: $out/$name.fsw.log; time series: $out/$name.csv"
 echo "Replay it:    lcm-logplayer -s 10 $log   (with ground/spy/rocksteady-spy running, see fsw/main/README.md)"
-exit $rc
+echo "Plot it:      $build/ground/cli/rocksteady-ground plot $log"
+exit 0

@@ -13,6 +13,7 @@ packages=(
   gnuplot-nox
   iproute2 util-linux
   clang libclang-rt-14-dev
+  libcpp-httplib-dev nlohmann-json3-dev chromium
 )
 cross=0
 if [[ "${1:-}" == "--cross" ]]; then
@@ -31,8 +32,25 @@ for p in "${packages[@]}"; do
   fi
 done
 
+# The browser console's npm packages (NASA Open MCT; puppeteer-core for the browser test, which
+# drives Debian's chromium: no browser is downloaded), from the checked-in package-lock.json.
+npm_packages() {
+  local dir
+  dir="$(cd "$(dirname "$0")/.." && pwd)/ground/console"
+  if [[ -f "$dir/node_modules/.package-lock.json" ]] &&
+     cmp -s "$dir/package-lock.json" "$dir/node_modules/.package-lock.json.installed" 2>/dev/null; then
+    return 0
+  fi
+  # Node 20 with npm is part of the machine image (ENVIRONMENT.md), not an apt package here.
+  command -v npm >/dev/null || { echo "setup: npm not found: install Node.js 20 with npm" >&2; return 1; }
+  echo "setup: npm ci in ground/console (Open MCT, puppeteer-core)"
+  (cd "$dir" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error) &&
+    cp "$dir/package-lock.json" "$dir/node_modules/.package-lock.json.installed"
+}
+
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
+  npm_packages
   exit 0
 fi
 
@@ -45,3 +63,4 @@ fi
 echo "setup: installing ${missing[*]}"
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+npm_packages

@@ -118,6 +118,11 @@ class Monitor {
       return;
     ++counts_.telemetry;
     have_tlm_ = true;
+    last_tlm_ = Clock::now();
+    if (stale_reported_ && !options_.ansi) {
+      std::fprintf(out_, "LIVE telemetry on %s again\n", channels::kGncTelemetry);
+    }
+    stale_reported_ = false;
     if (options_.ansi) {
       redraw();
     } else {
@@ -139,6 +144,28 @@ class Monitor {
   }
   const MonitorCounts& counts() const { return counts_; }
 
+  // Called between receptions: flags telemetry that has stopped (the flight software died, the
+  // link is down) instead of leaving the last values on screen as if they were current.
+  void check_stale() {
+    if (options_.stale_after_s <= 0.0) return;
+    const Clock::time_point ref = have_tlm_ ? last_tlm_ : started_;
+    const double silent = std::chrono::duration<double>(Clock::now() - ref).count();
+    if (silent < options_.stale_after_s) return;
+    char line[160];
+    std::snprintf(line, sizeof line, "STALE: no telemetry on %s for %.1f s%s",
+                  channels::kGncTelemetry, silent,
+                  have_tlm_ ? " (values below are old)" : " (none received yet)");
+    stale_line_ = line;
+    const bool first = !stale_reported_;
+    stale_reported_ = true;
+    if (options_.ansi) {
+      redraw();
+    } else if (first) {
+      std::fprintf(out_, "%s\n", line);
+      std::fflush(out_);
+    }
+  }
+
  private:
   void show(const std::string& line) {
     if (!options_.ansi) {
@@ -155,6 +182,7 @@ class Monitor {
     // cleared: no flicker from a full clear.
     constexpr const char* kEol = "\x1b[K\n";
     std::string screen = "\x1b[H";
+    if (stale_reported_) screen += "\x1b[1;41m" + stale_line_ + "\x1b[0m" + kEol;
     if (have_tlm_) {
       for (const std::string& l : format_status(tlm_, counts_)) screen += l + kEol;
     } else {
@@ -173,6 +201,10 @@ class Monitor {
   rocksteady::gnc_telemetry_t tlm_{};
   bool have_tlm_{false};
   std::deque<std::string> recent_;
+  Clock::time_point started_{Clock::now()};
+  Clock::time_point last_tlm_{};
+  bool stale_reported_{false};
+  std::string stale_line_;
 };
 
 }  // namespace
@@ -185,9 +217,9 @@ int SendResult::exit_code() const {
       return kExitRejected;
     case Outcome::kTimeout:
     case Outcome::kError:
-      return kExitTimeoutOrUsage;
+      return kExitRunFailed;
   }
-  return kExitTimeoutOrUsage;
+  return kExitRunFailed;
 }
 
 SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s) {
@@ -308,7 +340,8 @@ MonitorCounts run_monitor(lcm::LCM& lcm, const MonitorOptions& options, std::FIL
       ms = remaining_ms(deadline);
       if (ms <= 0) break;
     }
-    if (lcm.handleTimeout(ms) < 0) break;
+    if (lcm.handleTimeout(std::min(ms, 500)) < 0) break;
+    monitor.check_stale();
   }
   for (lcm::Subscription* s : subs) {
     if (s != nullptr) lcm.unsubscribe(s);

@@ -16,10 +16,12 @@
 
 namespace rocksteady::ground::cli {
 
-// Exit codes of `rocksteady-ground send`.
+// Exit codes, one convention for every Rocksteady tool: 0 ok, 1 the run failed (for send: the
+// command was rejected or not acknowledged), 2 usage or configuration error.
 inline constexpr int kExitAccepted = 0;
 inline constexpr int kExitRejected = 1;
-inline constexpr int kExitTimeoutOrUsage = 2;
+inline constexpr int kExitRunFailed = 1;
+inline constexpr int kExitUsage = 2;
 
 struct SendResult {
   enum class Outcome { kAccepted, kRejected, kTimeout, kError };
@@ -57,10 +59,11 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
                            const UploadOptions& options, std::FILE* log);
 
 struct MonitorOptions {
-  long count{-1};        // stop after this many telemetry messages (< 0: no limit)
-  double seconds{-1.0};  // stop after this long (< 0: no limit)
-  bool ansi{false};      // redraw a status block (terminal) instead of one line per message
-  int event_lines{10};   // events kept under the status block (ansi)
+  long count{-1};             // stop after this many telemetry messages (< 0: no limit)
+  double seconds{-1.0};       // stop after this long (< 0: no limit)
+  bool ansi{false};           // redraw a status block (terminal) instead of one line per message
+  int event_lines{10};        // events kept under the status block (ansi)
+  double stale_after_s{3.0};  // no telemetry this long: flag it STALE (<= 0: never)
 };
 
 // Runs until a limit is reached; returns what it saw.

@@ -7,6 +7,7 @@
 
 #include "gnc/math/rotation.hpp"
 #include "ground/cli/dictionary.hpp"
+#include "ground/dictionary/dictionary.hpp"
 
 namespace rocksteady::ground::cli {
 
@@ -291,10 +292,7 @@ std::string command_list() {
 }
 
 std::string opcode_name(int opcode) {
-  static const char* const kNames[] = {
-      "NOOP",         "SET_MODE",       "SET_TARGET", "SET_LAW",        "LOAD_TRAJECTORY",
-      "ABORT_UPLINK", "RESET_COUNTERS", "PARAM_LOAD", "PARAM_ACTIVATE", "PARAM_DISCARD"};
-  if (opcode >= 0 && opcode < Msg::OP_COUNT) return kNames[opcode];
+  if (auto n = dictionary::enum_name("opcode", opcode)) return *n;
   return "OP " + std::to_string(opcode);
 }
 

@@ -8,6 +8,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "ground/dictionary/dictionary.hpp"
+
 namespace rocksteady::ground::cli {
 
 // (the bus library is rocksteady::wire)
@@ -134,6 +136,30 @@ struct Converter {
       row;
 };
 
+// The dictionary's names of a channel's enum fields (mode, law, event id, severity, opcode,
+// reason, ...) as trailing columns "<column>_name", after every field of the message.
+void name_header(const char* channel, std::vector<std::string>& cells) {
+  const dictionary::Channel* c = dictionary::find_channel(channel);
+  if (c == nullptr) return;
+  for (int i = 0; i < c->point_count; ++i) {
+    if (c->points[i].enum_name[0] != '\0') cells.push_back(std::string(c->points[i].key) + "_name");
+  }
+}
+
+void name_cells(const char* channel, const void* data, int len, std::vector<std::string>& cells) {
+  const dictionary::Channel* c = dictionary::find_channel(channel);
+  if (c == nullptr) return;
+  std::vector<double> values(static_cast<std::size_t>(c->point_count));
+  std::string text;
+  wire::DecodeStatus status = wire::DecodeStatus::kOk;
+  const bool ok = c->decode(data, len, values.data(), text, status);
+  for (int i = 0; i < c->point_count; ++i) {
+    if (c->points[i].enum_name[0] == '\0') continue;
+    cells.push_back(ok ? dictionary::format_value(c->points[i], values[static_cast<std::size_t>(i)])
+                       : std::string());
+  }
+}
+
 template <class T>
 Converter converter() {
   Converter c;
@@ -141,6 +167,7 @@ Converter converter() {
     Sink s(true);
     s.integer("log_utime", 0);
     visit(wire::make<T>(), s);
+    name_header(wire::channel_of<T>(), s.cells());
     return s.cells();
   };
   c.row = [](const void* data, int len, std::int64_t utime, std::vector<std::string>& row,
@@ -151,6 +178,7 @@ Converter converter() {
     Sink s(false);
     s.integer("log_utime", utime);
     visit(m, s);
+    name_cells(wire::channel_of<T>(), data, len, s.cells());
     row = std::move(s.cells());
     return true;
   };

@@ -3,7 +3,8 @@
 // fails (truncated, wrong type, out-of-range fields) is counted and left out, never guessed at.
 // Columns: log_utime (the log's receive time, microseconds since the epoch), then every field of
 // the message in the order of its .lcm file; arrays are expanded as name_0, name_1, ... (two
-// dimensions: name_i_j).
+// dimensions: name_i_j), then, for every field the dictionary (ground/dictionary) gives an enum, a
+// column "<column>_name" with the value's name (mode_name HOLD, id_name sensor_timeout, ...).
 #pragma once
 
 #include <cstdint>

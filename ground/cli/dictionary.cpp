@@ -7,6 +7,7 @@
 
 #include "gnc/guidance/trajectory.hpp"
 #include "gnc/io.hpp"
+#include "ground/dictionary/dictionary.hpp"
 
 namespace rocksteady::ground::cli {
 
@@ -23,56 +24,19 @@ std::string dashes_to_underscores(std::string s) {
   return s;
 }
 
-constexpr std::array<const char*, 5> kModes{"IDLE", "DETUMBLE", "HOLD", "TRACK", "SAFE"};
-constexpr std::array<const char*, 7> kLaws{"ntcl", "el",  "integral",   "adaptive",
-                                           "so3",  "dpd", "feedforward"};
-constexpr std::array<const char*, 3> kReferences{"keep", "dpd_ref", "fuel_optimal"};
-constexpr std::array<const char*, 5> kPhases{"none", "damping", "hold", "track", "track_augmented"};
+// The names come from the generated dictionary (ground/dictionary): the dictionary's own enums
+// (mode, law, phase, reference, severity) and the flight's tables (reason, event, opcode).
+const char* enum_cstr(const char* enum_name, int value, const char* fallback) {
+  const auto& e = dictionary::generated::enums();
+  const auto it = e.find(enum_name);
+  if (it == e.end()) return fallback;
+  const auto v = it->second.find(value);
+  return v == it->second.end() ? fallback : v->second.c_str();
+}
 
-constexpr std::array<const char*, kReasonCount> kReasons{
-    "accepted",
-    "unknown opcode",
-    "bad length",
-    "argument not finite",
-    "out-of-range argument",
-    "stale or repeated sequence number",
-    "not authenticated",
-    "not allowed in this mode",
-    "trajectory rejected",
-    "busy",
-    "internal error",
-    "parameter table invalid",
-    "no parameter load pending",
-    "uplink incomplete",
-};
-
-constexpr std::array<const char*, kLastEventId - kFirstEventId + 1> kEvents{
-    "command_accepted",
-    "command_rejected",
-    "mode_changed",
-    "auto_hold",
-    "sensor_timeout",
-    "non_finite_state",
-    "mode_request_rejected",
-    "sensor_rejected",
-    "frame_rejected",
-    "slip",
-    "missed_ticks",
-    "table_loaded",
-    "table_activated",
-    "table_activation_failed",
-    "table_discarded",
-    "law_changed",
-    "target_set",
-    "chunk_rejected",
-    "uplink_started",
-    "uplink_abandoned",
-    "uplink_complete",
-    "trajectory_rejected",
-    "trajectory_loaded",
-    "counters_reset",
-    "overrun_safe",
-};
+std::optional<int> enum_index(const char* enum_name, const std::string& key) {
+  return dictionary::enum_value(enum_name, key);
+}
 
 constexpr std::array<const char*, 6> kChunkStatus{
     "stored",
@@ -83,19 +47,9 @@ constexpr std::array<const char*, 6> kChunkStatus{
     "a completed table awaits the tick boundary",
 };
 
-constexpr std::array<const char*, 5> kSeverities{"DEBUG", "INFO", "WARNING", "ERROR", "FATAL"};
-
 template <std::size_t N>
 const char* name_or(const std::array<const char*, N>& names, int i, const char* fallback) {
   return i >= 0 && i < static_cast<int>(N) ? names[static_cast<std::size_t>(i)] : fallback;
-}
-
-template <std::size_t N>
-std::optional<int> index_of(const std::array<const char*, N>& names, const std::string& key) {
-  for (std::size_t i = 0; i < N; ++i) {
-    if (key == names[i]) return static_cast<int>(i);
-  }
-  return std::nullopt;
 }
 
 }  // namespace
@@ -104,37 +58,37 @@ std::optional<int> mode_from_name(const std::string& name) {
   std::string up = name;
   std::transform(up.begin(), up.end(), up.begin(),
                  [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  return index_of(kModes, up);
+  return enum_index("mode", up);
 }
 const char* mode_name(int mode) {
-  return name_or(kModes, mode, "?");
+  return enum_cstr("mode", mode, "?");
 }
 std::vector<std::string> mode_names() {
-  return {kModes.begin(), kModes.end()};
+  return dictionary::enum_names("mode");
 }
 
 std::optional<int> law_from_name(const std::string& name) {
-  return index_of(kLaws, lower(name));
+  return enum_index("law", lower(name));
 }
 const char* law_name(int law) {
-  return name_or(kLaws, law, "?");
+  return enum_cstr("law", law, "?");
 }
 std::vector<std::string> law_names() {
-  return {kLaws.begin(), kLaws.end()};
+  return dictionary::enum_names("law");
 }
 
 std::optional<int> reference_from_name(const std::string& name) {
-  return index_of(kReferences, dashes_to_underscores(lower(name)));
+  return enum_index("reference", dashes_to_underscores(lower(name)));
 }
 const char* reference_name(int ref) {
-  return name_or(kReferences, ref, "?");
+  return enum_cstr("reference", ref, "?");
 }
 std::vector<std::string> reference_names() {
-  return {kReferences.begin(), kReferences.end()};
+  return dictionary::enum_names("reference");
 }
 
 const char* phase_name(int phase) {
-  return name_or(kPhases, phase, "?");
+  return enum_cstr("phase", phase, "?");
 }
 
 const std::vector<ParamEntry>& param_dictionary() {
@@ -188,12 +142,12 @@ std::optional<ParamEntry> find_param(const std::string& name_or_id) {
 }
 
 std::string reason_name(int reason) {
-  const char* n = name_or(kReasons, reason, nullptr);
+  const char* n = enum_cstr("reason", reason, nullptr);
   return n != nullptr ? std::string(n) : "reason " + std::to_string(reason);
 }
 
 std::string event_name(int id) {
-  const char* n = name_or(kEvents, id - kFirstEventId, nullptr);
+  const char* n = enum_cstr("event", id, nullptr);
   return n != nullptr ? std::string(n) : "event " + std::to_string(id);
 }
 
@@ -203,7 +157,7 @@ std::string chunk_status_name(int status) {
 }
 
 const char* severity_name(int severity) {
-  return name_or(kSeverities, severity, "?");
+  return enum_cstr("severity", severity, "?");
 }
 
 std::string reason_detail(int reason, int detail) {

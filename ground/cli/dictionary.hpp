@@ -1,7 +1,7 @@
 // The ground's command and telemetry dictionary: the names an operator types and reads, mapped to
 // the numbers on the bus (lcmtypes' ground_cmd_t OP_*, cmd_ack_t REASON_*, the fsw's event ids and
-// parameter ids). The ground keeps its own copy, as a ground system does; tests/ground_cli checks
-// it against the flight application's tables entry by entry.
+// parameter ids). Names come from the generated dictionary (ground/dictionary); tests/ground_cli
+// checks it against the flight application's tables entry by entry.
 #pragma once
 
 #include <cstdint>

@@ -8,8 +8,11 @@
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -23,12 +26,18 @@
 #include "ground/cli/commands.hpp"
 #include "ground/cli/csv.hpp"
 #include "ground/cli/dictionary.hpp"
+#include "ground/cli/plot.hpp"
+#include "ground/cli/sequence.hpp"
 #include "ground/cli/sequence_store.hpp"
 #include "ground/cli/trajectory_input.hpp"
 #include "ground/planner/planner.hpp"
 #include "wire/uplink.hpp"
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONFIG
 #include "ground/config/config.hpp"
+#include "ground/config/config_dir.hpp"
+#endif
+#ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
+#include "ground/console/server.hpp"
 #endif
 
 namespace cli = rocksteady::ground::cli;
@@ -55,7 +64,7 @@ struct SendArgs {
   double u_max{200.0};
   double delta_j{0.0};
   double delta_r{0.0};
-  std::string mission, gnc, case_file;
+  std::string mission, gnc, case_file, config_dir;
 };
 
 // The sequence number of the next command: --seq (recorded in the state file when there is one), or
@@ -148,12 +157,24 @@ int send_one(lcm::LCM* lcm, rocksteady::ground_cmd_t cmd, const std::string& des
 planner::PlanModel expected_model(const SendArgs& a) {
   if (!a.mission.empty() || !a.gnc.empty() || !a.case_file.empty()) {
 #ifdef ROCKSTEADY_GROUND_CLI_WITH_CONFIG
-    if (a.mission.empty() || a.gnc.empty() || a.case_file.empty()) {
-      throw std::runtime_error("--mission, --gnc and --case go together");
+    if (a.case_file.empty()) {
+      throw std::runtime_error(std::string(a.mission.empty() ? "--gnc" : "--mission") +
+                               " needs --case (the case whose model the plan must match)");
     }
-    const auto mission = rocksteady::config::load_mission(a.mission);
-    const auto run = rocksteady::config::assemble(mission, rocksteady::config::load_gnc(a.gnc),
-                                                  rocksteady::config::load_case(a.case_file));
+    std::string dir;
+    if (a.mission.empty() || a.gnc.empty() ||
+        std::all_of(a.case_file.begin(), a.case_file.end(), ::isdigit)) {
+      const rocksteady::config::ConfigDir d = rocksteady::config::find_config_dir(a.config_dir);
+      if (d.path.empty()) throw std::runtime_error(d.error);
+      dir = d.path;
+    }
+    const std::string case_path = rocksteady::config::case_file(dir, a.case_file, "--case");
+    const auto mission = rocksteady::config::load_mission(
+        a.mission.empty() ? rocksteady::config::mission_file(dir) : a.mission);
+    const auto run = rocksteady::config::assemble(
+        mission,
+        rocksteady::config::load_gnc(a.gnc.empty() ? rocksteady::config::gnc_file(dir) : a.gnc),
+        rocksteady::config::load_case(case_path));
     planner::PlanModel m;
     m.j_hat = rocksteady::gnc::total_inertia(run.flight.mass_hat);
     m.b_hat = rocksteady::gnc::torque_matrix(run.flight.rcs, run.flight.mass_hat.r_so_bcm);
@@ -174,7 +195,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
     std::fprintf(stderr,
                  "error: upload-trajectory takes 1 argument (the trajectory file), got %zu\n",
                  a.args.size());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   const std::string& path = a.args[0];
   planner::LoadResult loaded;
@@ -183,11 +204,11 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
                           : cli::load_trajectory(path, expected_model(a));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   if (!loaded.ok) {
     std::fprintf(stderr, "error: %s\n", loaded.error.c_str());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   const auto table = std::make_unique<rocksteady::gnc::TrajectoryTable>(loaded.file.to_table());
   // The upload id: --upload-id, else a fresh sequence number (unique per sender and state file).
@@ -209,7 +230,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   std::fprintf(stderr, "%s\n", r.message.c_str());
   if (!r.complete) {
     std::printf("TIMEOUT: %s\n", r.message.c_str());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitRunFailed;
   }
   if (a.no_load) {
     std::printf("UPLOADED: upload id %d (load it with: send load-trajectory %d)\n", id, id);
@@ -218,7 +239,7 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   const cli::Encoded e = cli::encode_command("load-trajectory", {std::to_string(id)});
   if (!e.ok) {
     std::fprintf(stderr, "error: %s\n", e.error.c_str());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
   return send_one(lcm, e.cmd, e.description, seqs, a);
 }
@@ -229,7 +250,7 @@ int run_send(const SendArgs& a, const std::string& url) {
     if (a.command == "upload-trajectory") {
       if (a.quat) {
         std::fprintf(stderr, "error: --quat applies to set-target only\n");
-        return cli::kExitTimeoutOrUsage;
+        return cli::kExitUsage;
       }
       std::unique_ptr<lcm::LCM> lcm = a.dry_run ? nullptr : open_bus(url);
       return upload(lcm.get(), seqs, a);
@@ -239,13 +260,13 @@ int run_send(const SendArgs& a, const std::string& url) {
     const cli::Encoded e = cli::encode_command(a.command, a.args, options);
     if (!e.ok) {
       std::fprintf(stderr, "error: %s\n", e.error.c_str());
-      return cli::kExitTimeoutOrUsage;
+      return cli::kExitUsage;
     }
     std::unique_ptr<lcm::LCM> lcm = a.dry_run ? nullptr : open_bus(url);
     return send_one(lcm.get(), e.cmd, e.description, seqs, a);
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "error: %s\n", ex.what());
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
 }
 
@@ -254,7 +275,8 @@ std::string send_footer() {
   for (const cli::CommandHelp& h : cli::command_help()) {
     s += std::string("  ") + h.usage + "\n      " + h.what + "\n";
   }
-  s += "Exit status: 0 accepted, 1 rejected, 2 timeout or usage error.\n"
+  s += "Exit status: 0 accepted, 1 rejected or not acknowledged (timeout), 2 usage or "
+       "configuration error.\n"
        "Negative numbers are arguments, e.g. set-target -0.1 0 0.2 (or put them after --).";
   return s;
 }
@@ -263,6 +285,9 @@ std::string send_footer() {
 
 int main(int argc, char** argv) {
   CLI::App app{"Rocksteady operator console: commands, live telemetry, log conversion"};
+  app.footer(
+      "Exit status (every subcommand): 0 ok, 1 the run failed (command rejected or not "
+      "acknowledged, sequence aborted, gnuplot failed), 2 usage or configuration error.");
   app.require_subcommand(1);
   std::string url;
   app.add_option("--lcm-url", url,
@@ -301,10 +326,15 @@ int main(int argc, char** argv) {
   send->add_option("--u-max", s.u_max, "upload-trajectory: study-case model, u_max (N)");
   send->add_option("--delta-j", s.delta_j, "upload-trajectory: study-case model, ||dJ_ast||_2");
   send->add_option("--delta-r", s.delta_r, "upload-trajectory: study-case model, ||dr||_2 (m)");
+  send->add_option("--case", s.case_file,
+                   "upload-trajectory: check the plan against study case N (<config dir>/cases/"
+                   "caseN.yaml) or a case file");
+  send->add_option("--config-dir", s.config_dir,
+                   "upload-trajectory: folder with mission.yaml, gnc.yaml, cases/ (default: "
+                   "$ROCKSTEADY_CONFIG_DIR, else next to this program, else ./configs)");
   send->add_option("--mission", s.mission,
-                   "upload-trajectory: model from mission YAML (with --gnc, --case)");
-  send->add_option("--gnc", s.gnc, "upload-trajectory: GNC YAML");
-  send->add_option("--case", s.case_file, "upload-trajectory: case YAML");
+                   "upload-trajectory: mission YAML (default: <config dir>/mission.yaml)");
+  send->add_option("--gnc", s.gnc, "upload-trajectory: GNC YAML (default: <config dir>/gnc.yaml)");
 
   cli::MonitorOptions mon;
   bool plain = false;
@@ -315,6 +345,10 @@ int main(int argc, char** argv) {
   monitor->add_option("--seconds", mon.seconds, "exit after S seconds")
       ->check(CLI::NonNegativeNumber);
   monitor->add_flag("--plain", plain, "one line per message even on a terminal");
+  monitor
+      ->add_option("--stale-after", mon.stale_after_s,
+                   "flag telemetry STALE after this many silent seconds (default 3, 0: never)")
+      ->check(CLI::NonNegativeNumber);
   monitor->add_flag("--ansi", ansi, "redraw a status block even when not on a terminal");
 
   std::string log_path;
@@ -331,6 +365,72 @@ int main(int argc, char** argv) {
 
   CLI::App* params = app.add_subcommand("params", "list the loadable parameters (set-gain)");
 
+  std::string seq_file;
+  bool seq_check = false;
+  cli::GateOptions run_gate;
+  CLI::App* run = app.add_subcommand(
+      "run", "run a command sequence: sends with acks, waits on telemetry conditions");
+  run->footer(
+      "A sequence is YAML:\n"
+      "  name: hold-after-detumble\n"
+      "  steps:\n"
+      "    - send: set-mode DETUMBLE\n"
+      "    - wait: mode == HOLD, timeout 600 s\n"
+      "    - sleep: 5 s\n"
+      "    - send: set-target 0.1 0 0\n"
+      "The whole file is checked before the first command is sent; the run stops at the first\n"
+      "rejection, missing acknowledgement or timeout.\n"
+      "Exit status: 0 completed, 1 aborted (rejected, timeout), 2 invalid sequence or usage.");
+  run->add_option("sequence", seq_file, "the sequence file (YAML)")->required();
+  run->add_flag("--check", seq_check, "validate only, send nothing");
+  run->add_option("--sender", run_gate.sender, "sender id (default 1, the operator console)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--timeout", run_gate.timeout_s,
+                  "seconds to wait for each acknowledgement (default 3)")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--state-dir", run_gate.state_dir, "sequence state directory (as for send)");
+
+  std::string plot_in;
+  std::string plot_out;
+  std::vector<double> plot_q_final;
+  CLI::App* plot = app.add_subcommand(
+      "plot", "the Figure-3 plot of a run (PIL LCM log or run CSV) as PNG, with gnuplot");
+  plot->footer(
+      "Panels: body rate, attitude (MRP) and fuel; truth solid, on-board estimate dashed, "
+      "reference dotted (when the input has them); t_omega,conv and t_q,conv (SPEC 7) marked, or "
+      "NC.\nExit status: 0 written, 1 gnuplot failed, 2 unreadable input or usage.");
+  plot->add_option("input", plot_in,
+                   "LCM log (RS_PLANT_TRUTH, RS_GNC_TLM) or CSV (campaign timeseries.csv, plant "
+                   "--out)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  plot->add_option("-o,--output", plot_out, "PNG file (default: INPUT with .png)");
+  plot->add_option("--q-final", plot_q_final,
+                   "target MRP for t_q,conv (default: from telemetry, else 0 0 0)")
+      ->expected(3);
+
+#ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
+  rocksteady::ground::console::ServeOptions so;
+  CLI::App* serve = app.add_subcommand(
+      "serve", "the browser console (NASA Open MCT): telemetry, events, commands over HTTP");
+  serve->add_option("--bind", so.bind, "address to listen on (default 127.0.0.1, loopback only)");
+  serve->add_option("--port", so.port, "TCP port (default 8090; 0: any free port, printed)")
+      ->check(CLI::Range(0, 65535));
+  serve->add_option("--web-root", so.web_root,
+                    "folder with app/ and openmct/ (default: next to this program)");
+  serve->add_option("--sender", so.sender, "sender id of the console's commands (default 2)")
+      ->check(CLI::NonNegativeNumber);
+  serve->add_option("--state-dir", so.state_dir, "sequence state directory (as for send)");
+  serve
+      ->add_option("--timeout", so.ack_timeout_s,
+                   "seconds to wait for a command's acknowledgement (default 3)")
+      ->check(CLI::PositiveNumber);
+  serve
+      ->add_option("--stale-after", so.stale_after_s,
+                   "seconds without a message before a channel is flagged stale (default 3)")
+      ->check(CLI::PositiveNumber);
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -339,7 +439,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
-    return cli::kExitTimeoutOrUsage;
+    return cli::kExitUsage;
   }
 
   if (*send) return run_send(s, url);
@@ -381,6 +481,58 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+
+  if (*plot) {
+    try {
+      const cli::PlotData d = cli::load_plot_data(plot_in);
+      cli::PlotOptions po;
+      po.output = plot_out.empty()
+                      ? std::filesystem::path(plot_in).replace_extension(".png").string()
+                      : plot_out;
+      if (plot_q_final.size() == 3) {
+        po.q_final = std::array<double, 3>{plot_q_final[0], plot_q_final[1], plot_q_final[2]};
+      }
+      const std::string error = cli::write_plot(d, po);
+      if (!error.empty()) {
+        std::fprintf(stderr, "error: %s\n", error.c_str());
+        return 1;
+      }
+      std::printf("%s\n", po.output.c_str());
+      return 0;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+  }
+
+  if (*run) {
+    const cli::SequenceParse parsed = cli::load_sequence(seq_file);
+    if (!parsed.ok) {
+      for (const std::string& e : parsed.errors) std::fprintf(stderr, "error: %s\n", e.c_str());
+      std::fprintf(stderr, "%s: %zu error(s); nothing was sent\n", seq_file.c_str(),
+                   parsed.errors.size());
+      return 2;
+    }
+    std::fprintf(stderr, "%s: %zu steps, valid\n", seq_file.c_str(), parsed.sequence.steps.size());
+    if (seq_check) return 0;
+    try {
+      run_gate.lcm_url = url;
+      cli::CommandGate gate(run_gate);
+      std::unique_ptr<lcm::LCM> lcm = open_bus(url);
+      const cli::SequenceReport r = cli::run_sequence(parsed.sequence, gate, *lcm, stdout);
+      return r.outcome == cli::SequenceReport::Outcome::kCompleted ? 0 : 1;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+  }
+
+#ifdef ROCKSTEADY_GROUND_CLI_WITH_CONSOLE
+  if (*serve) {
+    so.lcm_url = url;
+    return rocksteady::ground::console::serve(so);
+  }
+#endif
 
   if (*params) {
     for (const cli::ParamEntry& p : cli::param_dictionary()) {

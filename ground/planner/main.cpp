@@ -1,19 +1,21 @@
-// rocksteady-plan: plans the fuel-optimal despin (SPEC Eq. 44) for a study case's estimated model and
-// writes the reference-trajectory file. Failure to converge or to verify is an error exit, never a
-// file.
+// rocksteady-plan: plans the fuel-optimal despin (SPEC Eq. 44) for a study case's estimated model
+// and writes the reference-trajectory file. Failure to converge or to verify is an error exit,
+// never a file.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
 
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
 #include "ground/planner/cache.hpp"
 #include "ground/planner/planner.hpp"
 #include "ground/planner/trajectory_file.hpp"
-#include "gnc/model/mass_properties.hpp"
-#include "gnc/model/rcs.hpp"
 #ifdef ROCKSTEADY_PLANNER_WITH_CONFIG
 #include "ground/config/config.hpp"
+#include "ground/config/config_dir.hpp"
 #endif
 
 namespace planner = rocksteady::ground::planner;
@@ -42,7 +44,8 @@ void report(const planner::PlanResult& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Plan the fuel-optimal despin (SPEC Eq. 44) for the estimated model of a study case"};
+  CLI::App app{
+      "Plan the fuel-optimal despin (SPEC Eq. 44) for the estimated model of a study case"};
   double u_max = 200.0;
   double delta_j = 0.0;
   double delta_r = 0.0;
@@ -53,17 +56,20 @@ int main(int argc, char** argv) {
   std::string mission_file;
   std::string gnc_file;
   std::string case_file;
+  std::string config_dir;
   bool no_refinement = false;
   bool verbose = false;
   planner::PlanSettings settings;
   app.add_option("--u-max", u_max, "per-channel force limit u_max (N), SPEC Table 3")
       ->check(CLI::PositiveNumber);
-  app.add_option("--delta-j", delta_j, "||dJ_ast||_2 (kg m^2): J_ast_hat = J_ast - dJ diag(-1,1,0.5)")
+  app.add_option("--delta-j", delta_j,
+                 "||dJ_ast||_2 (kg m^2): J_ast_hat = J_ast - dJ diag(-1,1,0.5)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--delta-r", delta_r, "||dr_SO/BCM||_2 (m): r_hat = r - dr [1,1,1]/sqrt(3)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--case-name", case_name, "case name recorded in the file");
-  app.add_option("--nodes", settings.nodes, "grid nodes N (2N-1 samples)")->check(CLI::Range(3, 512));
+  app.add_option("--nodes", settings.nodes, "grid nodes N (2N-1 samples)")
+      ->check(CLI::Range(3, 512));
   app.add_option("--t-final-max", settings.t_final_max,
                  "final time (fixed) or its upper bound (free), s; default 8x the shortest despin");
   app.add_option("--t-final-min", settings.t_final_min, "lower bound of a free final time, s");
@@ -72,15 +78,32 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--no-refinement", no_refinement, "skip the grid-refinement check");
   app.add_option("-o,--output", output, "trajectory file to write");
-  app.add_option("--cache-dir", cache_dir, "plan-once cache directory (file named by problem hash)");
+  app.add_option("--cache-dir", cache_dir,
+                 "plan-once cache directory (file named by problem hash)");
   app.add_option("--check", check_file, "load and verify an existing trajectory file instead");
   app.add_flag("-v,--verbose", verbose, "IPOPT iteration log");
 #ifdef ROCKSTEADY_PLANNER_WITH_CONFIG
-  app.add_option("--mission", mission_file, "mission YAML (with --gnc and --case)");
-  app.add_option("--gnc", gnc_file, "GNC YAML");
-  app.add_option("--case", case_file, "case YAML: takes the model from the configuration");
+  app.add_option(
+      "--case", case_file,
+      "study case N (<config dir>/cases/caseN.yaml) or a case file: the model comes from "
+      "the configuration");
+  app.add_option("--config-dir", config_dir,
+                 "folder with mission.yaml, gnc.yaml, cases/ (default: $ROCKSTEADY_CONFIG_DIR, "
+                 "else next to this program, else ./configs)");
+  app.add_option("--mission", mission_file, "mission YAML (default: <config dir>/mission.yaml)");
+  app.add_option("--gnc", gnc_file, "GNC YAML (default: <config dir>/gnc.yaml)");
 #endif
-  CLI11_PARSE(app, argc, argv);
+  app.footer(
+      "Exit status: 0 planned (or --check: valid), 1 the run failed (no converged, verified plan; "
+      "--check: rejected), 2 usage or configuration error.");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
   settings.verify_refinement = !no_refinement;
   if (verbose) settings.print_level = 5;
 
@@ -90,13 +113,28 @@ int main(int argc, char** argv) {
   try {
     if (!case_file.empty() || !mission_file.empty() || !gnc_file.empty()) {
 #ifdef ROCKSTEADY_PLANNER_WITH_CONFIG
-      if (case_file.empty() || mission_file.empty() || gnc_file.empty()) {
-        std::fprintf(stderr, "error: --mission, --gnc and --case go together\n");
+      if (case_file.empty()) {
+        std::fprintf(stderr, "error: %s needs --case (the case whose model is planned)\n",
+                     mission_file.empty() ? "--gnc" : "--mission");
         return 2;
       }
+      const bool need_dir = mission_file.empty() || gnc_file.empty() ||
+                            std::all_of(case_file.begin(), case_file.end(), ::isdigit);
+      std::string dir;
+      if (need_dir) {
+        const rocksteady::config::ConfigDir d = rocksteady::config::find_config_dir(config_dir);
+        if (d.path.empty()) {
+          std::fprintf(stderr, "error: %s\n", d.error.c_str());
+          return 2;
+        }
+        dir = d.path;
+      }
+      case_file = rocksteady::config::case_file(dir, case_file, "--case");
+      if (mission_file.empty()) mission_file = rocksteady::config::mission_file(dir);
+      if (gnc_file.empty()) gnc_file = rocksteady::config::gnc_file(dir);
       const auto mission = rocksteady::config::load_mission(mission_file);
-      const auto run = rocksteady::config::assemble(
-          mission, rocksteady::config::load_gnc(gnc_file), rocksteady::config::load_case(case_file));
+      const auto run = rocksteady::config::assemble(mission, rocksteady::config::load_gnc(gnc_file),
+                                                    rocksteady::config::load_case(case_file));
       problem.case_name = run.case_name;
       problem.model.j_hat = rocksteady::gnc::total_inertia(run.flight.mass_hat);
       problem.model.b_hat =
@@ -133,8 +171,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     std::printf("%s %s: fuel %.4f kg, t_final %.2f s, %d iterations, %.3f s\n",
-                c.from_cache ? "cached" : "planned", c.path.c_str(), c.file.fuel_kg,
-                c.file.t_final, c.file.iterations, c.file.solve_seconds);
+                c.from_cache ? "cached" : "planned", c.path.c_str(), c.file.fuel_kg, c.file.t_final,
+                c.file.iterations, c.file.solve_seconds);
     return 0;
   }
   if (output.empty()) {

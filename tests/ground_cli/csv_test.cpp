@@ -3,6 +3,7 @@
 // independently of the converter) and whose values are the messages'; the garbage is counted.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -12,7 +13,9 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "fsw/interface.hpp"
 #include "ground/cli/csv.hpp"
+#include "ground/cli/dictionary.hpp"
 #include "test_util.hpp"
 
 namespace rocksteady::ground::cli {
@@ -60,6 +63,23 @@ std::vector<std::string> lcm_fields(const std::string& type) {
     }
   }
   return names;
+}
+
+// A CSV header: every field of the message in .lcm order, then only "<column>_name" columns (the
+// dictionary's names of enum fields), each naming a column before it.
+void expect_fields_then_names(const std::vector<std::string>& header,
+                              const std::vector<std::string>& fields) {
+  ASSERT_GE(header.size(), fields.size());
+  EXPECT_EQ(std::vector<std::string>(header.begin(),
+                                     header.begin() + static_cast<std::ptrdiff_t>(fields.size())),
+            fields);
+  for (std::size_t i = fields.size(); i < header.size(); ++i) {
+    const std::string& h = header[i];
+    ASSERT_GT(h.size(), 5u) << h;
+    ASSERT_EQ(h.substr(h.size() - 5), "_name") << h;
+    EXPECT_NE(std::find(fields.begin(), fields.end(), h.substr(0, h.size() - 5)), fields.end())
+        << h;
+  }
 }
 
 // RFC 4180 fields of one line (no line break inside).
@@ -198,7 +218,7 @@ TEST_F(Log2Csv, TelemetryHeaderIsTheLcmFieldsAndValuesRoundTrip) {
   ASSERT_EQ(rows.size(), 4u);
   std::vector<std::string> expected{"log_utime"};
   for (const std::string& f : lcm_fields("gnc_telemetry_t")) expected.push_back(f);
-  EXPECT_EQ(rows[0], expected);
+  expect_fields_then_names(rows[0], expected);
   const auto& h = rows[0];
   for (int k = 0; k < 3; ++k) {
     const auto& r = rows[static_cast<std::size_t>(k + 1)];
@@ -209,6 +229,9 @@ TEST_F(Log2Csv, TelemetryHeaderIsTheLcmFieldsAndValuesRoundTrip) {
     EXPECT_EQ(std::stoll(r[column(h, "tick")]), m.tick);
     EXPECT_EQ(std::stoi(r[column(h, "mode")]), 2);
     EXPECT_EQ(std::stoi(r[column(h, "law")]), k);
+    // The dictionary's names beside the numbers.
+    EXPECT_EQ(r[column(h, "mode_name")], "HOLD");
+    EXPECT_EQ(r[column(h, "law_name")], law_name(k));
     EXPECT_EQ(std::strtod(r[column(h, "omega_hat_1")].c_str(), nullptr), m.omega_hat[1]);
     EXPECT_EQ(std::strtod(r[column(h, "omega_hat_0")].c_str(), nullptr), 0.0);
     EXPECT_EQ(std::strtod(r[column(h, "fuel_kg")].c_str(), nullptr), m.fuel_kg);
@@ -250,6 +273,8 @@ TEST_F(Log2Csv, EventTextWithCommasAndQuotesSurvives) {
             "SET_TARGET (2) seq 5 rejected: \"not allowed\", in TRACK");
   EXPECT_EQ(rows[1][column(rows[0], "id")], "101");
   EXPECT_EQ(rows[1][column(rows[0], "severity")], "2");
+  EXPECT_EQ(rows[1][column(rows[0], "id_name")], fsw::to_string(fsw::EventId::kCommandRejected));
+  EXPECT_EQ(rows[1][column(rows[0], "severity_name")], "WARNING");
 }
 
 TEST(CsvHeaders, EverySupportedChannelHasItsLcmFields) {
@@ -268,7 +293,7 @@ TEST(CsvHeaders, EverySupportedChannelHasItsLcmFields) {
     std::vector<std::string> expected{"log_utime"};
     for (const std::string& f : lcm_fields(type)) expected.push_back(f);
     EXPECT_GT(expected.size(), 4u) << type;
-    EXPECT_EQ(csv_header(channel), expected) << channel;
+    expect_fields_then_names(csv_header(channel), expected);
   }
   EXPECT_FALSE(csv_supported("RS_NOT_A_CHANNEL"));
 }

@@ -92,10 +92,12 @@ TEST(GroundCliNet, CommandNotAllowedInTheFlightModeIsRejectedWithExitOne) {
   EXPECT_EQ(r.out.rfind("REJECTED: not allowed in this mode", 0), 0u) << r.out;
 }
 
-TEST(GroundCliNet, NoAcknowledgementIsATimeoutWithExitTwo) {
+// One exit convention for every tool: a command that is never acknowledged is a failed run (1),
+// not a usage error (2).
+TEST(GroundCliNet, NoAcknowledgementIsATimeoutWithExitOne) {
   test::TempDir dir;
   const test::Run r = in_namespace(dir, "", ground(17604, "send noop --timeout 0.3 --seq 1"));
-  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_EQ(r.out.rfind("TIMEOUT: no acknowledgement of seq 1", 0), 0u) << r.out;
 }
 
@@ -126,6 +128,16 @@ TEST(GroundCliNet, MonitorPrintsOneLinePerTelemetryMessage) {
   EXPECT_NE(r.err.find("monitor: 3 telemetry"), std::string::npos) << r.err;
 }
 
+TEST(GroundCliNet, MonitorFlagsSilenceAsStale) {
+  test::TempDir dir;
+  // Nobody publishes: the monitor says so instead of staying blank, once, in plain mode.
+  const test::Run r =
+      in_namespace(dir, "", ground(17608, "monitor --seconds 1.5 --plain --stale-after 0.5"));
+  EXPECT_NE(r.out.find("STALE: no telemetry on RS_GNC_TLM for"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(none received yet)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("STALE", r.out.find("STALE") + 1), std::string::npos) << r.out;
+}
+
 // A real plan (case 1, coarse grid) uplinked in chunks: the responder reassembles it with the
 // flight's TrajectoryUplink, announces uplink_complete, and accepts LOAD_TRAJECTORY only when the
 // reassembled table validates (CRC-32 included).
@@ -151,6 +163,35 @@ TEST(GroundCliNet, UploadTrajectoryChunksCompleteAndLoad) {
   EXPECT_NE(r.err.find("upload 77 complete on board (4 chunks)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("LOAD_TRAJECTORY 77 seq 3"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("responder=0"), std::string::npos) << r.err;
+}
+
+// --case N is checked against study case N's model, whose configs are found next to the program
+// even when run from a folder without them; a case that does not exist is named as typed.
+TEST(GroundCliConfigs, UploadCaseNumberFromAnyDirectory) {
+  test::TempDir dir;
+  planner::PlanProblem problem;
+  problem.case_name = "cli-case";
+  problem.model = planner::study_case_model(200.0, 0.0, 0.0);
+  problem.settings.nodes = 51;
+  problem.settings.verify_refinement = false;
+  const planner::PlanResult plan = planner::plan(problem);
+  ASSERT_TRUE(plan.ok) << plan.error;
+  const std::string file = dir.file("plan.yaml");
+  planner::write_trajectory_file(file, problem, plan);
+  const std::string g = "cd " + test::quote(dir.str()) + " && env -u ROCKSTEADY_CONFIG_DIR " +
+                        test::quote(ROCKSTEADY_GROUND_EXE) + " send upload-trajectory " +
+                        test::quote(file) + " --dry-run --seq 1 ";
+  const test::Run missing = test::run(g + "--case 9", dir);
+  EXPECT_EQ(missing.exit_code, 2) << missing.err;
+  EXPECT_NE(missing.err.find("--case 9: no case file"), std::string::npos) << missing.err;
+  // Case 1's configured model: the file (planned for the nominal study model) is checked against
+  // it, so the outcome is the loader's verdict, not "cannot read configs/mission.yaml".
+  const test::Run one = test::run(g + "--case 1", dir);
+  EXPECT_EQ(one.err.find("cannot read file"), std::string::npos) << one.err;
+  EXPECT_EQ(one.err.find("no configuration folder"), std::string::npos) << one.err;
+  const test::Run alone = test::run(g + "--mission x.yaml", dir);
+  EXPECT_EQ(alone.exit_code, 2);
+  EXPECT_NE(alone.err.find("--mission needs --case"), std::string::npos) << alone.err;
 }
 
 }  // namespace
