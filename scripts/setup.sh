@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  cmake ninja-build g++ pkg-config git
+  cmake ninja-build g++ pkg-config git dpkg-dev fakeroot
   libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev
   default-jdk-headless libjchart2d-java
