@@ -24,6 +24,8 @@ const char* to_string(Opcode op) {
       return "PARAM_ACTIVATE";
     case Opcode::kParamDiscard:
       return "PARAM_DISCARD";
+    case Opcode::kParamDump:
+      return "PARAM_DUMP";
   }
   return "?";
 }
@@ -132,6 +134,8 @@ const char* to_string(EventId id) {
       return "counters_reset";
     case EventId::kOverrunSafe:
       return "overrun_safe";
+    case EventId::kParamsDumped:
+      return "params_dumped";
   }
   return "?";
 }

@@ -17,7 +17,7 @@ namespace rocksteady::fsw {
 
 inline constexpr int kMaxCommandArgs = 8;
 
-// Numbers 0..6 are those of lcmtypes' ground_cmd_t OP_*; 7..9 are the parameter-table commands.
+// The numbers are those of lcmtypes' ground_cmd_t OP_* (tied by static_assert in fsw/bus).
 enum class Opcode : std::int32_t {
   kNoop = 0,            // no arguments
   kSetMode = 1,         // [mode]                      gnc::Mode
@@ -29,8 +29,9 @@ enum class Opcode : std::int32_t {
   kParamLoad = 7,       // [param_id, v0, ...]         into the inactive table (see ParamId)
   kParamActivate = 8,   // no arguments                inactive -> active at the next tick
   kParamDiscard = 9,    // no arguments                inactive := active
+  kParamDump = 10,      // no arguments                the active table -> telemetry (ParamDump)
 };
-inline constexpr int kOpcodeCount = 10;
+inline constexpr int kOpcodeCount = 11;
 const char* to_string(Opcode op);
 
 // The reference of "select law and reference" (second argument of kSetLaw).
@@ -138,6 +139,7 @@ enum class EventId : std::int32_t {
   kTrajectoryLoaded = 122,    // handed to the flight core at the tick boundary
   kCountersReset = 123,
   kOverrunSafe = 124,  // -> SAFE: arg0 = consecutive GNC slips
+  kParamsDumped = 125, // the active table read back; arg0 = dump number
 };
 const char* to_string(EventId id);
 
@@ -151,6 +153,21 @@ struct Event {
   std::int32_t arg0{0};
   std::int32_t arg1{0};
   std::array<char, kEventTextSize> text{};  // NUL-terminated
+};
+
+// ---------------------------------------------------------------------------------------------
+// Parameter read-back (PARAM_DUMP)
+// ---------------------------------------------------------------------------------------------
+
+inline constexpr int kMaxDumpParams = 32;
+inline constexpr int kMaxParamValues = 6;
+
+struct ParamDump {
+  double t{0.0};             // on-board time of the dump
+  std::uint32_t seq{0};      // dumps so far
+  std::int32_t count{0};     // parameters (fsw::kParamCount)
+  std::array<std::int32_t, kMaxDumpParams> value_count{};
+  std::array<std::array<double, kMaxParamValues>, kMaxDumpParams> values{};
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -155,4 +155,20 @@ DecodeStatus check(const rocksteady::trajectory_chunk_t& m) {
   return DecodeStatus::kOk;
 }
 
+DecodeStatus check(const rocksteady::param_table_t& m) {
+  using P = rocksteady::param_table_t;
+  if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
+  if (m.count < 0 || m.count > P::MAX_PARAMS || m.dump_seq < 0 || !std::isfinite(m.t)) {
+    return DecodeStatus::kOutOfRange;
+  }
+  for (int i = 0; i < P::MAX_PARAMS; ++i) {
+    const int n = m.value_count[i];
+    if (n < 0 || n > P::MAX_VALUES || (i >= m.count && n != 0)) return DecodeStatus::kOutOfRange;
+    for (int k = 0; k < n; ++k) {
+      if (!std::isfinite(m.values[i][k])) return DecodeStatus::kOutOfRange;
+    }
+  }
+  return DecodeStatus::kOk;
+}
+
 }  // namespace rocksteady::wire

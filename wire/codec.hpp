@@ -22,6 +22,7 @@
 #include "rocksteady/plant_truth_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
 #include "rocksteady/thruster_cmd_t.hpp"
+#include "rocksteady/param_table_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
 namespace rocksteady::wire {
@@ -71,6 +72,7 @@ DecodeStatus check(const rocksteady::ground_cmd_t& m);
 DecodeStatus check(const rocksteady::cmd_ack_t& m);
 DecodeStatus check(const rocksteady::plant_truth_t& m);
 DecodeStatus check(const rocksteady::trajectory_chunk_t& m);
+DecodeStatus check(const rocksteady::param_table_t& m);
 
 // Each type's channel (lcmtypes/channels.hpp).
 template <class T> const char* channel_of();
@@ -82,6 +84,7 @@ template <> inline const char* channel_of<rocksteady::ground_cmd_t>() { return c
 template <> inline const char* channel_of<rocksteady::cmd_ack_t>() { return channels::kCmdAck; }
 template <> inline const char* channel_of<rocksteady::plant_truth_t>() { return channels::kPlantTruth; }
 template <> inline const char* channel_of<rocksteady::trajectory_chunk_t>() { return channels::kTrajUplink; }
+template <> inline const char* channel_of<rocksteady::param_table_t>() { return channels::kParams; }
 
 // Types whose only variable-length field is a trailing string.
 template <class T> struct HasTrailingString { static constexpr bool value = false; };

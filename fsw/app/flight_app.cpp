@@ -216,7 +216,8 @@ HealthTelemetry FlightApp::health() const {
 // ----------------------------------------------------------------------------------------------
 
 DispatchContext FlightApp::dispatch_context() {
-  return DispatchContext{clock_ != nullptr, gnc_, trajectory_loaded_, params_, uplink_, events_};
+  return DispatchContext{clock_ != nullptr, gnc_,    trajectory_loaded_, time_base_.onboard_time(),
+                         params_,           uplink_, events_};
 }
 
 CommandAck FlightApp::submit(const GroundCommand& cmd) {

@@ -86,6 +86,8 @@ class FlightApp final : private BoundaryActions {
 
   // --- Outputs besides Outputs ------------------------------------------------------------------
   bool pop_event(Event& e) { return events_.pop(e); }
+  // The parameter table read back by an accepted PARAM_DUMP, once.
+  bool take_param_dump(ParamDump& out) { return params_.take_dump(out); }
   int pending_events() const { return events_.pending(); }
   HealthTelemetry health() const;  // the counters now (housekeeping publishes the same)
 

@@ -20,7 +20,10 @@ static_assert(static_cast<std::int32_t>(Opcode::kResetCounters) == GroundCmd::OP
 static_assert(static_cast<std::int32_t>(Opcode::kParamLoad) == GroundCmd::OP_PARAM_LOAD);
 static_assert(static_cast<std::int32_t>(Opcode::kParamActivate) == GroundCmd::OP_PARAM_ACTIVATE);
 static_assert(static_cast<std::int32_t>(Opcode::kParamDiscard) == GroundCmd::OP_PARAM_DISCARD);
+static_assert(static_cast<std::int32_t>(Opcode::kParamDump) == GroundCmd::OP_PARAM_DUMP);
 static_assert(kOpcodeCount == GroundCmd::OP_COUNT);
+static_assert(kMaxDumpParams == rocksteady::param_table_t::MAX_PARAMS);
+static_assert(kMaxParamValues == rocksteady::param_table_t::MAX_VALUES);
 static_assert(kMaxCommandArgs == GroundCmd::MAX_ARGS);
 static_assert(static_cast<std::int32_t>(RejectReason::kNone) == Ack::REASON_OK);
 static_assert(static_cast<std::int32_t>(RejectReason::kUnknownOpcode) == Ack::REASON_UNKNOWN_OPCODE);
@@ -128,6 +131,19 @@ void to_message(const Event& e, rocksteady::event_t& m) {
   m.arg0 = e.arg0;
   m.arg1 = e.arg1;
   set_text(m.text, e.text.data(), rocksteady::event_t::MAX_TEXT);
+}
+
+void to_message(const ParamDump& d, rocksteady::param_table_t& m) {
+  m.kind = rocksteady::param_table_t::KIND;
+  m.version = rocksteady::param_table_t::VERSION;
+  m.t = d.t;
+  m.dump_seq = d.seq;
+  m.count = d.count;
+  for (int i = 0; i < kMaxDumpParams; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    m.value_count[i] = d.value_count[k];
+    for (int v = 0; v < kMaxParamValues; ++v) m.values[i][v] = d.values[k][static_cast<std::size_t>(v)];
+  }
 }
 
 void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m) {

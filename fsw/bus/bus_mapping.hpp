@@ -14,6 +14,7 @@
 #include "rocksteady/event_t.hpp"
 #include "rocksteady/gnc_telemetry_t.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
+#include "rocksteady/param_table_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
@@ -34,6 +35,8 @@ void reserve_text(rocksteady::event_t& m);
 void to_message(const CommandAck& ack, double t, rocksteady::cmd_ack_t& m);
 // Event -> event_t.
 void to_message(const Event& e, rocksteady::event_t& m);
+// ParamDump -> param_table_t.
+void to_message(const ParamDump& d, rocksteady::param_table_t& m);
 
 // The fsw's part of gnc_telemetry_t: executive, commanding, health counters, tables, uplink.
 void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m);

@@ -137,6 +137,10 @@ void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/,
   const CommandAck ack = n.computer_.submit(to_command(n.scratch_cmd_));
   to_message(ack, n.computer_.onboard_time(), n.ack_msg_);
   n.publish(channels::kCmdAck, n.ack_msg_);
+  if (n.computer_.take_param_dump(n.dump_)) {  // PARAM_DUMP: the table goes out with the ack
+    to_message(n.dump_, n.params_msg_);
+    n.publish(channels::kParams, n.params_msg_);
+  }
   n.drain_events();
 }
 

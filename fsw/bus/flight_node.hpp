@@ -135,6 +135,8 @@ class FlightNode {
   rocksteady::cmd_ack_t ack_msg_{};
   rocksteady::event_t event_msg_{};
   rocksteady::gnc_telemetry_t tlm_msg_{};
+  ParamDump dump_{};
+  rocksteady::param_table_t params_msg_{};
   std::uint64_t gnc_cycles_{0};
   std::uint64_t bus_event_seq_{0};
   std::int64_t last_rx_event_ns_[3]{0, 0, 0};

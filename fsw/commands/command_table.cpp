@@ -37,6 +37,7 @@ constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
       real(-kValueMax, kValueMax)}},
     {Opcode::kParamActivate, 0, 0, kAllModes, {}},
     {Opcode::kParamDiscard, 0, 0, kAllModes, {}},
+    {Opcode::kParamDump, 0, 0, kAllModes, {}},
 }};
 
 constexpr bool rows_in_opcode_order() {

@@ -122,6 +122,8 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
     }
     case Opcode::kParamDiscard:
       return ctx.params.discard(ctx.core.params(), ctx.log);
+    case Opcode::kParamDump:
+      return ctx.params.dump(ctx.core.params(), ctx.onboard_time, ctx.log);
   }
   return reject(RejectReason::kUnknownOpcode, cmd.opcode, "unknown opcode");
 }

@@ -21,6 +21,7 @@ struct DispatchContext {
   bool ready;  // false: the application is not initialised (everything is refused)
   const gnc::Gnc& core;
   bool trajectory_loaded;
+  double onboard_time;
   ParamLifecycle& params;
   UplinkLifecycle& uplink;
   EventLog& log;

@@ -65,6 +65,7 @@ class FlightComputer {
   CommandAck submit(const GroundCommand& cmd) { return app_.submit(cmd); }
   ChunkStatus receive_chunk(const TrajectoryChunk& chunk) { return app_.receive_chunk(chunk); }
   bool pop_event(Event& e) { return app_.pop_event(e); }
+  bool take_param_dump(ParamDump& out) { return app_.take_param_dump(out); }
   const Outputs& outputs() const { return out_; }  // the last tick's command and telemetry
   HealthTelemetry health() const { return app_.health(); }
   const gnc::GncOutput& core_output() const { return app_.core_output(); }

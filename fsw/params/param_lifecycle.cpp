@@ -6,6 +6,32 @@ void ParamLifecycle::reset(const gnc::GncParams& active) {
   table_.reset(active);
   loads_ = 0;
   activations_ = 0;
+  dump_ = ParamDump{};
+  dump_ready_ = false;
+}
+
+CommandCheck ParamLifecycle::dump(const gnc::GncParams& active, double t, EventLog& log) {
+  static_assert(kParamCount <= kMaxDumpParams, "the dump holds every parameter");
+  const std::uint32_t seq = dump_.seq + 1;
+  dump_ = ParamDump{};
+  dump_.t = t;
+  dump_.seq = seq;
+  dump_.count = kParamCount;
+  for (int i = 0; i < kParamCount; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    dump_.value_count[k] = read_param(active, i, dump_.values[k].data());
+  }
+  dump_ready_ = true;
+  log.emit(Severity::kInfo, EventId::kParamsDumped, static_cast<std::int32_t>(seq), kParamCount,
+           "active parameter table read back (%d parameters)", kParamCount);
+  return CommandCheck{};
+}
+
+bool ParamLifecycle::take_dump(ParamDump& out) {
+  if (!dump_ready_) return false;
+  out = dump_;
+  dump_ready_ = false;
+  return true;
 }
 
 CommandCheck ParamLifecycle::load(const GroundCommand& cmd, EventLog& log) {

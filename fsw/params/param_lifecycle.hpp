@@ -25,6 +25,9 @@ class ParamLifecycle {
   CommandCheck discard(const gnc::GncParams& active, EventLog& log);
   // At the tick boundary: the staged table becomes the core's active table.
   void activate(gnc::Gnc& core, EventLog& log);
+  // PARAM_DUMP: read the active table back now; the bus layer collects it with take_dump().
+  CommandCheck dump(const gnc::GncParams& active, double t, EventLog& log);
+  bool take_dump(ParamDump& out);
 
   const ParamTable& table() const { return table_; }
   std::uint32_t loads() const { return loads_; }
@@ -35,6 +38,8 @@ class ParamLifecycle {
   gnc::GncParams activation_{};  // scratch: too large for the stack of a tick
   std::uint32_t loads_{0};
   std::uint32_t activations_{0};
+  ParamDump dump_{};
+  bool dump_ready_{false};
 };
 
 }  // namespace rocksteady::fsw

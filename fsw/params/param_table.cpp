@@ -7,34 +7,34 @@ namespace rocksteady::fsw {
 namespace {
 
 constexpr std::array<ParamSpec, kParamCount> kSpecs{{
-    {ParamId::kNtclK, "ntcl.K", ParamKind::kMatrix},
-    {ParamId::kNtclLambda, "ntcl.Lambda", ParamKind::kMatrix},
-    {ParamId::kElK, "el.K", ParamKind::kMatrix},
-    {ParamId::kElLambda, "el.Lambda", ParamKind::kMatrix},
-    {ParamId::kFeedforwardK, "feedforward.K", ParamKind::kMatrix},
-    {ParamId::kFeedforwardLambda, "feedforward.Lambda", ParamKind::kMatrix},
-    {ParamId::kIntegralK, "integral.K", ParamKind::kMatrix},
-    {ParamId::kIntegralLambda, "integral.Lambda", ParamKind::kMatrix},
-    {ParamId::kIntegralKi, "integral.K_I", ParamKind::kMatrix},
-    {ParamId::kIntegralLimit, "integral.integral_limit", ParamKind::kScalar},
-    {ParamId::kAdaptiveK, "adaptive.K", ParamKind::kMatrix},
-    {ParamId::kAdaptiveLambda, "adaptive.Lambda", ParamKind::kMatrix},
-    {ParamId::kAdaptiveGamma, "adaptive.Gamma", ParamKind::kScalar},
-    {ParamId::kAdaptiveEigFloor, "adaptive.eig_floor_ratio", ParamKind::kScalar},
-    {ParamId::kAdaptiveEigCeiling, "adaptive.eig_ceiling_ratio", ParamKind::kScalar},
-    {ParamId::kSo3K, "so3.K", ParamKind::kMatrix},
-    {ParamId::kSo3Lambda, "so3.Lambda", ParamKind::kMatrix},
-    {ParamId::kDpdKd, "dpd.K_d", ParamKind::kMatrix},
-    {ParamId::kDpdKp, "dpd.k_p", ParamKind::kScalar},
-    {ParamId::kOmegaSwitch, "guidance.omega_switch", ParamKind::kScalar},
-    {ParamId::kKqd, "guidance.k_qd", ParamKind::kScalar},
-    {ParamId::kEpsTrans, "guidance.eps_trans", ParamKind::kScalar},
-    {ParamId::kTrackResetPeriod, "guidance.track_reset_period", ParamKind::kScalar},
-    {ParamId::kSensorTimeout, "mode.sensor_timeout", ParamKind::kScalar},
-    {ParamId::kAutoHold, "mode.auto_hold", ParamKind::kFlag},
-    {ParamId::kGyroMaxRate, "estimator.gyro_max_rate", ParamKind::kScalar},
-    {ParamId::kQuatNormTolerance, "estimator.quat_norm_tolerance", ParamKind::kScalar},
-    {ParamId::kEstimatorOmegaC, "estimator.omega_c", ParamKind::kScalar},
+    {ParamId::kNtclK, "ntcl.K", ParamKind::kMatrix, "N m s"},
+    {ParamId::kNtclLambda, "ntcl.Lambda", ParamKind::kMatrix, "1/s"},
+    {ParamId::kElK, "el.K", ParamKind::kMatrix, "N m s"},
+    {ParamId::kElLambda, "el.Lambda", ParamKind::kMatrix, "1/s"},
+    {ParamId::kFeedforwardK, "feedforward.K", ParamKind::kMatrix, "N m s"},
+    {ParamId::kFeedforwardLambda, "feedforward.Lambda", ParamKind::kMatrix, "1/s"},
+    {ParamId::kIntegralK, "integral.K", ParamKind::kMatrix, "N m s"},
+    {ParamId::kIntegralLambda, "integral.Lambda", ParamKind::kMatrix, "1/s"},
+    {ParamId::kIntegralKi, "integral.K_I", ParamKind::kMatrix, "N m/rad"},
+    {ParamId::kIntegralLimit, "integral.integral_limit", ParamKind::kScalar, "N m"},
+    {ParamId::kAdaptiveK, "adaptive.K", ParamKind::kMatrix, "N m s"},
+    {ParamId::kAdaptiveLambda, "adaptive.Lambda", ParamKind::kMatrix, "1/s"},
+    {ParamId::kAdaptiveGamma, "adaptive.Gamma", ParamKind::kScalar, "(adaptation gain)"},
+    {ParamId::kAdaptiveEigFloor, "adaptive.eig_floor_ratio", ParamKind::kScalar, ""},
+    {ParamId::kAdaptiveEigCeiling, "adaptive.eig_ceiling_ratio", ParamKind::kScalar, ""},
+    {ParamId::kSo3K, "so3.K", ParamKind::kMatrix, "N m s"},
+    {ParamId::kSo3Lambda, "so3.Lambda", ParamKind::kMatrix, "1/s"},
+    {ParamId::kDpdKd, "dpd.K_d", ParamKind::kMatrix, "N m s"},
+    {ParamId::kDpdKp, "dpd.k_p", ParamKind::kScalar, "1/s"},
+    {ParamId::kOmegaSwitch, "guidance.omega_switch", ParamKind::kScalar, "rad/s"},
+    {ParamId::kKqd, "guidance.k_qd", ParamKind::kScalar, "1/s"},
+    {ParamId::kEpsTrans, "guidance.eps_trans", ParamKind::kScalar, "rad/s"},
+    {ParamId::kTrackResetPeriod, "guidance.track_reset_period", ParamKind::kScalar, "s"},
+    {ParamId::kSensorTimeout, "mode.sensor_timeout", ParamKind::kScalar, "s"},
+    {ParamId::kAutoHold, "mode.auto_hold", ParamKind::kFlag, "(flag)"},
+    {ParamId::kGyroMaxRate, "estimator.gyro_max_rate", ParamKind::kScalar, "rad/s"},
+    {ParamId::kQuatNormTolerance, "estimator.quat_norm_tolerance", ParamKind::kScalar, ""},
+    {ParamId::kEstimatorOmegaC, "estimator.omega_c", ParamKind::kScalar, "rad/s"},
 }};
 
 constexpr bool specs_in_id_order() {
@@ -45,7 +45,7 @@ constexpr bool specs_in_id_order() {
 }
 static_assert(specs_in_id_order(), "parameter specs must be indexed by id");
 
-gnc::Mat3* matrix_field(gnc::GncParams& p, ParamId id) {
+template <class Params> auto matrix_field(Params& p, ParamId id) -> decltype(&p.ntcl.k) {
   switch (id) {
     case ParamId::kNtclK:
       return &p.ntcl.k;
@@ -80,7 +80,7 @@ gnc::Mat3* matrix_field(gnc::GncParams& p, ParamId id) {
   }
 }
 
-double* scalar_field(gnc::GncParams& p, ParamId id) {
+template <class Params> auto scalar_field(Params& p, ParamId id) -> decltype(&p.dpd.k_p) {
   switch (id) {
     case ParamId::kIntegralLimit:
       return &p.integral.integral_limit_nm;
@@ -162,6 +162,30 @@ ParamLoadResult write_param(gnc::GncParams& table, std::int32_t id, const double
     }
   }
   return ParamLoadResult{RejectReason::kInternal, id, "parameter table"};
+}
+
+int read_param(const gnc::GncParams& table, std::int32_t id, double* values) {
+  if (id < 0 || id >= kParamCount) return 0;
+  const ParamSpec& spec = kSpecs[id];
+  switch (spec.kind) {
+    case ParamKind::kMatrix: {
+      const gnc::Mat3* m = matrix_field(table, spec.id);
+      if (m == nullptr) return 0;
+      const double v[6] = {(*m)(0, 0), (*m)(1, 1), (*m)(2, 2), (*m)(0, 1), (*m)(0, 2), (*m)(1, 2)};
+      for (int i = 0; i < 6; ++i) values[i] = v[i];
+      return 6;
+    }
+    case ParamKind::kScalar: {
+      const double* v = scalar_field(table, spec.id);
+      if (v == nullptr) return 0;
+      values[0] = *v;
+      return 1;
+    }
+    case ParamKind::kFlag:
+      values[0] = table.mode.auto_hold ? 1.0 : 0.0;  // the only flag
+      return 1;
+  }
+  return 0;
 }
 
 void ParamTable::reset(const gnc::GncParams& active) {

@@ -54,6 +54,7 @@ struct ParamSpec {
   ParamId id;
   const char* name;
   ParamKind kind;
+  const char* units;  // for the ground's read-back (rocksteady-ground params get)
 };
 const std::array<ParamSpec, kParamCount>& param_specs();
 
@@ -67,6 +68,9 @@ struct ParamLoadResult {
 
 // Writes `n` values of parameter `id` into `table` (no validation of the whole table).
 ParamLoadResult write_param(gnc::GncParams& table, std::int32_t id, const double* values, int n);
+// The inverse: parameter `id` of `table` into `values` (a matrix as 6 values xx yy zz xy xz yz, a
+// scalar or flag as 1); returns the number of values, 0 for an unknown id.
+int read_param(const gnc::GncParams& table, std::int32_t id, double* values);
 
 class ParamTable {
  public:

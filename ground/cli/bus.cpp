@@ -257,6 +257,81 @@ SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, dou
   return r;
 }
 
+namespace {
+class ParamCatcher {
+ public:
+  void on_table(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rocksteady::param_table_t t;
+    if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), t, &rx_)) return;
+    table_ = t;
+    have_ = true;
+  }
+  bool have() const { return have_; }
+  const rocksteady::param_table_t& table() const { return table_; }
+
+ private:
+  rocksteady::param_table_t table_{};
+  bool have_{false};
+  wire::RxCounters rx_{};
+};
+}  // namespace
+
+ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s) {
+  ParamReadback r;
+  ParamCatcher catcher;
+  AckWaiter waiter(cmd);
+  lcm::Subscription* tsub = lcm.subscribe(channels::kParams, &ParamCatcher::on_table, &catcher);
+  lcm::Subscription* asub = lcm.subscribe(channels::kCmdAck, &AckWaiter::on_ack, &waiter);
+  if (tsub == nullptr || asub == nullptr || lcm.publish(channels::kGroundCmd, &cmd) != 0) {
+    r.send.error = "cannot subscribe or publish on the bus";
+  } else {
+    const Clock::time_point deadline = after(timeout_s);
+    while (!(waiter.matched() && (catcher.have() || waiter.ack().accepted == 0))) {
+      const int ms = remaining_ms(deadline);
+      if (ms <= 0) break;
+      if (lcm.handleTimeout(ms) < 0) {
+        r.send.error = "LCM receive failed";
+        break;
+      }
+    }
+  }
+  if (tsub != nullptr) lcm.unsubscribe(tsub);
+  if (asub != nullptr) lcm.unsubscribe(asub);
+  r.send.other_acks = waiter.others();
+  r.send.rx = waiter.rx();
+  if (waiter.matched()) {
+    r.send.ack = waiter.ack();
+    r.send.outcome = r.send.ack.accepted != 0 ? SendResult::Outcome::kAccepted
+                                              : SendResult::Outcome::kRejected;
+  } else if (r.send.error.empty()) {
+    r.send.outcome = SendResult::Outcome::kTimeout;
+  }
+  r.have_table = catcher.have();
+  r.table = catcher.table();
+  return r;
+}
+
+std::string format_params(const rocksteady::param_table_t& table) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "active parameter table at t = %.3f s (dump %lld)\n", table.t,
+                static_cast<long long>(table.dump_seq));
+  out += line;
+  for (int i = 0; i < table.count; ++i) {
+    const std::optional<ParamEntry> p = find_param(std::to_string(i));
+    std::string values;
+    for (int k = 0; k < table.value_count[i]; ++k) {
+      std::snprintf(line, sizeof line, "%s%.9g", k == 0 ? "" : " ", table.values[i][k]);
+      values += line;
+    }
+    if (table.value_count[i] == 6) values = "[xx yy zz xy xz yz] " + values;
+    std::snprintf(line, sizeof line, "%2d  %-30s %-16s %s\n", i, p ? p->name : "?",
+                  p && p->units[0] != '\0' ? p->units : "-", values.c_str());
+    out += line;
+  }
+  return out;
+}
+
 UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
                            const UploadOptions& options, std::FILE* log) {
   UploadResult r;

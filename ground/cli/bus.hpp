@@ -13,6 +13,7 @@
 #include "ground/cli/monitor_format.hpp"
 #include "rocksteady/cmd_ack_t.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
+#include "rocksteady/param_table_t.hpp"
 
 namespace rocksteady::ground::cli {
 
@@ -36,6 +37,19 @@ struct SendResult {
 // Publishes `cmd` on RS_GROUND_CMD and waits up to `timeout_s` for the cmd_ack_t that echoes its
 // seq, sender and opcode.
 SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s);
+
+struct ParamReadback {
+  SendResult send;                  // the PARAM_DUMP's acknowledgement
+  bool have_table{false};
+  rocksteady::param_table_t table{};  // the flight's active table (RS_PARAMS)
+};
+
+// Publishes a PARAM_DUMP `cmd` and waits up to `timeout_s` for its acknowledgement and, once
+// accepted, for the table the flight publishes with it.
+ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s);
+
+// The read-back as text: one line per parameter with its name, values and units.
+std::string format_params(const rocksteady::param_table_t& table);
 
 struct UploadOptions {
   std::int32_t upload_id{0};

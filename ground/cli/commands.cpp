@@ -35,6 +35,8 @@ const std::vector<CommandHelp> kHelp{
      "xz yz), a scalar 1, a flag 0|1; PARAM is a name (ntcl.K) or number (see 'params')"},
     {"activate-gains", "activate-gains", "the inactive table becomes active at the next GNC tick"},
     {"discard-gains", "discard-gains", "drop the loads: inactive table := active table"},
+    {"dump-params", "dump-params",
+     "read the active parameter table back on RS_PARAMS (params get prints it)"},
     {"reset-counters", "reset-counters",
      "reset the command/health counters (cycle counts are kept)"},
     {"load-trajectory", "load-trajectory UPLOAD_ID",
@@ -252,6 +254,7 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
   if (name == "reset-counters") return no_args(Msg::OP_RESET_COUNTERS, "RESET_COUNTERS");
   if (name == "activate-gains") return no_args(Msg::OP_PARAM_ACTIVATE, "PARAM_ACTIVATE");
   if (name == "discard-gains") return no_args(Msg::OP_PARAM_DISCARD, "PARAM_DISCARD");
+  if (name == "dump-params") return no_args(Msg::OP_PARAM_DUMP, "PARAM_DUMP");
   if (name == "set-mode") {
     if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
     const auto mode = mode_from_name(args[0]);

@@ -7,6 +7,7 @@
 
 #include "gnc/guidance/trajectory.hpp"
 #include "gnc/io.hpp"
+#include "fsw/params/param_table.hpp"
 #include "ground/dictionary/dictionary.hpp"
 
 namespace rocksteady::ground::cli {
@@ -92,36 +93,16 @@ const char* phase_name(int phase) {
 }
 
 const std::vector<ParamEntry>& param_dictionary() {
-  static const std::vector<ParamEntry> table{
-      {0, "ntcl.K", ParamKind::kMatrix},
-      {1, "ntcl.Lambda", ParamKind::kMatrix},
-      {2, "el.K", ParamKind::kMatrix},
-      {3, "el.Lambda", ParamKind::kMatrix},
-      {4, "feedforward.K", ParamKind::kMatrix},
-      {5, "feedforward.Lambda", ParamKind::kMatrix},
-      {6, "integral.K", ParamKind::kMatrix},
-      {7, "integral.Lambda", ParamKind::kMatrix},
-      {8, "integral.K_I", ParamKind::kMatrix},
-      {9, "integral.integral_limit", ParamKind::kScalar},
-      {10, "adaptive.K", ParamKind::kMatrix},
-      {11, "adaptive.Lambda", ParamKind::kMatrix},
-      {12, "adaptive.Gamma", ParamKind::kScalar},
-      {13, "adaptive.eig_floor_ratio", ParamKind::kScalar},
-      {14, "adaptive.eig_ceiling_ratio", ParamKind::kScalar},
-      {15, "so3.K", ParamKind::kMatrix},
-      {16, "so3.Lambda", ParamKind::kMatrix},
-      {17, "dpd.K_d", ParamKind::kMatrix},
-      {18, "dpd.k_p", ParamKind::kScalar},
-      {19, "guidance.omega_switch", ParamKind::kScalar},
-      {20, "guidance.k_qd", ParamKind::kScalar},
-      {21, "guidance.eps_trans", ParamKind::kScalar},
-      {22, "guidance.track_reset_period", ParamKind::kScalar},
-      {23, "mode.sensor_timeout", ParamKind::kScalar},
-      {24, "mode.auto_hold", ParamKind::kFlag},
-      {25, "estimator.gyro_max_rate", ParamKind::kScalar},
-      {26, "estimator.quat_norm_tolerance", ParamKind::kScalar},
-      {27, "estimator.omega_c", ParamKind::kScalar},
-  };
+  static const std::vector<ParamEntry> table = [] {
+    std::vector<ParamEntry> t;
+    for (const fsw::ParamSpec& s : fsw::param_specs()) {
+      const ParamKind kind = s.kind == fsw::ParamKind::kMatrix   ? ParamKind::kMatrix
+                             : s.kind == fsw::ParamKind::kScalar ? ParamKind::kScalar
+                                                                 : ParamKind::kFlag;
+      t.push_back(ParamEntry{static_cast<int>(s.id), s.name, kind, s.units});
+    }
+    return t;
+  }();
   return table;
 }
 

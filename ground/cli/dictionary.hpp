@@ -35,7 +35,9 @@ struct ParamEntry {
   int id;
   const char* name;  // as in fsw/README.md: "ntcl.K", "guidance.omega_switch", ...
   ParamKind kind;
+  const char* units;
 };
+// The flight's own parameter table (fsw::param_specs): one source of ids, names, kinds and units.
 const std::vector<ParamEntry>& param_dictionary();
 // By name (case-sensitive, as in the README) or by number.
 std::optional<ParamEntry> find_param(const std::string& name_or_id);

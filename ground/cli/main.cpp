@@ -270,6 +270,32 @@ int run_send(const SendArgs& a, const std::string& url) {
   }
 }
 
+int run_params_get(const SendArgs& a, const std::string& url) {
+  try {
+    SeqSource seqs(a);
+    const cli::Encoded e = cli::encode_command("dump-params", {}, cli::EncodeOptions{});
+    rocksteady::ground_cmd_t cmd = e.cmd;
+    cli::stamp(cmd, seqs.next(), a.sender);
+    std::unique_ptr<lcm::LCM> lcm = open_bus(url);
+    const cli::ParamReadback r = cli::read_params(*lcm, cmd, a.timeout);
+    if (r.send.outcome == cli::SendResult::Outcome::kRejected) {
+      std::printf("%s\n", cli::format_ack_verdict(r.send.ack).c_str());
+      return cli::kExitRunFailed;
+    }
+    if (!r.have_table) {
+      std::printf("TIMEOUT: no parameter table (seq %lld) within %g s%s\n",
+                  static_cast<long long>(cmd.seq), a.timeout,
+                  r.send.error.empty() ? "" : (": " + r.send.error).c_str());
+      return cli::kExitRunFailed;
+    }
+    std::fputs(cli::format_params(r.table).c_str(), stdout);
+    return cli::kExitAccepted;
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "error: %s\n", ex.what());
+    return cli::kExitUsage;
+  }
+}
+
 std::string send_footer() {
   std::string s = "Commands:\n";
   for (const cli::CommandHelp& h : cli::command_help()) {
@@ -363,7 +389,18 @@ int main(int argc, char** argv) {
   bool strict = false;
   log2csv->add_flag("--strict", strict, "exit 1 when an event of the channel was rejected");
 
-  CLI::App* params = app.add_subcommand("params", "list the loadable parameters (set-gain)");
+  CLI::App* params = app.add_subcommand(
+      "params", "the loadable parameters: list them (set-gain), or read the active table back");
+  SendArgs pg;
+  CLI::App* params_get = params->add_subcommand(
+      "get", "PARAM_DUMP: print the flight's active parameter table (names, values, units)");
+  params_get->add_option("--sender", pg.sender, "sender id (default 1, the operator console)")
+      ->check(CLI::NonNegativeNumber);
+  params_get->add_option("--seq", pg.seq, "sequence number (default: the next from the state file)")
+      ->check(CLI::PositiveNumber);
+  params_get->add_option("--timeout", pg.timeout, "seconds to wait for the table (default 3)")
+      ->check(CLI::PositiveNumber);
+  params_get->add_option("--state-dir", pg.state_dir, "where sequence numbers are kept");
 
   std::string seq_file;
   bool seq_check = false;
@@ -534,12 +571,13 @@ int main(int argc, char** argv) {
   }
 #endif
 
+  if (*params_get) return run_params_get(pg, url);
   if (*params) {
     for (const cli::ParamEntry& p : cli::param_dictionary()) {
       const char* kind = p.kind == cli::ParamKind::kMatrix   ? "matrix: 3 (diagonal) or 6 values"
                          : p.kind == cli::ParamKind::kScalar ? "scalar: 1 value"
                                                              : "flag: 0 or 1";
-      std::printf("%2d  %-30s %s\n", p.id, p.name, kind);
+      std::printf("%2d  %-30s %-16s %s\n", p.id, p.name, p.units[0] != '\0' ? p.units : "-", kind);
     }
     return 0;
   }

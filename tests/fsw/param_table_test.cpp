@@ -213,5 +213,54 @@ TEST(ParamTableActivation, DiscardRestoresTheInactiveTableFromTheActiveOne) {
   EXPECT_EQ(f.send(Opcode::kParamActivate).reason, RejectReason::kNothingToActivate);
 }
 
+// read_param is write_param's inverse for every parameter: values written (a symmetric matrix as 6
+// values, a scalar, the flag) read back unchanged.
+TEST(ParamTable, ReadParamInvertsWriteParamForEveryId) {
+  for (int id = 0; id < kParamCount; ++id) {
+    gnc::GncParams p = test::small_vehicle_params();
+    double in[6] = {11.0 + id, 12.0, 13.0, 0.5, -0.25, 0.125};
+    int n = 6;
+    if (param_specs()[id].kind == ParamKind::kScalar) n = 1;
+    if (param_specs()[id].kind == ParamKind::kFlag) {
+      n = 1;
+      in[0] = p.mode.auto_hold ? 0.0 : 1.0;  // the other value
+    }
+    ASSERT_TRUE(write_param(p, id, in, n).ok()) << param_specs()[id].name;
+    double out[6] = {};
+    ASSERT_EQ(read_param(p, id, out), n) << param_specs()[id].name;
+    for (int k = 0; k < n; ++k) EXPECT_EQ(out[k], in[k]) << param_specs()[id].name << " " << k;
+  }
+  double out[6];
+  EXPECT_EQ(read_param(test::small_vehicle_params(), kParamCount, out), 0);
+  EXPECT_EQ(read_param(test::small_vehicle_params(), -1, out), 0);
+}
+
+// PARAM_DUMP reads the ACTIVE table back at once (not the inactive one with its pending loads).
+TEST(ParamTableActivation, DumpReadsTheActiveTableBack) {
+  AppFixture f;
+  f.ticks(2);
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kDpdKp), 5.0}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamActivate).accepted);
+  f.ticks(1);
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {id_arg(ParamId::kDpdKp), 7.0}).accepted);  // inactive only
+  ParamDump d;
+  EXPECT_FALSE(f.app->take_param_dump(d));
+  ASSERT_TRUE(f.send(Opcode::kParamDump).accepted);
+  ASSERT_TRUE(f.app->take_param_dump(d));
+  EXPECT_FALSE(f.app->take_param_dump(d));  // once per command
+  EXPECT_EQ(d.seq, 1u);
+  EXPECT_EQ(d.count, kParamCount);
+  EXPECT_EQ(d.t, f.app->onboard_time());
+  for (int id = 0; id < kParamCount; ++id) {
+    double expect[6];
+    const int n = read_param(f.app->active_params(), id, expect);
+    ASSERT_EQ(d.value_count[id], n);
+    for (int k = 0; k < n; ++k) EXPECT_EQ(d.values[id][k], expect[k]);
+  }
+  EXPECT_EQ(d.values[static_cast<int>(ParamId::kDpdKp)][0], 5.0);
+  const std::vector<Event> ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kParamsDumped), 1);
+}
+
 }  // namespace
 }  // namespace rocksteady::fsw

@@ -48,6 +48,7 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
   s += g + "send upload-trajectory " + test::quote(file) +
        " --chunk-interval 0.01 --wait 5 --timeout 5" + state + "; echo rc=$?\n";
   s += g + "monitor --count 2 --seconds 5 --plain; echo rc=$?\n";
+  s += g + "params get --timeout 5" + state + "; echo rc=$?\n";
   s += "kill $fpid; wait $fpid\n";
   const test::Run r = test::run_in_namespace(s, dir, 90);
   const std::string& o = r.out;
@@ -70,6 +71,13 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
   // flight decoded everything the console sent.
   EXPECT_NE(o.find("cmd_rej=1 "), std::string::npos) << said;
   EXPECT_NE(o.find("rx_malformed=0 rx_bad_kind=0 rx_out_of_range=0"), std::string::npos) << said;
+  // The read-back shows the activated gains (PARAM_DUMP -> RS_PARAMS), with names and units.
+  EXPECT_NE(o.find(" 0  ntcl.K                         N m s            [xx yy zz xy xz yz] 20000 "
+                   "20000 30000 0 0 0\n"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(o.find("23  mode.sensor_timeout            s                1\n"), std::string::npos)
+      << said;
 }
 
 }  // namespace

@@ -63,7 +63,8 @@ TEST(Dictionary, EveryElementOfEveryBusTypeIsAPointInLcmOrder) {
       {"RS_GNC_TLM", "gnc_telemetry_t"},     {"RS_EVENTS", "event_t"},
       {"RS_CMD_ACK", "cmd_ack_t"},           {"RS_GROUND_CMD", "ground_cmd_t"},
       {"RS_PLANT_TRUTH", "plant_truth_t"},   {"RS_SENSORS", "sensor_frame_t"},
-      {"RS_THRUSTER_CMD", "thruster_cmd_t"}, {"RS_TRAJ_UPLINK", "trajectory_chunk_t"}};
+      {"RS_THRUSTER_CMD", "thruster_cmd_t"}, {"RS_TRAJ_UPLINK", "trajectory_chunk_t"},
+      {"RS_PARAMS", "param_table_t"}};
   EXPECT_EQ(channels().size(), types.size());
   for (const auto& [channel, type] : types) {
     const Channel* c = find_channel(channel);
@@ -84,7 +85,7 @@ TEST(Dictionary, FlightNamesAreTheFlightsOwn) {
     EXPECT_EQ(enum_name("reason", r), fsw::to_string(static_cast<fsw::RejectReason>(r)));
   }
   int events_seen = 0;
-  for (int id = 100; id <= static_cast<int>(fsw::EventId::kOverrunSafe); ++id) {
+  for (int id = 100; id <= static_cast<int>(fsw::EventId::kParamsDumped); ++id) {
     const EventInfo* e = find_event(id);
     ASSERT_NE(e, nullptr) << id;
     EXPECT_STREQ(e->name, fsw::to_string(static_cast<fsw::EventId>(id)));

@@ -21,6 +21,7 @@
 #include "rocksteady/plant_truth_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
 #include "rocksteady/thruster_cmd_t.hpp"
+#include "rocksteady/param_table_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
 namespace {
@@ -46,6 +47,7 @@ std::map<std::string, TypeInfo> cpp_types() {
       {"rocksteady.cmd_ack_t", info<rocksteady::cmd_ack_t>()},
       {"rocksteady.plant_truth_t", info<rocksteady::plant_truth_t>()},
       {"rocksteady.trajectory_chunk_t", info<rocksteady::trajectory_chunk_t>()},
+      {"rocksteady.param_table_t", info<rocksteady::param_table_t>()},
   };
 }
 
