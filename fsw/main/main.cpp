@@ -21,12 +21,13 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
 
-#include "fsw/computer/flight_computer.hpp"
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/bus/flight_node.hpp"
-#include "fsw/executive/clock.hpp"
+#include "fsw/computer/flight_computer.hpp"
 #include "fsw/config/config_files.hpp"
+#include "fsw/executive/clock.hpp"
 #include "hal/lcm/lcm_ports.hpp"
+#include "rt/realtime.hpp"
 
 namespace {
 
@@ -114,6 +115,32 @@ int main(int argc, char** argv) {
   cli.add_option("--exit-after-ticks", opt.exit_after_ticks, "exit after this many base ticks");
   cli.add_flag("-v,--verbose", opt.verbose, "one status line per second");
   cli.add_flag("--jitter", jitter, "realtime: print tick-start deviation statistics at exit");
+  std::string ground_url;
+  cli.add_option(
+      "--ground-lcm-url", ground_url,
+      "separate bus for the ground channels (commands, uplink, acks, events, telemetry); "
+      "the --lcm-url bus then carries only sensor frames and thruster commands");
+  cli.add_option(
+         "--ground-drain-max", opt.ground_drain_max,
+         "ground messages decoded per base tick; the rest of the tick's are dropped, counted")
+      ->check(CLI::Range(1u, 100000u))
+      ->capture_default_str();
+  double watchdog_ms = 0.0;
+  cli.add_option("--watchdog-ms", watchdog_ms,
+                 "software watchdog: no GNC cycle for this long -> event 203, all thrusters off, "
+                 "exit status 5 (0: off)")
+      ->check(CLI::NonNegativeNumber);
+  rocksteady::rt::RealtimeOptions rt_opt;
+  rocksteady::rt::add_options(cli, rt_opt);
+  auto* stall = cli.add_option("--test-stall-at-tick", opt.test_stall_at_tick,
+                               "FAULT INJECTION for watchdog tests: stall base tick N (> 0)")
+                    ->check(CLI::PositiveNumber);
+  stall->group("Fault injection (tests only)");
+  cli.add_option("--test-stall-s", opt.test_stall_s,
+                 "FAULT INJECTION: length of the stall, wall seconds (0: forever)")
+      ->needs(stall)
+      ->check(CLI::NonNegativeNumber)
+      ->group("Fault injection (tests only)");
   CLI11_PARSE(cli, argc, argv);
 
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
@@ -160,6 +187,44 @@ int main(int argc, char** argv) {
     fc.executive.housekeeping_divider = static_cast<std::uint32_t>(std::max(1.0, std::round(base)));
   }
 
+  if (watchdog_ms > 0.0) {
+    // The watchdog is fed by each GNC cycle: it must allow a whole GNC period and, in lockstep, the
+    // frame watchdog's silence before frameless ticks resume.
+    const double min_s = dt + (opt.clock == bus::ClockMode::kLockstep ? opt.frame_watchdog_s : 0.0);
+    if (watchdog_ms * 1e-3 <= min_s) {
+      std::fprintf(
+          stderr,
+          "rocksteady-fsw: --watchdog-ms %g is too short: it must exceed the GNC period "
+          "(%g ms)%s, i.e. be above %g ms\n",
+          watchdog_ms, dt * 1e3,
+          opt.clock == bus::ClockMode::kLockstep ? " plus --frame-watchdog in lockstep" : "",
+          min_s * 1e3);
+      return 2;
+    }
+    opt.watchdog_s = watchdog_ms * 1e-3;
+  }
+
+  // Real-time hardening before the bus is opened: LCM's receive threads and the watchdog inherit
+  // it.
+  rocksteady::rt::RealtimeResult rt_result;
+  if (const int rc = rocksteady::rt::apply_and_report(rt_opt, "rocksteady-fsw", stdout, &rt_result);
+      rc != 0) {
+    return rc;
+  }
+  if (rt_result.fifo_priority_applied > 0) {
+    opt.watchdog_fifo_priority = std::min(99, rt_result.fifo_priority_applied + 1);
+  }
+  if (opt.watchdog_s > 0.0) {
+    std::printf(
+        "rocksteady-fsw: watchdog: %g ms, fed by the GNC rate group%s\n", watchdog_ms,
+        opt.watchdog_fifo_priority > 0 ? " (thread under SCHED_FIFO, one above the tick)" : "");
+  }
+  if (opt.test_stall_at_tick > 0) {
+    std::printf("rocksteady-fsw: FAULT INJECTION armed: base tick %llu will stall\n",
+                static_cast<unsigned long long>(opt.test_stall_at_tick));
+  }
+  std::fflush(stdout);
+
   fsw::MonotonicClock clock;
   // The flight computer and its LCM ports (sensor frames in, thruster commands out; the frames are
   // aligned with the body frame, so the devices' alignment is the identity).
@@ -177,6 +242,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rocksteady-fsw: cannot open the LCM bus\n");
     return 3;
   }
+  lcm_t* ground = nullptr;
+  if (!ground_url.empty()) {
+    ground = lcm_create(ground_url.c_str());
+    if (ground == nullptr) {
+      std::fprintf(stderr, "rocksteady-fsw: cannot open the ground bus %s\n", ground_url.c_str());
+      lcm_destroy(lcm);
+      return 3;
+    }
+  }
   thrusters.attach(lcm);
   std::vector<std::int64_t> jitter_ns;
   if (jitter && opt.clock == bus::ClockMode::kRealtime) {
@@ -193,9 +267,11 @@ int main(int argc, char** argv) {
   int rc = 0;
   {
     bus::FlightNode node(lcm, computer, sensors, thrusters, clock);
+    node.set_ground_bus(ground);
     if (!node.subscribe()) {
       std::fprintf(stderr, "rocksteady-fsw: cannot subscribe\n");
       lcm_destroy(lcm);
+      if (ground != nullptr) lcm_destroy(ground);
       return 3;
     }
     if (opt.verbose) {
@@ -205,8 +281,22 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
     rc = node.run(opt, &g_stop);
-    if (jitter) print_jitter("fsw jitter:", jitter_ns, fc.executive.base_rate_hz);
+    if (jitter) {
+      print_jitter("fsw jitter:", jitter_ns, fc.executive.base_rate_hz);
+      const bus::NodeStats& st = node.stats();
+      const fsw::HealthTelemetry h = computer.health();
+      std::printf(
+          "fsw bus: ticks=%llu frameless=%u frames=%llu superseded=%llu missed=%u "
+          "ground_dropped=%llu ground_bound_ticks=%llu rx_rejected=%llu\n",
+          static_cast<unsigned long long>(st.ticks), h.frameless_ticks,
+          static_cast<unsigned long long>(st.frames),
+          static_cast<unsigned long long>(st.frames_superseded), h.base_missed,
+          static_cast<unsigned long long>(st.ground_dropped),
+          static_cast<unsigned long long>(st.ground_bound_ticks),
+          static_cast<unsigned long long>(node.rx_total().rejected()));
+    }
   }
   lcm_destroy(lcm);
+  if (ground != nullptr) lcm_destroy(ground);
   return rc;
 }

@@ -32,9 +32,10 @@
 #include "ground/config/config.hpp"
 #include "ground/merit/figures_of_merit.hpp"
 #include "ground/plant/plant.hpp"
+#include "lcmtypes/channels.hpp"
+#include "rt/realtime.hpp"
 #include "wire/codec.hpp"
 #include "wire/convert.hpp"
-#include "lcmtypes/channels.hpp"
 
 namespace {
 
@@ -64,6 +65,7 @@ enum PlantEvent : std::int32_t { kRunStarted = 1000, kEchoTimeout = 1001, kRunFi
 
 struct Bus {
   lcm_t* lcm{nullptr};
+  lcm_t* ground{nullptr};  // --ground-lcm-url: telemetry in, events and truth out (else lcm)
   rocksteady::thruster_cmd_t scratch{};
   rocksteady::gnc_telemetry_t tlm{};
   bool have_cmd{false};
@@ -93,10 +95,12 @@ struct Bus {
       b.fuel_hat = b.tlm.fuel_kg;
     }
   }
-  template <class T> void publish(const char* channel, const T& msg) {
+  template <class T>
+  void publish(const char* channel, const T& msg, lcm_t* on = nullptr) {
     const int n = wire::encode(msg, buf, static_cast<int>(sizeof buf));
-    if (n > 0) lcm_publish(lcm, channel, buf, static_cast<unsigned int>(n));
+    if (n > 0) lcm_publish(on != nullptr ? on : lcm, channel, buf, static_cast<unsigned int>(n));
   }
+  lcm_t* ground_bus() const { return ground != nullptr ? ground : lcm; }
   // One message dispatched or the deadline passed. False on a bus error.
   bool wait_once(std::int64_t deadline) {
     std::int64_t rem = deadline - now_ns();
@@ -104,13 +108,19 @@ struct Bus {
     timespec ts{};
     ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
     ts.tv_nsec = static_cast<long>(rem % kNsPerS);
-    pollfd p{};
-    p.fd = lcm_get_fileno(lcm);
-    p.events = POLLIN;
-    const int r = ppoll(&p, 1, &ts, nullptr);
+    pollfd p[2]{};
+    p[0].fd = lcm_get_fileno(lcm);
+    p[0].events = POLLIN;
+    nfds_t n = 1;
+    if (ground != nullptr) {
+      p[1].fd = lcm_get_fileno(ground);
+      p[1].events = POLLIN;
+      n = 2;
+    }
+    const int r = ppoll(p, n, &ts, nullptr);
     if (r < 0) return errno == EINTR;
     if (r == 0) return true;
-    return lcm_handle(lcm) == 0;
+    return lcm_handle(p[0].revents != 0 ? lcm : ground) == 0;
   }
   void event(std::int8_t sev, std::int32_t id, std::int32_t a0, std::int32_t a1, double t,
              const std::string& text) {
@@ -122,7 +132,7 @@ struct Bus {
     e.arg0 = a0;
     e.arg1 = a1;
     e.text = text.substr(0, rocksteady::event_t::MAX_TEXT);
-    publish(channels::kEvents, e);
+    publish(channels::kEvents, e, ground_bus());
   }
 };
 
@@ -189,6 +199,11 @@ int main(int argc, char** argv) {
   cli.add_option("--out", out_csv, "time series CSV (true state, forces, fuel)");
   cli.add_option("--log-interval", log_interval_s, "CSV row interval, s")->capture_default_str();
   cli.add_flag("-v,--verbose", verbose, "progress once per wall second");
+  std::string ground_url;
+  cli.add_option("--ground-lcm-url", ground_url,
+                 "separate ground bus (as rocksteady-fsw's): telemetry in, events and truth out");
+  rt::RealtimeOptions rt_opt;
+  rt::add_options(cli, rt_opt);
   CLI11_PARSE(cli, argc, argv);
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
   if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
@@ -230,14 +245,24 @@ int main(int argc, char** argv) {
     csv << '\n';
   };
 
+  // Real-time hardening (meant for --mode realtime) before the bus is opened.
+  if (const int rc = rt::apply_and_report(rt_opt, "rocksteady-plant", stdout); rc != 0) return rc;
+
   Bus bus;
   bus.lcm = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
   if (bus.lcm == nullptr) {
     std::fprintf(stderr, "rocksteady-plant: cannot open the LCM bus\n");
     return 3;
   }
+  if (!ground_url.empty()) {
+    bus.ground = lcm_create(ground_url.c_str());
+    if (bus.ground == nullptr) {
+      std::fprintf(stderr, "rocksteady-plant: cannot open the ground bus %s\n", ground_url.c_str());
+      return 3;
+    }
+  }
   lcm_subscribe(bus.lcm, channels::kThrusterCmd, &Bus::on_cmd, &bus);
-  lcm_subscribe(bus.lcm, channels::kGncTelemetry, &Bus::on_tlm, &bus);
+  lcm_subscribe(bus.ground_bus(), channels::kGncTelemetry, &Bus::on_tlm, &bus);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
@@ -270,7 +295,8 @@ int main(int argc, char** argv) {
     const rocksteady::sensor_frame_t frame = wire::to_message(plant.read_sensors());
     bus.publish(channels::kSensors, frame);
     if (truth_every > 0 && k % truth_every == 0) {
-      bus.publish(channels::kPlantTruth, make_truth(static_cast<std::int64_t>(k), plant));
+      bus.publish(channels::kPlantTruth, make_truth(static_cast<std::int64_t>(k), plant),
+                  bus.ground_bus());
     }
     if (csv_every != 0 && k % csv_every == 0) write_row();
 
@@ -421,5 +447,6 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   lcm_destroy(bus.lcm);
+  if (bus.ground != nullptr) lcm_destroy(bus.ground);
   return bus_error ? 1 : 0;
 }
