@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <ctime>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "lcmtypes/channels.hpp"
@@ -231,7 +232,10 @@ void FlightNode::test_stall(const Tick& t, const NodeOptions& o) {
 
 void FlightNode::tick(const Tick& t, const NodeOptions& o) {
   test_stall(t, o);
+  const std::int64_t t0 = clock_.now_ns();
   const TickReport r = computer_.tick(t);  // sensors in and thrusters out through the ports
+  const std::int64_t t1 = clock_.now_ns();
+  stats_.ns_tick += t1 - t0;
   last_index_ = t.index;
   have_index_ = true;
   ++stats_.ticks;
@@ -258,6 +262,7 @@ void FlightNode::tick(const Tick& t, const NodeOptions& o) {
     publish(channels::kCmdAck, ack_msg_);
     drain_events();
   }
+  stats_.ns_after_tick += clock_.now_ns() - t1;
 }
 
 void FlightNode::publish_telemetry(const NodeOptions& o) {
@@ -341,6 +346,8 @@ bool FlightNode::wait_once(std::int64_t deadline_ns) {
     n = 2;
   }
   const int r = ppoll(p, n, &ts, nullptr);
+  const std::int64_t woke = clock_.now_ns();
+  stats_.ns_wait += woke - now;
   if (r < 0) return errno == EINTR;  // a signal: the caller looks at its stop flag
   if (r == 0) return true;          // deadline
   // The flight bus (sensor frames) always first; the ground bus only when the flight bus is idle.
@@ -350,7 +357,9 @@ bool FlightNode::wait_once(std::int64_t deadline_ns) {
   } else {
     ++stats_.ground_handled;
   }
-  if (lcm_handle(bus) != 0) {
+  const int handled = lcm_handle(bus);
+  stats_.ns_handle += clock_.now_ns() - woke;
+  if (handled != 0) {
     bus_error_ = true;
     return false;
   }
@@ -378,7 +387,25 @@ int FlightNode::run(const NodeOptions& o, const volatile std::sig_atomic_t* stop
   }
   const int rc = o.clock == ClockMode::kLockstep ? run_lockstep(o, stop) : run_realtime(o, stop);
   watchdog_.stop();
-  if (o.verbose) status_line("fsw exit:");
+  if (o.verbose) {
+    status_line("fsw exit:");
+    const double n = stats_.ticks > 0 ? static_cast<double>(stats_.ticks) : 1.0;
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    std::printf("fsw process: cpu_s=%.3f ctx=%ld\n",
+                static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+                    static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) * 1e-6,
+                ru.ru_nvcsw + ru.ru_nivcsw);
+    std::printf(
+        "fsw time per tick: wait %.2f us, lcm_handle %.2f us, computer tick %.2f us, "
+        "telemetry+events %.2f us (%" PRIu64 " ticks, %" PRIu64 " messages handled)\n",
+        static_cast<double>(stats_.ns_wait) * 1e-3 / n,
+        static_cast<double>(stats_.ns_handle) * 1e-3 / n,
+        static_cast<double>(stats_.ns_tick) * 1e-3 / n,
+        static_cast<double>(stats_.ns_after_tick) * 1e-3 / n, stats_.ticks,
+        stats_.flight_handled + stats_.ground_handled);
+    std::fflush(stdout);
+  }
   return rc;
 }
 

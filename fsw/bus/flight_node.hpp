@@ -111,6 +111,13 @@ struct NodeStats {
   std::uint64_t ground_bound_ticks{0};  // ticks in which the bound was reached
   std::uint64_t flight_handled{0};      // messages dispatched from the flight bus
   std::uint64_t ground_handled{0};      // messages dispatched from the ground bus (when separate)
+  // Where the wall time goes (CLOCK_MONOTONIC, summed): waiting in ppoll, lcm_handle (LCM's queue,
+  // decoding, the handlers), the flight computer's tick (devices, FlightApp, the thruster publish),
+  // and after it (telemetry, events, the start command).
+  std::int64_t ns_wait{0};
+  std::int64_t ns_handle{0};
+  std::int64_t ns_tick{0};
+  std::int64_t ns_after_tick{0};
 };
 
 class FlightNode {

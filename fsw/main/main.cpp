@@ -120,6 +120,11 @@ int main(int argc, char** argv) {
       "--ground-lcm-url", ground_url,
       "separate bus for the ground channels (commands, uplink, acks, events, telemetry); "
       "the --lcm-url bus then carries only sensor frames and thruster commands");
+  std::string actuator_url;
+  cli.add_option("--actuator-lcm-url", actuator_url,
+                 "publish thruster commands on this bus (default: --lcm-url); with "
+                 "--ground-lcm-url, --lcm-url then carries only sensor frames: each process hears "
+                 "only what it consumes (faster lockstep)");
   cli.add_option(
          "--ground-drain-max", opt.ground_drain_max,
          "ground messages decoded per base tick; the rest of the tick's are dropped, counted")
@@ -251,7 +256,18 @@ int main(int argc, char** argv) {
       return 3;
     }
   }
-  thrusters.attach(lcm);
+  lcm_t* actuator = nullptr;
+  if (!actuator_url.empty()) {
+    actuator = lcm_create(actuator_url.c_str());  // publish only: no receive thread
+    if (actuator == nullptr) {
+      std::fprintf(stderr, "rocksteady-fsw: cannot open the actuator bus %s\n",
+                   actuator_url.c_str());
+      lcm_destroy(lcm);
+      if (ground != nullptr) lcm_destroy(ground);
+      return 3;
+    }
+  }
+  thrusters.attach(actuator != nullptr ? actuator : lcm);
   std::vector<std::int64_t> jitter_ns;
   if (jitter && opt.clock == bus::ClockMode::kRealtime) {
     const double base = fc.executive.base_rate_hz;
@@ -272,6 +288,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "rocksteady-fsw: cannot subscribe\n");
       lcm_destroy(lcm);
       if (ground != nullptr) lcm_destroy(ground);
+      if (actuator != nullptr) lcm_destroy(actuator);
       return 3;
     }
     if (opt.verbose) {
@@ -298,5 +315,6 @@ int main(int argc, char** argv) {
   }
   lcm_destroy(lcm);
   if (ground != nullptr) lcm_destroy(ground);
+  if (actuator != nullptr) lcm_destroy(actuator);
   return rc;
 }

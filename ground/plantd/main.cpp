@@ -13,6 +13,7 @@
 // exactly as the in-process runner does (ground/merit). The plant links no flight software: it speaks
 // device readings (hal/readings.hpp) through the bus library (wire/).
 #include <poll.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cctype>
@@ -66,6 +67,7 @@ enum PlantEvent : std::int32_t { kRunStarted = 1000, kEchoTimeout = 1001, kRunFi
 struct Bus {
   lcm_t* lcm{nullptr};
   lcm_t* ground{nullptr};  // --ground-lcm-url: telemetry in, events and truth out (else lcm)
+  lcm_t* actuator{nullptr};  // --actuator-lcm-url: thruster commands in (else lcm)
   rocksteady::thruster_cmd_t scratch{};
   rocksteady::gnc_telemetry_t tlm{};
   bool have_cmd{false};
@@ -101,6 +103,7 @@ struct Bus {
     if (n > 0) lcm_publish(on != nullptr ? on : lcm, channel, buf, static_cast<unsigned int>(n));
   }
   lcm_t* ground_bus() const { return ground != nullptr ? ground : lcm; }
+  lcm_t* command_bus() const { return actuator != nullptr ? actuator : lcm; }
   // One message dispatched or the deadline passed. False on a bus error.
   bool wait_once(std::int64_t deadline) {
     std::int64_t rem = deadline - now_ns();
@@ -108,8 +111,10 @@ struct Bus {
     timespec ts{};
     ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
     ts.tv_nsec = static_cast<long>(rem % kNsPerS);
+    // Only buses this process receives on are polled (lcm_get_fileno starts LCM's receive thread: a
+    // publish-only bus, such as the sensor bus beside an actuator bus, must not get one).
     pollfd p[2]{};
-    p[0].fd = lcm_get_fileno(lcm);
+    p[0].fd = lcm_get_fileno(command_bus());
     p[0].events = POLLIN;
     nfds_t n = 1;
     if (ground != nullptr) {
@@ -120,7 +125,7 @@ struct Bus {
     const int r = ppoll(p, n, &ts, nullptr);
     if (r < 0) return errno == EINTR;
     if (r == 0) return true;
-    return lcm_handle(p[0].revents != 0 ? lcm : ground) == 0;
+    return lcm_handle(p[0].revents != 0 ? command_bus() : ground) == 0;
   }
   void event(std::int8_t sev, std::int32_t id, std::int32_t a0, std::int32_t a1, double t,
              const std::string& text) {
@@ -202,6 +207,10 @@ int main(int argc, char** argv) {
   std::string ground_url;
   cli.add_option("--ground-lcm-url", ground_url,
                  "separate ground bus (as rocksteady-fsw's): telemetry in, events and truth out");
+  std::string actuator_url;
+  cli.add_option("--actuator-lcm-url", actuator_url,
+                 "receive thruster commands on this bus (as rocksteady-fsw's); --lcm-url then "
+                 "carries only the sensor frames this process publishes");
   rt::RealtimeOptions rt_opt;
   rt::add_options(cli, rt_opt);
   CLI11_PARSE(cli, argc, argv);
@@ -261,7 +270,15 @@ int main(int argc, char** argv) {
       return 3;
     }
   }
-  lcm_subscribe(bus.lcm, channels::kThrusterCmd, &Bus::on_cmd, &bus);
+  if (!actuator_url.empty()) {
+    bus.actuator = lcm_create(actuator_url.c_str());
+    if (bus.actuator == nullptr) {
+      std::fprintf(stderr, "rocksteady-plant: cannot open the actuator bus %s\n",
+                   actuator_url.c_str());
+      return 3;
+    }
+  }
+  lcm_subscribe(bus.command_bus(), channels::kThrusterCmd, &Bus::on_cmd, &bus);
   lcm_subscribe(bus.ground_bus(), channels::kGncTelemetry, &Bus::on_tlm, &bus);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -415,6 +432,11 @@ int main(int argc, char** argv) {
             static_cast<std::int32_t>(holds), plant.t(), "plant run finished");
 
   if (summary) {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);  // every thread: the loop and LCM's receive threads
+    const double cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+                         static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) * 1e-6;
+    const long ctx = ru.ru_nvcsw + ru.ru_nivcsw;
     const double ticks_per_s = wall > 0.0 ? static_cast<double>(plant.ticks()) / wall : 0.0;
     const char* mode_name = bus.last_mode >= 0 && bus.last_mode < gnc::kModeCount
                                 ? gnc::to_string(static_cast<gnc::Mode>(bus.last_mode))
@@ -435,18 +457,20 @@ int main(int argc, char** argv) {
                 ", rx rejected %" PRIu64 ", thruster/channel mismatches %" PRIu64 "\n",
                 bus.commands, applied, timeouts, resends, holds, stale, bus.rx.rejected(),
                 wiring_mismatch);
-    std::printf("summary: case=%d mode=%s periods=%" PRIu64 " t_omega=%s fuel_omega=%s t_q=%s "
+    std::printf("summary: case=%d mode=%s periods=%" PRIu64
+                " t_omega=%s fuel_omega=%s t_q=%s "
                 "fuel_q=%s total_fuel=%.17g final_rate=%.17g final_q_error=%.17g flight_mode=%s "
                 "timeouts=%" PRIu64 " resends=%" PRIu64 " holds=%" PRIu64 " rx_rejected=%" PRIu64
-                " fresh=%" PRIu64 " wall_s=%.3f\n",
+                " fresh=%" PRIu64 " wall_s=%.3f cpu_s=%.3f ctx=%ld\n",
                 setup.case_number, mode.c_str(), plant.ticks(), exact(omega_conv.time()).c_str(),
                 exact(omega_conv.fuel_kg()).c_str(), exact(q_conv.time()).c_str(),
                 exact(q_conv.fuel_kg()).c_str(), plant.fuel_kg(), plant.omega().norm(),
                 merit::attitude_error(plant.mrp(), q_final), mode_name, timeouts, resends, holds,
-                bus.rx.rejected(), fresh_periods, wall);
+                bus.rx.rejected(), fresh_periods, wall, cpu_s, ctx);
     std::fflush(stdout);
   }
   lcm_destroy(bus.lcm);
   if (bus.ground != nullptr) lcm_destroy(bus.ground);
+  if (bus.actuator != nullptr) lcm_destroy(bus.actuator);
   return bus_error ? 1 : 0;
 }
