@@ -6,6 +6,7 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 
 #include <sys/resource.h>
@@ -81,12 +82,13 @@ FlightNode::~FlightNode() {
 
 bool FlightNode::subscribe() {
   out_ = ground_ != nullptr ? ground_ : lcm_;
-  subs_[0] = lcm_subscribe(lcm_, channels::kSensors, &FlightNode::on_sensors, this);
+  if (direct_ == nullptr) {
+    subs_[0] = lcm_subscribe(lcm_, channels::kSensors, &FlightNode::on_sensors, this);
+    if (subs_[0] == nullptr) return false;
+  }
   subs_[1] = lcm_subscribe(out_, channels::kGroundCmd, &FlightNode::on_command, this);
   subs_[2] = lcm_subscribe(out_, channels::kTrajUplink, &FlightNode::on_chunk, this);
-  for (lcm_subscription_t* s : subs_) {
-    if (s == nullptr) return false;
-  }
+  if (subs_[1] == nullptr || subs_[2] == nullptr) return false;
   // A whole table's uplink (32 chunks) may arrive between two ticks.
   lcm_subscription_set_queue_capacity(subs_[2], 64);
   return true;
@@ -337,7 +339,7 @@ bool FlightNode::wait_once(std::int64_t deadline_ns) {
   ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
   ts.tv_nsec = static_cast<long>(rem % kNsPerS);
   pollfd p[2]{};
-  p[0].fd = lcm_get_fileno(lcm_);
+  p[0].fd = direct_ != nullptr ? direct_->fd() : lcm_get_fileno(lcm_);
   p[0].events = POLLIN;
   nfds_t n = 1;
   if (ground_ != nullptr) {
@@ -356,6 +358,26 @@ bool FlightNode::wait_once(std::int64_t deadline_ns) {
     ++stats_.flight_handled;
   } else {
     ++stats_.ground_handled;
+  }
+  if (bus == lcm_ && direct_ != nullptr) {
+    const char* channel = nullptr;
+    const void* data = nullptr;
+    int size = 0;
+    const int got = direct_->receive(&channel, &data, &size);
+    if (got > 0 && std::strcmp(channel, channels::kSensors) == 0) {
+      lcm_recv_buf_t rbuf{};
+      rbuf.data = const_cast<void*>(data);
+      rbuf.data_size = static_cast<std::uint32_t>(size);
+      rbuf.recv_utime = woke / 1000;
+      rbuf.lcm = lcm_;
+      on_sensors(&rbuf, channel, this);
+    }
+    stats_.ns_handle += clock_.now_ns() - woke;
+    if (got < 0) {
+      bus_error_ = true;
+      return false;
+    }
+    return true;
   }
   const int handled = lcm_handle(bus);
   stats_.ns_handle += clock_.now_ns() - woke;

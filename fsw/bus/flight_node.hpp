@@ -46,6 +46,7 @@
 #include "fsw/computer/flight_computer.hpp"
 #include "fsw/executive/clock.hpp"
 #include "hal/lcm/lcm_ports.hpp"
+#include "rt/udpm_receiver.hpp"
 #include "rt/watchdog.hpp"
 #include "wire/codec.hpp"
 
@@ -132,6 +133,9 @@ class FlightNode {
 
   // A separate bus for the ground-facing channels (call before subscribe; nullptr: the one bus).
   void set_ground_bus(lcm_t* ground) { ground_ = ground; }
+  // Sensor frames read from this socket by the loop itself instead of through LCM's receive thread
+  // (call before subscribe; the flight bus must then carry nothing else the node needs).
+  void set_direct_sensor_rx(rt::UdpmReceiver* rx) { direct_ = rx; }
   bool subscribe();
   // Runs until *stop becomes non-zero or an exit limit is reached. Returns 0, or 1 on a bus error.
   int run(const NodeOptions& options, const volatile std::sig_atomic_t* stop);
@@ -168,6 +172,7 @@ class FlightNode {
   lcm_t* lcm_;
   lcm_t* ground_{nullptr};  // separate ground bus, or nullptr
   lcm_t* out_{nullptr};     // where acks, events, telemetry go (ground_ or lcm_)
+  rt::UdpmReceiver* direct_{nullptr};
   FlightComputer& computer_;
   hal::LcmSensorSource& sensors_;
   hal::LcmThrusterSink& thrusters_;

@@ -6,11 +6,12 @@
 //   rocksteady-fsw --case 1 --clock lockstep --initial-mode DETUMBLE
 //   rocksteady-fsw --case 1 --clock realtime --rate 100 -v
 #include <algorithm>
-#include <cmath>
 #include <cctype>
 #include <cinttypes>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <memory>
 #include <string>
@@ -125,6 +126,10 @@ int main(int argc, char** argv) {
                  "publish thruster commands on this bus (default: --lcm-url); with "
                  "--ground-lcm-url, --lcm-url then carries only sensor frames: each process hears "
                  "only what it consumes (faster lockstep)");
+  bool direct_rx = false;
+  cli.add_flag("--direct-rx", direct_rx,
+               "read sensor frames from the --lcm-url socket in the loop thread (no LCM receive "
+               "thread: one wake-up per frame); needs --actuator-lcm-url and --ground-lcm-url");
   cli.add_option(
          "--ground-drain-max", opt.ground_drain_max,
          "ground messages decoded per base tick; the rest of the tick's are dropped, counted")
@@ -230,6 +235,13 @@ int main(int argc, char** argv) {
   }
   std::fflush(stdout);
 
+  if (direct_rx && (actuator_url.empty() || ground_url.empty())) {
+    std::fprintf(stderr,
+                 "rocksteady-fsw: --direct-rx needs --actuator-lcm-url and --ground-lcm-url (the "
+                 "--lcm-url bus must carry only sensor frames)\n");
+    return 2;
+  }
+
   fsw::MonotonicClock clock;
   // The flight computer and its LCM ports (sensor frames in, thruster commands out; the frames are
   // aligned with the body frame, so the devices' alignment is the identity).
@@ -284,6 +296,17 @@ int main(int argc, char** argv) {
   {
     bus::FlightNode node(lcm, computer, sensors, thrusters, clock);
     node.set_ground_bus(ground);
+    rocksteady::rt::UdpmReceiver direct;
+    if (direct_rx) {
+      const char* env = std::getenv("LCM_DEFAULT_URL");
+      const std::string url =
+          !lcm_url.empty() ? lcm_url : (env != nullptr ? env : "udpm://239.255.76.67:7667?ttl=0");
+      if (!direct.open(url)) {
+        std::fprintf(stderr, "rocksteady-fsw: --direct-rx: %s\n", direct.error().c_str());
+        return 3;
+      }
+      node.set_direct_sensor_rx(&direct);
+    }
     if (!node.subscribe()) {
       std::fprintf(stderr, "rocksteady-fsw: cannot subscribe\n");
       lcm_destroy(lcm);

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <exception>
 #include <fstream>
@@ -35,6 +36,7 @@
 #include "ground/plant/plant.hpp"
 #include "lcmtypes/channels.hpp"
 #include "rt/realtime.hpp"
+#include "rt/udpm_receiver.hpp"
 #include "wire/codec.hpp"
 #include "wire/convert.hpp"
 
@@ -104,6 +106,7 @@ struct Bus {
   }
   lcm_t* ground_bus() const { return ground != nullptr ? ground : lcm; }
   lcm_t* command_bus() const { return actuator != nullptr ? actuator : lcm; }
+  rt::UdpmReceiver* direct{nullptr};  // --direct-rx: thruster commands read by the loop itself
   // One message dispatched or the deadline passed. False on a bus error.
   bool wait_once(std::int64_t deadline) {
     std::int64_t rem = deadline - now_ns();
@@ -114,7 +117,7 @@ struct Bus {
     // Only buses this process receives on are polled (lcm_get_fileno starts LCM's receive thread: a
     // publish-only bus, such as the sensor bus beside an actuator bus, must not get one).
     pollfd p[2]{};
-    p[0].fd = lcm_get_fileno(command_bus());
+    p[0].fd = direct != nullptr ? direct->fd() : lcm_get_fileno(command_bus());
     p[0].events = POLLIN;
     nfds_t n = 1;
     if (ground != nullptr) {
@@ -125,6 +128,20 @@ struct Bus {
     const int r = ppoll(p, n, &ts, nullptr);
     if (r < 0) return errno == EINTR;
     if (r == 0) return true;
+    if (p[0].revents != 0 && direct != nullptr) {
+      const char* channel = nullptr;
+      const void* data = nullptr;
+      int size = 0;
+      const int got = direct->receive(&channel, &data, &size);
+      if (got > 0 && std::strcmp(channel, channels::kThrusterCmd) == 0) {
+        lcm_recv_buf_t rbuf{};
+        rbuf.data = const_cast<void*>(data);
+        rbuf.data_size = static_cast<std::uint32_t>(size);
+        rbuf.lcm = command_bus();
+        on_cmd(&rbuf, channel, this);
+      }
+      return got >= 0;
+    }
     return lcm_handle(p[0].revents != 0 ? command_bus() : ground) == 0;
   }
   void event(std::int8_t sev, std::int32_t id, std::int32_t a0, std::int32_t a1, double t,
@@ -211,9 +228,18 @@ int main(int argc, char** argv) {
   cli.add_option("--actuator-lcm-url", actuator_url,
                  "receive thruster commands on this bus (as rocksteady-fsw's); --lcm-url then "
                  "carries only the sensor frames this process publishes");
+  bool direct_rx = false;
+  cli.add_flag("--direct-rx", direct_rx,
+               "read thruster commands from the --actuator-lcm-url socket in the loop thread (no "
+               "LCM receive thread); needs --actuator-lcm-url and --ground-lcm-url");
   rt::RealtimeOptions rt_opt;
   rt::add_options(cli, rt_opt);
   CLI11_PARSE(cli, argc, argv);
+  if (direct_rx && (actuator_url.empty() || ground_url.empty())) {
+    std::fprintf(stderr,
+                 "rocksteady-plant: --direct-rx needs --actuator-lcm-url and --ground-lcm-url\n");
+    return 2;
+  }
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
   if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
 
@@ -278,7 +304,16 @@ int main(int argc, char** argv) {
       return 3;
     }
   }
-  lcm_subscribe(bus.command_bus(), channels::kThrusterCmd, &Bus::on_cmd, &bus);
+  rt::UdpmReceiver direct;
+  if (direct_rx) {
+    if (!direct.open(actuator_url)) {
+      std::fprintf(stderr, "rocksteady-plant: --direct-rx: %s\n", direct.error().c_str());
+      return 3;
+    }
+    bus.direct = &direct;
+  } else {
+    lcm_subscribe(bus.command_bus(), channels::kThrusterCmd, &Bus::on_cmd, &bus);
+  }
   lcm_subscribe(bus.ground_bus(), channels::kGncTelemetry, &Bus::on_tlm, &bus);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

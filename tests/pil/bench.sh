@@ -8,8 +8,10 @@
 #   split          sensor frames on --lcm-url, thruster commands on --actuator-lcm-url, ground channels
 #                  (telemetry, truth, events, commands) on --ground-lcm-url: each process receives
 #                  only what it consumes
-# each with telemetry (and plant truth) every tick and every 10th. Wake-ups per tick are the
-# context switches of both processes (all threads, /proc) divided by the ticks. The figures of merit
+#   split+direct   split, and the hot channel read by each loop itself (--direct-rx): no LCM receive
+#                  thread on the hot path, one wake-up per message
+# each with telemetry (and plant truth) every tick and every 10th. CPU time and context switches
+# per tick are both processes' (every thread, getrusage at exit) divided by the ticks. The figures of merit
 # of every layout must be identical (printed).
 #
 # Usage: tests/pil/bench.sh [BUILD_DIR] [SECONDS_PER_JITTER_RUN] [--sim-s S] [--no-jitter]
@@ -41,28 +43,28 @@ unshare -rn bash -c '
   url="udpm://239.255.76.67:7900?ttl=0"
   act="udpm://239.255.76.67:7901?ttl=0"
   gnd="udpm://239.255.76.67:7902?ttl=0"
-  ctx() {  # context switches of all threads of a process
-    cat /proc/$1/task/*/status 2> /dev/null | awk "/ctxt_switches/ {s += \$2} END {print s + 0}"
-  }
-  for layout in one split; do
+  for layout in one split direct; do
     for tlm in 1 10; do
       fx=(); px=()
-      if [[ $layout == split ]]; then
+      if [[ $layout != one ]]; then
         fx=(--actuator-lcm-url "$act" --ground-lcm-url "$gnd"); px=(--actuator-lcm-url "$act" --ground-lcm-url "$gnd")
       fi
-      "$B_FSW" --lcm-url "$url" --case 1 --start-mode DETUMBLE --tlm-every $tlm "${fx[@]}" > /dev/null & f=$!
+      if [[ $layout == direct ]]; then fx+=(--direct-rx); px+=(--direct-rx); fi
+      "$B_FSW" --lcm-url "$url" --case 1 --start-mode DETUMBLE --tlm-every $tlm -v "${fx[@]}" \
+          > "$B_OUT/fsw.log" & f=$!
       "$B_PLANT" --lcm-url "$url" --case 1 --duration "$B_SIM" --summary --truth-every $tlm "${px[@]}" \
-          > "$B_OUT/plant.log" & p=$!
-      # sample both processes just before the plant ends (its context switches vanish with it)
-      c=0
-      while kill -0 $p 2> /dev/null; do c=$(( $(ctx $f) + $(ctx $p) )); sleep 0.05; done
-      wait $p
+          > "$B_OUT/plant.log"
       kill $f; wait $f 2> /dev/null || true
       s=$(grep "^summary:" "$B_OUT/plant.log")
+      fp=$(grep "^fsw process:" "$B_OUT/fsw.log")
       v() { sed -E "s/.* $1=([^ ]+).*/\1/" <<< "$s"; }
+      fv() { sed -E "s/.* $1=([^ ]+).*/\1/" <<< " $fp"; }
       periods=$(v periods); wall=$(v wall_s)
-      awk -v p=$periods -v w=$wall -v t=$tlm -v to=$(v timeouts) -v c=$c -v l=$layout \
-        "BEGIN{printf \"| %s | %d | %d | %.2f | %.0f | %.1f | %d |\n\", l, t, p, w, p/w, c/p, to}" >> "$B_OUT/rows"
+      cpu=$(awk -v a=$(v cpu_s) -v b=$(fv cpu_s) -v p=$periods "BEGIN{printf \"%.1f\", (a+b)*1e6/p}")
+      c=$(awk -v a=$(v ctx) -v b=$(fv ctx) -v p=$periods "BEGIN{printf \"%.2f\", (a+b)/p}")
+      lname=$layout; [[ $layout == direct ]] && lname="split+direct"
+      awk -v p=$periods -v w=$wall -v t=$tlm -v to=$(v timeouts) -v c=$c -v l="$lname" \
+        -v cpu=$cpu "BEGIN{printf \"| %s | %d | %d | %.2f | %.0f | %s | %s | %d |\n\", l, t, p, w, p/w, cpu, c, to}" >> "$B_OUT/rows"
       echo "$layout tlm=$tlm: t_omega=$(v t_omega) t_q=$(v t_q) total_fuel=$(v total_fuel) final_rate=$(v final_rate)" >> "$B_OUT/fom"
     done
   done
@@ -78,8 +80,8 @@ unshare -rn bash -c '
 {
   echo "Measured by \`tests/pil/bench.sh --sim-s $sim\` on $(date -u +%Y-%m-%d), $(nproc) cores: case 1, lockstep, $(( sim * 10 )) ticks per row."
   echo
-  echo "| buses | telemetry + truth every | ticks | wall s | ticks/s | context switches per tick | echo timeouts |"
-  echo "|---|---|---|---|---|---|---|"
+  echo "| buses | telemetry + truth every | ticks | wall s | ticks/s | CPU µs per tick | context switches per tick | echo timeouts |"
+  echo "|---|---|---|---|---|---|---|---|"
   cat "$out/rows"
   echo
   if [[ $(cut -d: -f2 "$out/fom" | sort -u | wc -l) -eq 1 ]]; then

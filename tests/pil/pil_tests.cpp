@@ -89,7 +89,8 @@ std::string exact(double v) { return exact(std::optional<double>(v)); }
 // A lockstep PIL run of the fast case; returns the plant's summary.
 std::map<std::string, std::string> run_fast_pil(const std::string& name, int port,
                                                 const std::vector<std::string>& fsw_extra,
-                                                FastCase* out_case) {
+                                                FastCase* out_case,
+                                                const std::vector<std::string>& plant_extra = {}) {
   const std::string dir = scratch_dir(name);
   const FastCase fc = make_fast_case(dir);
   if (out_case != nullptr) *out_case = fc;
@@ -97,8 +98,9 @@ std::map<std::string, std::string> run_fast_pil(const std::string& name, int por
   std::vector<std::string> fx = {"--law", "ntcl", "--tlm-every", "10"};
   fx.insert(fx.end(), fsw_extra.begin(), fsw_extra.end());
   Process fsw(fsw_args(url, fc.mission, fc.gnc, fc.case_file, fx), dir + "/fsw.log");
-  Process plant(plant_args(url, fc.mission, fc.gnc, fc.case_file, {"--truth-every", "10"}),
-                dir + "/plant.log");
+  std::vector<std::string> px = {"--truth-every", "10"};
+  px.insert(px.end(), plant_extra.begin(), plant_extra.end());
+  Process plant(plant_args(url, fc.mission, fc.gnc, fc.case_file, px), dir + "/plant.log");
   int status = -1;
   EXPECT_TRUE(plant.wait(120.0, &status)) << "plant did not finish";
   EXPECT_EQ(status, 0) << read_file(plant.log_path());
@@ -154,6 +156,24 @@ TEST(PilLockstep, MatchesTheInProcessFlightApplicationRunBitForBit) {
   FastCase fc;
   const auto s = run_fast_pil("vs_app", 7812, {"--start-mode", "DETUMBLE"}, &fc);
   ASSERT_FALSE(s.empty()) << "no plant summary";
+  campaign::FswFlightSide side;
+  const campaign::RunResult r = run_in_process(fc, side);
+  ASSERT_EQ(r.status, campaign::RunStatus::kOk) << r.note;
+  expect_same_figures(s, r);
+}
+
+// The fast lockstep layout: sensor frames, thruster commands and the ground channels on three
+// buses, the hot channels read by each process's loop itself (--direct-rx, no LCM receive thread).
+// Same messages, same order: the same run bit for bit.
+TEST(PilLockstep, SplitBusesWithDirectReceiveMatchTheInProcessRunBitForBit) {
+  FastCase fc;
+  const std::vector<std::string> buses = {"--actuator-lcm-url", lcm_url(7815), "--ground-lcm-url",
+                                          lcm_url(7816), "--direct-rx"};
+  std::vector<std::string> fx = {"--start-mode", "DETUMBLE"};
+  fx.insert(fx.end(), buses.begin(), buses.end());
+  const auto s = run_fast_pil("vs_app_direct", 7814, fx, &fc, buses);
+  ASSERT_FALSE(s.empty()) << "no plant summary";
+  EXPECT_EQ(s.at("holds"), "0");
   campaign::FswFlightSide side;
   const campaign::RunResult r = run_in_process(fc, side);
   ASSERT_EQ(r.status, campaign::RunStatus::kOk) << r.note;
