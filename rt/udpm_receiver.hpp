@@ -4,10 +4,11 @@
 // application through a pipe: two wake-ups per message; this socket wakes the loop directly.
 //
 // It receives LCM's small-message packets (magic "LC02", sequence number, NUL-terminated channel,
-// payload; what lcm_publish sends for a message under 1400 bytes). Larger (fragmented, "LC03") or
-// malformed packets are counted and dropped. Publishing stays with LCM (lcm_publish), and other LCM
-// tools on the bus (loggers, lcm-spy) see the same traffic. Do not also lcm_subscribe to the same
-// URL in this process: LCM would start its receive thread and read every packet too.
+// payload: what LCM 1.3's lcm_publish sends in one datagram, up to ~64 KB). Fragmented messages
+// ("LC03") and malformed packets are counted and dropped: the hot channels carry small messages.
+// Publishing stays with LCM (lcm_publish), and other LCM tools on the bus (loggers, lcm-spy) see
+// the same traffic. Do not also lcm_subscribe to the same URL in this process: LCM would start its
+// receive thread and read every packet too.
 #pragma once
 
 #include <cstdint>

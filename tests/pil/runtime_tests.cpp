@@ -2,10 +2,20 @@
 // refused with a clear message, the software watchdog catching a stalled tick while it is stalled.
 // Runs inside the PIL test binary's private network namespace (an unprivileged user namespace: the
 // kernel refuses SCHED_FIFO there, which is what the refusal tests rely on).
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <lcm/lcm.h>
+
+#include "rt/udpm_receiver.hpp"
 
 #include "tests/pil/pil_harness.hpp"
 
@@ -144,6 +154,58 @@ TEST(PilWatchdog, AStalledTickIsCaughtWhileStalledThrustersOffAndANonZeroExit) {
     EXPECT_EQ(bus.thruster.thruster_force[i], 0.0) << "thruster " << i;
   }
   for (int i = 0; i < 8; ++i) EXPECT_EQ(bus.thruster.channel_force[i], 0.0) << "channel " << i;
+}
+
+// The direct receiver against LCM's own publisher: a small message arrives with its channel and
+// payload byte for byte; a message LCM fragments (LCM 1.3 sends up to ~64 KB in one datagram; above
+// that, "LC03" fragments) and a packet that is not LCM are counted and skipped, never delivered.
+TEST(UdpmReceiver, ReadsLcmSmallMessagesAndSkipsFragmentsAndForeignPackets) {
+  const std::string url = lcm_url(7866);
+  rt::UdpmReceiver rx;
+  ASSERT_TRUE(rx.open(url)) << rx.error();
+  lcm_t* lcm = lcm_create(url.c_str());
+  ASSERT_NE(lcm, nullptr);
+  const auto wait_readable = [&] {
+    pollfd p{rx.fd(), POLLIN, 0};
+    return poll(&p, 1, 2000) == 1;
+  };
+  const char* channel = nullptr;
+  const void* data = nullptr;
+  int size = 0;
+
+  std::vector<unsigned char> small(300);
+  for (std::size_t i = 0; i < small.size(); ++i) small[i] = static_cast<unsigned char>(i * 7 + 1);
+  ASSERT_EQ(lcm_publish(lcm, "RS_SENSORS", small.data(), static_cast<unsigned>(small.size())), 0);
+  ASSERT_TRUE(wait_readable());
+  ASSERT_EQ(rx.receive(&channel, &data, &size), 1);
+  EXPECT_STREQ(channel, "RS_SENSORS");
+  ASSERT_EQ(size, static_cast<int>(small.size()));
+  EXPECT_EQ(std::memcmp(data, small.data(), small.size()), 0);
+  EXPECT_EQ(rx.receive(&channel, &data, &size), 0);  // nothing else waiting
+
+  std::vector<unsigned char> big(100000, 0x5a);  // fragmented by LCM: several LC03 packets
+  ASSERT_EQ(lcm_publish(lcm, "RS_SENSORS", big.data(), static_cast<unsigned>(big.size())), 0);
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(7866);
+  inet_aton("239.255.76.67", &to.sin_addr);
+  const char junk[] = "not an LCM packet";
+  ASSERT_GT(sendto(fd, junk, sizeof junk, 0, reinterpret_cast<const sockaddr*>(&to), sizeof to), 0);
+  close(fd);
+  ASSERT_EQ(lcm_publish(lcm, "RS_THRUSTER_CMD", small.data(), 10), 0);  // a marker after them
+  ASSERT_TRUE(wait_readable());
+  int got = 0;
+  for (int i = 0; i < 100 && got == 0; ++i) {
+    got = rx.receive(&channel, &data, &size);
+    if (got == 0) wait_readable();
+  }
+  ASSERT_EQ(got, 1);
+  EXPECT_STREQ(channel, "RS_THRUSTER_CMD");  // the fragments and the junk were skipped
+  EXPECT_EQ(size, 10);
+  EXPECT_EQ(rx.received(), 2u);
+  EXPECT_GE(rx.rejected(), 2u + 1u);  // at least two fragments, and the junk
+  lcm_destroy(lcm);
 }
 
 }  // namespace
