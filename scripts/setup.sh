@@ -12,6 +12,7 @@ packages=(
   coinor-libipopt-dev
   gnuplot-nox
   iproute2 util-linux
+  stress-ng python3
   clang libclang-rt-14-dev
   libcpp-httplib-dev nlohmann-json3-dev chromium
 )

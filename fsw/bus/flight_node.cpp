@@ -6,7 +6,11 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
+
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include "gnc/units.hpp"
 #include "lcmtypes/channels.hpp"
@@ -64,23 +68,30 @@ FlightNode::FlightNode(lcm_t* lcm, FlightComputer& computer, hal::LcmSensorSourc
     : lcm_(lcm), computer_(computer), sensors_(sensors), thrusters_(thrusters), clock_(clock) {
   reserve_text(ack_msg_);
   reserve_text(event_msg_);
+  wd_event_msg_ = wire::make<rocksteady::event_t>();
+  reserve_text(wd_event_msg_);
   tlm_msg_ = wire::make<rocksteady::gnc_telemetry_t>();
+  out_ = lcm_;
 }
 
 FlightNode::~FlightNode() {
-  for (lcm_subscription_t*& s : subs_) {
-    if (s != nullptr && lcm_ != nullptr) lcm_unsubscribe(lcm_, s);
-    s = nullptr;
+  watchdog_.stop();
+  for (int i = 0; i < 3; ++i) {
+    lcm_t* bus = i == 0 ? lcm_ : out_;
+    if (subs_[i] != nullptr && bus != nullptr) lcm_unsubscribe(bus, subs_[i]);
+    subs_[i] = nullptr;
   }
 }
 
 bool FlightNode::subscribe() {
-  subs_[0] = lcm_subscribe(lcm_, channels::kSensors, &FlightNode::on_sensors, this);
-  subs_[1] = lcm_subscribe(lcm_, channels::kGroundCmd, &FlightNode::on_command, this);
-  subs_[2] = lcm_subscribe(lcm_, channels::kTrajUplink, &FlightNode::on_chunk, this);
-  for (lcm_subscription_t* s : subs_) {
-    if (s == nullptr) return false;
+  out_ = ground_ != nullptr ? ground_ : lcm_;
+  if (direct_ == nullptr) {
+    subs_[0] = lcm_subscribe(lcm_, channels::kSensors, &FlightNode::on_sensors, this);
+    if (subs_[0] == nullptr) return false;
   }
+  subs_[1] = lcm_subscribe(out_, channels::kGroundCmd, &FlightNode::on_command, this);
+  subs_[2] = lcm_subscribe(out_, channels::kTrajUplink, &FlightNode::on_chunk, this);
+  if (subs_[1] == nullptr || subs_[2] == nullptr) return false;
   // A whole table's uplink (32 chunks) may arrive between two ticks.
   lcm_subscription_set_queue_capacity(subs_[2], 64);
   return true;
@@ -126,8 +137,19 @@ void FlightNode::sync_sensor_stats() {
   stats_.rx_sensors = sensors_.counters();
 }
 
+bool FlightNode::ground_budget() {
+  if (ground_left_ > 0) {
+    --ground_left_;
+    if (ground_left_ == 0) ++stats_.ground_bound_ticks;
+    return true;
+  }
+  ++stats_.ground_dropped;
+  return false;
+}
+
 void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
   auto& n = *static_cast<FlightNode*>(self);
+  if (!n.ground_budget()) return;
   if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_cmd_,
                               &n.stats_.rx_commands)) {
     n.note_rx_reject(1, n.stats_.rx_commands);
@@ -146,6 +168,7 @@ void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/,
 
 void FlightNode::on_chunk(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* self) {
   auto& n = *static_cast<FlightNode*>(self);
+  if (!n.ground_budget()) return;
   if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), n.scratch_chunk_,
                               &n.stats_.rx_uplink)) {
     n.note_rx_reject(2, n.stats_.rx_uplink);
@@ -175,7 +198,7 @@ void FlightNode::note_rx_reject(int channel, const wire::RxCounters& c) {
 
 template <class T> void FlightNode::publish(const char* channel, const T& msg) {
   const int n = wire::encode(msg, buf_, static_cast<int>(sizeof buf_));
-  if (n < 0 || lcm_publish(lcm_, channel, buf_, static_cast<unsigned int>(n)) != 0) {
+  if (n < 0 || lcm_publish(out_, channel, buf_, static_cast<unsigned int>(n)) != 0) {
     ++stats_.publish_errors;
   }
 }
@@ -202,11 +225,38 @@ void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::
   publish(channels::kEvents, event_msg_);
 }
 
+void FlightNode::test_stall(const Tick& t, const NodeOptions& o) {
+  if (o.test_stall_at_tick == 0 || t.index != o.test_stall_at_tick) return;
+  std::fprintf(stderr,
+               "rocksteady-fsw: FAULT INJECTION (--test-stall-at-tick): tick %llu stalls %s\n",
+               static_cast<unsigned long long>(t.index),
+               o.test_stall_s > 0.0 ? "for --test-stall-s" : "forever");
+  std::fflush(stderr);
+  const std::int64_t until = clock_.now_ns() + to_ns(o.test_stall_s);
+  while (o.test_stall_s <= 0.0 || clock_.now_ns() < until) {
+    timespec ts{0, 10 * kNsPerMs};
+    nanosleep(&ts, nullptr);
+  }
+}
+
 void FlightNode::tick(const Tick& t, const NodeOptions& o) {
+  test_stall(t, o);
+  const std::int64_t t0 = clock_.now_ns();
   const TickReport r = computer_.tick(t);  // sensors in and thrusters out through the ports
+  const std::int64_t t1 = clock_.now_ns();
+  stats_.ns_tick += t1 - t0;
   last_index_ = t.index;
   have_index_ = true;
   ++stats_.ticks;
+  ground_left_ = ground_drain_max_;  // a new tick: a new ground budget
+  ground_reset_ns_ = t.start_ns;
+  if (r.gnc_ran) {
+    // The GNC rate group completed a cycle: feed the watchdog (the only place it is fed).
+    wd_seq_.store(computer_.echo_seq(), std::memory_order_relaxed);
+    wd_t_.store(computer_.onboard_time(), std::memory_order_relaxed);
+    wd_tick_.store(t.index, std::memory_order_relaxed);
+    watchdog_.feed();
+  }
   if (r.gnc_ran) publish_telemetry(o);
   drain_events();
   if (o.has_start_mode && !start_done_ && r.gnc_ran && computer_.health().frames_accepted > 0) {
@@ -221,6 +271,7 @@ void FlightNode::tick(const Tick& t, const NodeOptions& o) {
     publish(channels::kCmdAck, ack_msg_);
     drain_events();
   }
+  stats_.ns_after_tick += clock_.now_ns() - t1;
 }
 
 void FlightNode::publish_telemetry(const NodeOptions& o) {
@@ -238,12 +289,44 @@ void FlightNode::status_line(const char* prefix) const {
   const HealthTelemetry h = computer_.health();
   const wire::RxCounters rx = rx_total();
   std::printf("%s t=%.1f s mode=%s law=%s ticks=%" PRIu64 " frames=%" PRIu64
-              " frameless=%u cmd=%u/%u rx_ok=%" PRIu64 " rx_rejected=%" PRIu64
-              " restarts=%" PRIu64 "\n",
+              " frameless=%u superseded=%" PRIu64 " cmd=%u/%u rx_ok=%" PRIu64
+              " rx_rejected=%" PRIu64 " restarts=%" PRIu64 " ground_dropped=%" PRIu64
+              " ground_bound_ticks=%" PRIu64 " missed=%u\n",
               prefix, h.t, gnc::to_string(h.mode), gnc::to_string(h.law), stats_.ticks,
-              stats_.frames, h.frameless_ticks, h.cmd_accepted, h.cmd_rejected, rx.ok,
-              rx.rejected(), stats_.stream_restarts);
+              stats_.frames, h.frameless_ticks, stats_.frames_superseded, h.cmd_accepted,
+              h.cmd_rejected, rx.ok, rx.rejected(), stats_.stream_restarts, stats_.ground_dropped,
+              stats_.ground_bound_ticks, h.base_missed);
   std::fflush(stdout);
+}
+
+// Runs on the watchdog thread while the tick thread is stuck: only atomics, the thread-safe
+// thruster sink, and the watchdog's own message and buffer (LCM's publish is thread-safe).
+void FlightNode::on_watchdog(void* self, std::int64_t since_feed_ns) {
+  auto& n = *static_cast<FlightNode*>(self);
+  const std::int64_t seq = n.wd_seq_.load();
+  const double t = n.wd_t_.load();
+  const std::uint64_t tick = n.wd_tick_.load();
+  const auto ms = static_cast<std::int32_t>(since_feed_ns / kNsPerMs);
+  n.thrusters_.all_off(seq, t);
+  auto& e = n.wd_event_msg_;
+  e.t = t;
+  e.seq = static_cast<std::int64_t>(kBusEventSeqBase - 1);  // outside both numberings
+  e.severity = static_cast<std::int8_t>(Severity::kError);
+  e.id = static_cast<std::int32_t>(BusEventId::kWatchdog);
+  e.arg0 = ms;
+  e.arg1 = static_cast<std::int32_t>(tick);
+  char text[96];
+  std::snprintf(text, sizeof text, "watchdog: no GNC cycle for %d ms: thrusters off, exiting", ms);
+  e.text = text;
+  const int len = wire::encode(e, n.wd_buf_, static_cast<int>(sizeof n.wd_buf_));
+  if (len > 0) lcm_publish(n.out_, channels::kEvents, n.wd_buf_, static_cast<unsigned int>(len));
+  std::fprintf(stderr,
+               "rocksteady-fsw: WATCHDOG: no GNC cycle for %d ms (last at base tick %llu): every "
+               "thruster commanded off, exiting with status %d\n",
+               ms, static_cast<unsigned long long>(tick), kExitWatchdog);
+  std::fflush(stderr);
+  std::fflush(stdout);
+  _exit(kExitWatchdog);
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -251,19 +334,61 @@ void FlightNode::status_line(const char* prefix) const {
 // ----------------------------------------------------------------------------------------------
 
 bool FlightNode::wait_once(std::int64_t deadline_ns) {
-  const int fd = lcm_get_fileno(lcm_);
-  std::int64_t rem = deadline_ns - clock_.now_ns();
+  std::int64_t now = clock_.now_ns();
+  if (period_ns_ > 0 && now - ground_reset_ns_ >= period_ns_) {
+    // No tick for a base period (before the first frame, or a silent plant): refill the budget.
+    ground_left_ = ground_drain_max_;
+    ground_reset_ns_ = now;
+  }
+  std::int64_t rem = deadline_ns - now;
   if (rem < 0) rem = 0;
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
   ts.tv_nsec = static_cast<long>(rem % kNsPerS);
-  pollfd p{};
-  p.fd = fd;
-  p.events = POLLIN;
-  const int r = ppoll(&p, 1, &ts, nullptr);
+  pollfd p[2]{};
+  p[0].fd = direct_ != nullptr ? direct_->fd() : lcm_get_fileno(lcm_);
+  p[0].events = POLLIN;
+  nfds_t n = 1;
+  if (ground_ != nullptr) {
+    p[1].fd = lcm_get_fileno(ground_);
+    p[1].events = POLLIN;
+    n = 2;
+  }
+  const int r = ppoll(p, n, &ts, nullptr);
+  const std::int64_t woke = clock_.now_ns();
+  stats_.ns_wait += woke - now;
   if (r < 0) return errno == EINTR;  // a signal: the caller looks at its stop flag
   if (r == 0) return true;          // deadline
-  if (lcm_handle(lcm_) != 0) {
+  // The flight bus (sensor frames) always first; the ground bus only when the flight bus is idle.
+  lcm_t* bus = (p[0].revents & (POLLIN | POLLERR | POLLHUP)) != 0 ? lcm_ : ground_;
+  if (bus == lcm_) {
+    ++stats_.flight_handled;
+  } else {
+    ++stats_.ground_handled;
+  }
+  if (bus == lcm_ && direct_ != nullptr) {
+    const char* channel = nullptr;
+    const void* data = nullptr;
+    int size = 0;
+    const int got = direct_->receive(&channel, &data, &size);
+    if (got > 0 && std::strcmp(channel, channels::kSensors) == 0) {
+      lcm_recv_buf_t rbuf{};
+      rbuf.data = const_cast<void*>(data);
+      rbuf.data_size = static_cast<std::uint32_t>(size);
+      rbuf.recv_utime = woke / 1000;
+      rbuf.lcm = lcm_;
+      on_sensors(&rbuf, channel, this);
+    }
+    stats_.ns_handle += clock_.now_ns() - woke;
+    if (got < 0) {
+      bus_error_ = true;
+      return false;
+    }
+    return true;
+  }
+  const int handled = lcm_handle(bus);
+  stats_.ns_handle += clock_.now_ns() - woke;
+  if (handled != 0) {
     bus_error_ = true;
     return false;
   }
@@ -278,8 +403,38 @@ bool FlightNode::limits_reached(const NodeOptions& o, std::int64_t start_ns) con
 
 int FlightNode::run(const NodeOptions& o, const volatile std::sig_atomic_t* stop) {
   last_status_ns_ = clock_.now_ns();
+  period_ns_ = computer_.app().executive().base_period_ns();
+  ground_drain_max_ = o.ground_drain_max;
+  ground_left_ = ground_drain_max_;
+  ground_reset_ns_ = last_status_ns_;
+  if (o.watchdog_s > 0.0) {
+    if (!watchdog_.start(to_ns(o.watchdog_s), &FlightNode::on_watchdog, this,
+                         o.watchdog_fifo_priority)) {
+      std::fprintf(stderr, "rocksteady-fsw: watchdog: %s\n", watchdog_.error());
+      return 1;
+    }
+  }
   const int rc = o.clock == ClockMode::kLockstep ? run_lockstep(o, stop) : run_realtime(o, stop);
-  if (o.verbose) status_line("fsw exit:");
+  watchdog_.stop();
+  if (o.verbose) {
+    status_line("fsw exit:");
+    const double n = stats_.ticks > 0 ? static_cast<double>(stats_.ticks) : 1.0;
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    std::printf("fsw process: cpu_s=%.3f ctx=%ld\n",
+                static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+                    static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) * 1e-6,
+                ru.ru_nvcsw + ru.ru_nivcsw);
+    std::printf(
+        "fsw time per tick: wait %.2f us, lcm_handle %.2f us, computer tick %.2f us, "
+        "telemetry+events %.2f us (%" PRIu64 " ticks, %" PRIu64 " messages handled)\n",
+        static_cast<double>(stats_.ns_wait) * 1e-3 / n,
+        static_cast<double>(stats_.ns_handle) * 1e-3 / n,
+        static_cast<double>(stats_.ns_tick) * 1e-3 / n,
+        static_cast<double>(stats_.ns_after_tick) * 1e-3 / n, stats_.ticks,
+        stats_.flight_handled + stats_.ground_handled);
+    std::fflush(stdout);
+  }
   return rc;
 }
 

@@ -7,8 +7,8 @@
 //
 // Two clocks:
 //   lockstep  each new sensor frame is one base tick (fsw::LockstepSource); the thruster command
-//             echoes the frame's seq. A repeated frame (the plant resending after a lost command) is
-//             answered by re-publishing the command it already produced, without a second tick.
+//             echoes the frame's seq. A repeated frame (the plant resending after a lost command)
+//             is answered by re-publishing the command it already produced, without a second tick.
 //             After the first frame, when no frame arrives for `frame_watchdog_s` of wall time, the
 //             node runs frameless ticks at the base period, so the flight core's sensor timeout
 //             takes it to SAFE (thrusters off, event) when the plant is gone.
@@ -19,9 +19,23 @@
 // devices forget their last readings (the application re-anchors its time base after
 // frame_resync_count frames).
 //
+// Inbound priority and bounds: sensor frames first. With a separate ground bus (set_ground_bus),
+// the flight bus carries only RS_SENSORS / RS_THRUSTER_CMD and its socket is always served before
+// the ground bus's; the ground-facing channels (RS_GROUND_CMD, RS_TRAJ_UPLINK in; RS_CMD_ACK,
+// RS_EVENTS, RS_GNC_TLM out) move to the ground bus. Either way at most `ground_drain_max` ground
+// messages are decoded per base tick (or per base period while no ticks run); the rest of that
+// tick's ground messages are dropped undecoded and counted (NodeStats::ground_dropped, the status
+// line).
+//
+// Software watchdog (NodeOptions::watchdog_s > 0): fed by each GNC cycle; when no cycle completes
+// within the timeout, a watchdog thread (not the stalled one) raises event 203, commands every
+// thruster off through hal::LcmThrusterSink::all_off and ends the process with kExitWatchdog so a
+// supervisor restarts it.
+//
 // Only this object's thread calls lcm_handle. Nothing here allocates per message except LCM itself.
 #pragma once
 
+#include <atomic>
 #include <csignal>
 #include <cstdint>
 #include <vector>
@@ -32,6 +46,8 @@
 #include "fsw/computer/flight_computer.hpp"
 #include "fsw/executive/clock.hpp"
 #include "hal/lcm/lcm_ports.hpp"
+#include "rt/udpm_receiver.hpp"
+#include "rt/watchdog.hpp"
 #include "wire/codec.hpp"
 
 namespace rocksteady::fsw::bus {
@@ -42,8 +58,13 @@ enum class ClockMode { kLockstep, kRealtime };
 enum class BusEventId : std::int32_t {
   kStreamRestart = 200,  // sensor frame seq went backwards; arg0 = new seq, arg1 = restarts
   kFrameWatchdog = 201,  // lockstep: no frame for frame_watchdog_s, frameless ticks
-  kRxRejected = 202,     // throttled; arg0 = channel (0 sensors, 1 ground cmd, 2 uplink), arg1 = total
+  kRxRejected = 202,  // throttled; arg0 = channel (0 sensors, 1 ground cmd, 2 uplink), arg1 = total
+  kWatchdog = 203,    // error; no GNC cycle within the watchdog time: thrusters off, process exits
+                      // arg0 = ms since the last GNC cycle, arg1 = base tick of that cycle
 };
+
+// Exit status after the software watchdog fired (a supervisor restarts the process).
+inline constexpr int kExitWatchdog = 5;
 
 struct NodeOptions {
   ClockMode clock{ClockMode::kLockstep};
@@ -59,6 +80,15 @@ struct NodeOptions {
   // kStartupSource (the in-process campaign's habit: the estimator has a state by then).
   bool has_start_mode{false};
   gnc::Mode start_mode{gnc::Mode::kDetumble};
+  // Ground messages (commands + uplink chunks) decoded per base tick; beyond it they are dropped.
+  std::uint32_t ground_drain_max{64};
+  // Software watchdog: no GNC cycle for this many wall seconds -> thrusters off, exit. 0: off.
+  double watchdog_s{0.0};
+  int watchdog_fifo_priority{0};  // > 0: the watchdog thread runs under SCHED_FIFO at this priority
+  // FAULT INJECTION, for tests of the watchdog only: base tick `test_stall_at_tick` (> 0) stalls
+  // before the flight computer runs, for test_stall_s wall seconds (0: forever).
+  std::uint64_t test_stall_at_tick{0};
+  double test_stall_s{0.0};
 };
 
 // Command source of the --start-mode command (the operator's sources are unaffected).
@@ -78,6 +108,17 @@ struct NodeStats {
   wire::RxCounters rx_sensors{};
   wire::RxCounters rx_commands{};
   wire::RxCounters rx_uplink{};
+  std::uint64_t ground_dropped{0};  // ground messages dropped undecoded (per-tick bound reached)
+  std::uint64_t ground_bound_ticks{0};  // ticks in which the bound was reached
+  std::uint64_t flight_handled{0};      // messages dispatched from the flight bus
+  std::uint64_t ground_handled{0};      // messages dispatched from the ground bus (when separate)
+  // Where the wall time goes (CLOCK_MONOTONIC, summed): waiting in ppoll, lcm_handle (LCM's queue,
+  // decoding, the handlers), the flight computer's tick (devices, FlightApp, the thruster publish),
+  // and after it (telemetry, events, the start command).
+  std::int64_t ns_wait{0};
+  std::int64_t ns_handle{0};
+  std::int64_t ns_tick{0};
+  std::int64_t ns_after_tick{0};
 };
 
 class FlightNode {
@@ -90,6 +131,11 @@ class FlightNode {
   FlightNode& operator=(const FlightNode&) = delete;
   ~FlightNode();
 
+  // A separate bus for the ground-facing channels (call before subscribe; nullptr: the one bus).
+  void set_ground_bus(lcm_t* ground) { ground_ = ground; }
+  // Sensor frames read from this socket by the loop itself instead of through LCM's receive thread
+  // (call before subscribe; the flight bus must then carry nothing else the node needs).
+  void set_direct_sensor_rx(rt::UdpmReceiver* rx) { direct_ = rx; }
   bool subscribe();
   // Runs until *stop becomes non-zero or an exit limit is reached. Returns 0, or 1 on a bus error.
   int run(const NodeOptions& options, const volatile std::sig_atomic_t* stop);
@@ -105,6 +151,9 @@ class FlightNode {
   static void on_sensors(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
   static void on_command(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
   static void on_chunk(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+  static void on_watchdog(void* self, std::int64_t since_feed_ns);
+  bool ground_budget();  // false: drop this ground message (counted)
+  void test_stall(const Tick& t, const NodeOptions& o);
 
   int run_lockstep(const NodeOptions& o, const volatile std::sig_atomic_t* stop);
   int run_realtime(const NodeOptions& o, const volatile std::sig_atomic_t* stop);
@@ -121,6 +170,9 @@ class FlightNode {
   bool limits_reached(const NodeOptions& o, std::int64_t start_ns) const;
 
   lcm_t* lcm_;
+  lcm_t* ground_{nullptr};  // separate ground bus, or nullptr
+  lcm_t* out_{nullptr};     // where acks, events, telemetry go (ground_ or lcm_)
+  rt::UdpmReceiver* direct_{nullptr};
   FlightComputer& computer_;
   hal::LcmSensorSource& sensors_;
   hal::LcmThrusterSink& thrusters_;
@@ -148,6 +200,17 @@ class FlightNode {
   bool start_done_{false};
   unsigned char buf_[4096]{};
   NodeStats stats_{};
+  std::uint32_t ground_drain_max_{64};
+  std::uint32_t ground_left_{64};    // ground messages still allowed in this tick
+  std::int64_t ground_reset_ns_{0};  // when the budget was last refilled
+  std::int64_t period_ns_{0};
+  // Watchdog: its thread reads only these atomics and its own message and buffer.
+  rt::Watchdog watchdog_;
+  std::atomic<std::int64_t> wd_seq_{0};
+  std::atomic<double> wd_t_{0.0};
+  std::atomic<std::uint64_t> wd_tick_{0};
+  rocksteady::event_t wd_event_msg_{};
+  unsigned char wd_buf_[1024]{};
 };
 
 }  // namespace rocksteady::fsw::bus

@@ -6,11 +6,12 @@
 //   rocksteady-fsw --case 1 --clock lockstep --initial-mode DETUMBLE
 //   rocksteady-fsw --case 1 --clock realtime --rate 100 -v
 #include <algorithm>
-#include <cmath>
 #include <cctype>
 #include <cinttypes>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <memory>
 #include <string>
@@ -21,12 +22,13 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
 
-#include "fsw/computer/flight_computer.hpp"
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/bus/flight_node.hpp"
-#include "fsw/executive/clock.hpp"
 #include "config/config_files.hpp"
+#include "fsw/computer/flight_computer.hpp"
+#include "fsw/executive/clock.hpp"
 #include "hal/lcm/lcm_ports.hpp"
+#include "rt/realtime.hpp"
 
 namespace {
 
@@ -114,6 +116,41 @@ int main(int argc, char** argv) {
   cli.add_option("--exit-after-ticks", opt.exit_after_ticks, "exit after this many base ticks");
   cli.add_flag("-v,--verbose", opt.verbose, "one status line per second");
   cli.add_flag("--jitter", jitter, "realtime: print tick-start deviation statistics at exit");
+  std::string ground_url;
+  cli.add_option(
+      "--ground-lcm-url", ground_url,
+      "separate bus for the ground channels (commands, uplink, acks, events, telemetry); "
+      "the --lcm-url bus then carries only sensor frames and thruster commands");
+  std::string actuator_url;
+  cli.add_option("--actuator-lcm-url", actuator_url,
+                 "publish thruster commands on this bus (default: --lcm-url); with "
+                 "--ground-lcm-url, --lcm-url then carries only sensor frames: each process hears "
+                 "only what it consumes (faster lockstep)");
+  bool direct_rx = false;
+  cli.add_flag("--direct-rx", direct_rx,
+               "read sensor frames from the --lcm-url socket in the loop thread (no LCM receive "
+               "thread: one wake-up per frame); needs --actuator-lcm-url and --ground-lcm-url");
+  cli.add_option(
+         "--ground-drain-max", opt.ground_drain_max,
+         "ground messages decoded per base tick; the rest of the tick's are dropped, counted")
+      ->check(CLI::Range(1u, 100000u))
+      ->capture_default_str();
+  double watchdog_ms = 0.0;
+  cli.add_option("--watchdog-ms", watchdog_ms,
+                 "software watchdog: no GNC cycle for this long -> event 203, all thrusters off, "
+                 "exit status 5 (0: off)")
+      ->check(CLI::NonNegativeNumber);
+  rocksteady::rt::RealtimeOptions rt_opt;
+  rocksteady::rt::add_options(cli, rt_opt);
+  auto* stall = cli.add_option("--test-stall-at-tick", opt.test_stall_at_tick,
+                               "FAULT INJECTION for watchdog tests: stall base tick N (> 0)")
+                    ->check(CLI::PositiveNumber);
+  stall->group("Fault injection (tests only)");
+  cli.add_option("--test-stall-s", opt.test_stall_s,
+                 "FAULT INJECTION: length of the stall, wall seconds (0: forever)")
+      ->needs(stall)
+      ->check(CLI::NonNegativeNumber)
+      ->group("Fault injection (tests only)");
   CLI11_PARSE(cli, argc, argv);
 
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
@@ -160,6 +197,51 @@ int main(int argc, char** argv) {
     fc.executive.housekeeping_divider = static_cast<std::uint32_t>(std::max(1.0, std::round(base)));
   }
 
+  if (watchdog_ms > 0.0) {
+    // The watchdog is fed by each GNC cycle: it must allow a whole GNC period and, in lockstep, the
+    // frame watchdog's silence before frameless ticks resume.
+    const double min_s = dt + (opt.clock == bus::ClockMode::kLockstep ? opt.frame_watchdog_s : 0.0);
+    if (watchdog_ms * 1e-3 <= min_s) {
+      std::fprintf(
+          stderr,
+          "rocksteady-fsw: --watchdog-ms %g is too short: it must exceed the GNC period "
+          "(%g ms)%s, i.e. be above %g ms\n",
+          watchdog_ms, dt * 1e3,
+          opt.clock == bus::ClockMode::kLockstep ? " plus --frame-watchdog in lockstep" : "",
+          min_s * 1e3);
+      return 2;
+    }
+    opt.watchdog_s = watchdog_ms * 1e-3;
+  }
+
+  // Real-time hardening before the bus is opened: LCM's receive threads and the watchdog inherit
+  // it.
+  rocksteady::rt::RealtimeResult rt_result;
+  if (const int rc = rocksteady::rt::apply_and_report(rt_opt, "rocksteady-fsw", stdout, &rt_result);
+      rc != 0) {
+    return rc;
+  }
+  if (rt_result.fifo_priority_applied > 0) {
+    opt.watchdog_fifo_priority = std::min(99, rt_result.fifo_priority_applied + 1);
+  }
+  if (opt.watchdog_s > 0.0) {
+    std::printf(
+        "rocksteady-fsw: watchdog: %g ms, fed by the GNC rate group%s\n", watchdog_ms,
+        opt.watchdog_fifo_priority > 0 ? " (thread under SCHED_FIFO, one above the tick)" : "");
+  }
+  if (opt.test_stall_at_tick > 0) {
+    std::printf("rocksteady-fsw: FAULT INJECTION armed: base tick %llu will stall\n",
+                static_cast<unsigned long long>(opt.test_stall_at_tick));
+  }
+  std::fflush(stdout);
+
+  if (direct_rx && (actuator_url.empty() || ground_url.empty())) {
+    std::fprintf(stderr,
+                 "rocksteady-fsw: --direct-rx needs --actuator-lcm-url and --ground-lcm-url (the "
+                 "--lcm-url bus must carry only sensor frames)\n");
+    return 2;
+  }
+
   fsw::MonotonicClock clock;
   // The flight computer and its LCM ports (sensor frames in, thruster commands out; the frames are
   // aligned with the body frame, so the devices' alignment is the identity).
@@ -177,7 +259,27 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rocksteady-fsw: cannot open the LCM bus\n");
     return 3;
   }
-  thrusters.attach(lcm);
+  lcm_t* ground = nullptr;
+  if (!ground_url.empty()) {
+    ground = lcm_create(ground_url.c_str());
+    if (ground == nullptr) {
+      std::fprintf(stderr, "rocksteady-fsw: cannot open the ground bus %s\n", ground_url.c_str());
+      lcm_destroy(lcm);
+      return 3;
+    }
+  }
+  lcm_t* actuator = nullptr;
+  if (!actuator_url.empty()) {
+    actuator = lcm_create(actuator_url.c_str());  // publish only: no receive thread
+    if (actuator == nullptr) {
+      std::fprintf(stderr, "rocksteady-fsw: cannot open the actuator bus %s\n",
+                   actuator_url.c_str());
+      lcm_destroy(lcm);
+      if (ground != nullptr) lcm_destroy(ground);
+      return 3;
+    }
+  }
+  thrusters.attach(actuator != nullptr ? actuator : lcm);
   std::vector<std::int64_t> jitter_ns;
   if (jitter && opt.clock == bus::ClockMode::kRealtime) {
     const double base = fc.executive.base_rate_hz;
@@ -193,9 +295,23 @@ int main(int argc, char** argv) {
   int rc = 0;
   {
     bus::FlightNode node(lcm, computer, sensors, thrusters, clock);
+    node.set_ground_bus(ground);
+    rocksteady::rt::UdpmReceiver direct;
+    if (direct_rx) {
+      const char* env = std::getenv("LCM_DEFAULT_URL");
+      const std::string url =
+          !lcm_url.empty() ? lcm_url : (env != nullptr ? env : "udpm://239.255.76.67:7667?ttl=0");
+      if (!direct.open(url)) {
+        std::fprintf(stderr, "rocksteady-fsw: --direct-rx: %s\n", direct.error().c_str());
+        return 3;
+      }
+      node.set_direct_sensor_rx(&direct);
+    }
     if (!node.subscribe()) {
       std::fprintf(stderr, "rocksteady-fsw: cannot subscribe\n");
       lcm_destroy(lcm);
+      if (ground != nullptr) lcm_destroy(ground);
+      if (actuator != nullptr) lcm_destroy(actuator);
       return 3;
     }
     if (opt.verbose) {
@@ -205,8 +321,23 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
     rc = node.run(opt, &g_stop);
-    if (jitter) print_jitter("fsw jitter:", jitter_ns, fc.executive.base_rate_hz);
+    if (jitter) {
+      print_jitter("fsw jitter:", jitter_ns, fc.executive.base_rate_hz);
+      const bus::NodeStats& st = node.stats();
+      const fsw::HealthTelemetry h = computer.health();
+      std::printf(
+          "fsw bus: ticks=%llu frameless=%u frames=%llu superseded=%llu missed=%u "
+          "ground_dropped=%llu ground_bound_ticks=%llu rx_rejected=%llu\n",
+          static_cast<unsigned long long>(st.ticks), h.frameless_ticks,
+          static_cast<unsigned long long>(st.frames),
+          static_cast<unsigned long long>(st.frames_superseded), h.base_missed,
+          static_cast<unsigned long long>(st.ground_dropped),
+          static_cast<unsigned long long>(st.ground_bound_ticks),
+          static_cast<unsigned long long>(node.rx_total().rejected()));
+    }
   }
   lcm_destroy(lcm);
+  if (ground != nullptr) lcm_destroy(ground);
+  if (actuator != nullptr) lcm_destroy(actuator);
   return rc;
 }

@@ -13,6 +13,7 @@
 // exactly as the in-process runner does (ground/merit). The plant links no flight software: it speaks
 // device readings (hal/readings.hpp) through the bus library (wire/).
 #include <poll.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cctype>
@@ -21,6 +22,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <exception>
 #include <fstream>
@@ -33,9 +35,11 @@
 #include "ground/config/config.hpp"
 #include "ground/merit/figures_of_merit.hpp"
 #include "ground/plant/plant.hpp"
+#include "lcmtypes/channels.hpp"
+#include "rt/realtime.hpp"
+#include "rt/udpm_receiver.hpp"
 #include "wire/codec.hpp"
 #include "wire/convert.hpp"
-#include "lcmtypes/channels.hpp"
 
 namespace {
 
@@ -65,6 +69,8 @@ enum PlantEvent : std::int32_t { kRunStarted = 1000, kEchoTimeout = 1001, kRunFi
 
 struct Bus {
   lcm_t* lcm{nullptr};
+  lcm_t* ground{nullptr};  // --ground-lcm-url: telemetry in, events and truth out (else lcm)
+  lcm_t* actuator{nullptr};  // --actuator-lcm-url: thruster commands in (else lcm)
   rocksteady::thruster_cmd_t scratch{};
   rocksteady::gnc_telemetry_t tlm{};
   bool have_cmd{false};
@@ -94,10 +100,14 @@ struct Bus {
       b.fuel_hat = b.tlm.fuel_kg;
     }
   }
-  template <class T> void publish(const char* channel, const T& msg) {
+  template <class T>
+  void publish(const char* channel, const T& msg, lcm_t* on = nullptr) {
     const int n = wire::encode(msg, buf, static_cast<int>(sizeof buf));
-    if (n > 0) lcm_publish(lcm, channel, buf, static_cast<unsigned int>(n));
+    if (n > 0) lcm_publish(on != nullptr ? on : lcm, channel, buf, static_cast<unsigned int>(n));
   }
+  lcm_t* ground_bus() const { return ground != nullptr ? ground : lcm; }
+  lcm_t* command_bus() const { return actuator != nullptr ? actuator : lcm; }
+  rt::UdpmReceiver* direct{nullptr};  // --direct-rx: thruster commands read by the loop itself
   // One message dispatched or the deadline passed. False on a bus error.
   bool wait_once(std::int64_t deadline) {
     std::int64_t rem = deadline - now_ns();
@@ -105,13 +115,35 @@ struct Bus {
     timespec ts{};
     ts.tv_sec = static_cast<time_t>(rem / kNsPerS);
     ts.tv_nsec = static_cast<long>(rem % kNsPerS);
-    pollfd p{};
-    p.fd = lcm_get_fileno(lcm);
-    p.events = POLLIN;
-    const int r = ppoll(&p, 1, &ts, nullptr);
+    // Only buses this process receives on are polled (lcm_get_fileno starts LCM's receive thread: a
+    // publish-only bus, such as the sensor bus beside an actuator bus, must not get one).
+    pollfd p[2]{};
+    p[0].fd = direct != nullptr ? direct->fd() : lcm_get_fileno(command_bus());
+    p[0].events = POLLIN;
+    nfds_t n = 1;
+    if (ground != nullptr) {
+      p[1].fd = lcm_get_fileno(ground);
+      p[1].events = POLLIN;
+      n = 2;
+    }
+    const int r = ppoll(p, n, &ts, nullptr);
     if (r < 0) return errno == EINTR;
     if (r == 0) return true;
-    return lcm_handle(lcm) == 0;
+    if (p[0].revents != 0 && direct != nullptr) {
+      const char* channel = nullptr;
+      const void* data = nullptr;
+      int size = 0;
+      const int got = direct->receive(&channel, &data, &size);
+      if (got > 0 && std::strcmp(channel, channels::kThrusterCmd) == 0) {
+        lcm_recv_buf_t rbuf{};
+        rbuf.data = const_cast<void*>(data);
+        rbuf.data_size = static_cast<std::uint32_t>(size);
+        rbuf.lcm = command_bus();
+        on_cmd(&rbuf, channel, this);
+      }
+      return got >= 0;
+    }
+    return lcm_handle(p[0].revents != 0 ? command_bus() : ground) == 0;
   }
   void event(std::int8_t sev, std::int32_t id, std::int32_t a0, std::int32_t a1, double t,
              const std::string& text) {
@@ -123,7 +155,7 @@ struct Bus {
     e.arg0 = a0;
     e.arg1 = a1;
     e.text = text.substr(0, rocksteady::event_t::MAX_TEXT);
-    publish(channels::kEvents, e);
+    publish(channels::kEvents, e, ground_bus());
   }
 };
 
@@ -190,7 +222,25 @@ int main(int argc, char** argv) {
   cli.add_option("--out", out_csv, "time series CSV (true state, forces, fuel)");
   cli.add_option("--log-interval", log_interval_s, "CSV row interval, s")->capture_default_str();
   cli.add_flag("-v,--verbose", verbose, "progress once per wall second");
+  std::string ground_url;
+  cli.add_option("--ground-lcm-url", ground_url,
+                 "separate ground bus (as rocksteady-fsw's): telemetry in, events and truth out");
+  std::string actuator_url;
+  cli.add_option("--actuator-lcm-url", actuator_url,
+                 "receive thruster commands on this bus (as rocksteady-fsw's); --lcm-url then "
+                 "carries only the sensor frames this process publishes");
+  bool direct_rx = false;
+  cli.add_flag("--direct-rx", direct_rx,
+               "read thruster commands from the --actuator-lcm-url socket in the loop thread (no "
+               "LCM receive thread); needs --actuator-lcm-url and --ground-lcm-url");
+  rt::RealtimeOptions rt_opt;
+  rt::add_options(cli, rt_opt);
   CLI11_PARSE(cli, argc, argv);
+  if (direct_rx && (actuator_url.empty() || ground_url.empty())) {
+    std::fprintf(stderr,
+                 "rocksteady-plant: --direct-rx needs --actuator-lcm-url and --ground-lcm-url\n");
+    return 2;
+  }
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
   if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
 
@@ -231,14 +281,41 @@ int main(int argc, char** argv) {
     csv << '\n';
   };
 
+  // Real-time hardening (meant for --mode realtime) before the bus is opened.
+  if (const int rc = rt::apply_and_report(rt_opt, "rocksteady-plant", stdout); rc != 0) return rc;
+
   Bus bus;
   bus.lcm = lcm_create(lcm_url.empty() ? nullptr : lcm_url.c_str());
   if (bus.lcm == nullptr) {
     std::fprintf(stderr, "rocksteady-plant: cannot open the LCM bus\n");
     return 3;
   }
-  lcm_subscribe(bus.lcm, channels::kThrusterCmd, &Bus::on_cmd, &bus);
-  lcm_subscribe(bus.lcm, channels::kGncTelemetry, &Bus::on_tlm, &bus);
+  if (!ground_url.empty()) {
+    bus.ground = lcm_create(ground_url.c_str());
+    if (bus.ground == nullptr) {
+      std::fprintf(stderr, "rocksteady-plant: cannot open the ground bus %s\n", ground_url.c_str());
+      return 3;
+    }
+  }
+  if (!actuator_url.empty()) {
+    bus.actuator = lcm_create(actuator_url.c_str());
+    if (bus.actuator == nullptr) {
+      std::fprintf(stderr, "rocksteady-plant: cannot open the actuator bus %s\n",
+                   actuator_url.c_str());
+      return 3;
+    }
+  }
+  rt::UdpmReceiver direct;
+  if (direct_rx) {
+    if (!direct.open(actuator_url)) {
+      std::fprintf(stderr, "rocksteady-plant: --direct-rx: %s\n", direct.error().c_str());
+      return 3;
+    }
+    bus.direct = &direct;
+  } else {
+    lcm_subscribe(bus.command_bus(), channels::kThrusterCmd, &Bus::on_cmd, &bus);
+  }
+  lcm_subscribe(bus.ground_bus(), channels::kGncTelemetry, &Bus::on_tlm, &bus);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
@@ -271,7 +348,8 @@ int main(int argc, char** argv) {
     const rocksteady::sensor_frame_t frame = wire::to_message(plant.read_sensors());
     bus.publish(channels::kSensors, frame);
     if (truth_every > 0 && k % truth_every == 0) {
-      bus.publish(channels::kPlantTruth, make_truth(static_cast<std::int64_t>(k), plant));
+      bus.publish(channels::kPlantTruth, make_truth(static_cast<std::int64_t>(k), plant),
+                  bus.ground_bus());
     }
     if (csv_every != 0 && k % csv_every == 0) write_row();
 
@@ -390,6 +468,11 @@ int main(int argc, char** argv) {
             static_cast<std::int32_t>(holds), plant.t(), "plant run finished");
 
   if (summary) {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);  // every thread: the loop and LCM's receive threads
+    const double cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+                         static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) * 1e-6;
+    const long ctx = ru.ru_nvcsw + ru.ru_nivcsw;
     const double ticks_per_s = wall > 0.0 ? static_cast<double>(plant.ticks()) / wall : 0.0;
     const char* mode_name = bus.last_mode >= 0 && bus.last_mode < gnc::kModeCount
                                 ? gnc::to_string(static_cast<gnc::Mode>(bus.last_mode))
@@ -410,17 +493,20 @@ int main(int argc, char** argv) {
                 ", rx rejected %" PRIu64 ", thruster/channel mismatches %" PRIu64 "\n",
                 bus.commands, applied, timeouts, resends, holds, stale, bus.rx.rejected(),
                 wiring_mismatch);
-    std::printf("summary: case=%d mode=%s periods=%" PRIu64 " t_omega=%s fuel_omega=%s t_q=%s "
+    std::printf("summary: case=%d mode=%s periods=%" PRIu64
+                " t_omega=%s fuel_omega=%s t_q=%s "
                 "fuel_q=%s total_fuel=%.17g final_rate=%.17g final_q_error=%.17g flight_mode=%s "
                 "timeouts=%" PRIu64 " resends=%" PRIu64 " holds=%" PRIu64 " rx_rejected=%" PRIu64
-                " fresh=%" PRIu64 " wall_s=%.3f\n",
+                " fresh=%" PRIu64 " wall_s=%.3f cpu_s=%.3f ctx=%ld\n",
                 setup.case_number, mode.c_str(), plant.ticks(), exact(omega_conv.time()).c_str(),
                 exact(omega_conv.fuel_kg()).c_str(), exact(q_conv.time()).c_str(),
                 exact(q_conv.fuel_kg()).c_str(), plant.fuel_kg(), plant.omega().norm(),
                 merit::attitude_error(plant.mrp(), q_final), mode_name, timeouts, resends, holds,
-                bus.rx.rejected(), fresh_periods, wall);
+                bus.rx.rejected(), fresh_periods, wall, cpu_s, ctx);
     std::fflush(stdout);
   }
   lcm_destroy(bus.lcm);
+  if (bus.ground != nullptr) lcm_destroy(bus.ground);
+  if (bus.actuator != nullptr) lcm_destroy(bus.actuator);
   return bus_error ? 1 : 0;
 }

@@ -30,16 +30,35 @@ bool LcmSensorSource::poll(RawSensors& out) {
 }
 
 void LcmThrusterSink::write(const ThrusterOutputs& outputs, std::int64_t seq, double t) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (off_latched_.load()) {
+    ++suppressed_;
+    return;
+  }
   msg_ = wire::to_message(outputs, channel_forces(wiring_, outputs), seq, t);
   written_ = true;
-  publish();
+  publish_locked();
 }
 
 void LcmThrusterSink::republish() {
-  if (written_) publish();
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (off_latched_.load()) {
+    ++suppressed_;
+    return;
+  }
+  if (written_) publish_locked();
 }
 
-void LcmThrusterSink::publish() {
+void LcmThrusterSink::all_off(std::int64_t seq, double t) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  off_latched_.store(true);
+  const ThrusterOutputs off{};  // disabled, every thruster off, zero force
+  msg_ = wire::to_message(off, channel_forces(wiring_, off), seq, t);
+  written_ = true;
+  publish_locked();
+}
+
+void LcmThrusterSink::publish_locked() {
   const int n = wire::encode(msg_, buf_, static_cast<int>(sizeof buf_));
   if (n < 0 || bus_ == nullptr || lcm_publish(bus_, channels::kThrusterCmd, buf_, static_cast<unsigned int>(n)) != 0) {
     ++publish_errors_;

@@ -4,7 +4,9 @@
 // message <-> reading mapping are the bus library's (wire/); this file only holds the devices' side.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <mutex>
 
 #include <lcm/lcm.h>
 
@@ -49,6 +51,8 @@ class LcmSensorSource final : public SensorSource {
   std::uint64_t superseded_{0};
 };
 
+// Thread-safe: write() runs on the tick's thread, all_off() may run on a watchdog thread while the
+// tick is stalled (LCM's publish is thread-safe; the message and buffer here are under a mutex).
 class LcmThrusterSink final : public ThrusterSink {
  public:
   // `wiring` maps the thrusters back to the channel forces the message also carries. Publishes on
@@ -59,18 +63,28 @@ class LcmThrusterSink final : public ThrusterSink {
   void write(const ThrusterOutputs& outputs, std::int64_t seq, double t) override;
   // Publish the last command again (lockstep: the plant resent a frame that was already answered).
   void republish();
-  bool written() const { return written_; }
-  std::uint64_t publish_errors() const { return publish_errors_; }
+  bool written() const { return written_.load(); }
+  std::uint64_t publish_errors() const { return publish_errors_.load(); }
+
+  // Commands every thruster off (thruster bank disabled, all 16 off, zero force), echoing `seq`,
+  // and latches: later write() and republish() calls publish nothing (counted in suppressed()).
+  // For the watchdog: callable from any thread, also while write() is in progress on another.
+  void all_off(std::int64_t seq, double t);
+  bool latched_off() const { return off_latched_.load(); }
+  std::uint64_t suppressed() const { return suppressed_.load(); }
 
  private:
-  void publish();
+  void publish_locked();
 
   lcm_t* bus_;
   ThrusterBankConfig wiring_;
+  std::mutex mutex_;  // msg_ and buf_ (the flags and counters are atomic, for unlocked readers)
   rocksteady::thruster_cmd_t msg_{};
-  bool written_{false};
+  std::atomic<bool> written_{false};
   unsigned char buf_[1024]{};
-  std::uint64_t publish_errors_{0};
+  std::atomic<std::uint64_t> publish_errors_{0};
+  std::atomic<std::uint64_t> suppressed_{0};
+  std::atomic<bool> off_latched_{false};
 };
 
 }  // namespace rocksteady::hal

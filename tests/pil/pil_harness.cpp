@@ -167,6 +167,12 @@ void TestBus::on_thruster(const lcm_recv_buf_t* rbuf, const char*, void* self) {
     b.thruster = m;
     b.have_thruster = true;
     ++b.thruster_count;
+    for (int i = 0; i < 16; ++i) {
+      if (m.thruster_on[i]) {
+        ++b.thruster_firing_count;
+        break;
+      }
+    }
   }
 }
 

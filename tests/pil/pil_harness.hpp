@@ -80,6 +80,7 @@ class TestBus {
   bool have_thruster{false};
   rocksteady::thruster_cmd_t thruster{};  // newest thruster command
   std::uint64_t thruster_count{0};
+  std::uint64_t thruster_firing_count{0};  // commands with at least one thruster on
 
   bool has_event(std::int32_t id) const;
   const rocksteady::cmd_ack_t* ack_for(std::int64_t seq, std::int32_t sender = 1) const;

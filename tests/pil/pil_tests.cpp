@@ -4,11 +4,14 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -86,7 +89,8 @@ std::string exact(double v) { return exact(std::optional<double>(v)); }
 // A lockstep PIL run of the fast case; returns the plant's summary.
 std::map<std::string, std::string> run_fast_pil(const std::string& name, int port,
                                                 const std::vector<std::string>& fsw_extra,
-                                                FastCase* out_case) {
+                                                FastCase* out_case,
+                                                const std::vector<std::string>& plant_extra = {}) {
   const std::string dir = scratch_dir(name);
   const FastCase fc = make_fast_case(dir);
   if (out_case != nullptr) *out_case = fc;
@@ -94,8 +98,9 @@ std::map<std::string, std::string> run_fast_pil(const std::string& name, int por
   std::vector<std::string> fx = {"--law", "ntcl", "--tlm-every", "10"};
   fx.insert(fx.end(), fsw_extra.begin(), fsw_extra.end());
   Process fsw(fsw_args(url, fc.mission, fc.gnc, fc.case_file, fx), dir + "/fsw.log");
-  Process plant(plant_args(url, fc.mission, fc.gnc, fc.case_file, {"--truth-every", "10"}),
-                dir + "/plant.log");
+  std::vector<std::string> px = {"--truth-every", "10"};
+  px.insert(px.end(), plant_extra.begin(), plant_extra.end());
+  Process plant(plant_args(url, fc.mission, fc.gnc, fc.case_file, px), dir + "/plant.log");
   int status = -1;
   EXPECT_TRUE(plant.wait(120.0, &status)) << "plant did not finish";
   EXPECT_EQ(status, 0) << read_file(plant.log_path());
@@ -157,6 +162,24 @@ TEST(PilLockstep, MatchesTheInProcessFlightApplicationRunBitForBit) {
   expect_same_figures(s, r);
 }
 
+// The fast lockstep layout: sensor frames, thruster commands and the ground channels on three
+// buses, the hot channels read by each process's loop itself (--direct-rx, no LCM receive thread).
+// Same messages, same order: the same run bit for bit.
+TEST(PilLockstep, SplitBusesWithDirectReceiveMatchTheInProcessRunBitForBit) {
+  FastCase fc;
+  const std::vector<std::string> buses = {"--actuator-lcm-url", lcm_url(7815), "--ground-lcm-url",
+                                          lcm_url(7816), "--direct-rx"};
+  std::vector<std::string> fx = {"--start-mode", "DETUMBLE"};
+  fx.insert(fx.end(), buses.begin(), buses.end());
+  const auto s = run_fast_pil("vs_app_direct", 7814, fx, &fc, buses);
+  ASSERT_FALSE(s.empty()) << "no plant summary";
+  EXPECT_EQ(s.at("holds"), "0");
+  campaign::FswFlightSide side;
+  const campaign::RunResult r = run_in_process(fc, side);
+  ASSERT_EQ(r.status, campaign::RunStatus::kOk) << r.note;
+  expect_same_figures(s, r);
+}
+
 // Booting in DETUMBLE (mode.initial) is the bare flight core's start (GncFlightSide requests
 // DETUMBLE on the first tick): the PIL run matches it bit for bit too.
 TEST(PilLockstep, BootModeDetumbleMatchesTheInProcessFlightCoreRunBitForBit) {
@@ -167,6 +190,116 @@ TEST(PilLockstep, BootModeDetumbleMatchesTheInProcessFlightCoreRunBitForBit) {
   const campaign::RunResult r = run_in_process(fc, side);
   ASSERT_EQ(r.status, campaign::RunStatus::kOk) << r.note;
   expect_same_figures(s, r);
+}
+
+// A flood of garbage on RS_GROUND_CMD, published as fast as a thread can, during a lockstep run of
+// the fast case, on the one bus and on a separate ground bus. Every tick still has its sensor frame
+// (fsw: ticks = frames = the plant's periods, no frameless tick), the plant never holds a command,
+// and the run is the in-process run bit for bit. The per-tick bound (here 4) drops the excess
+// undecoded, and the fsw's exit line counts it.
+struct FloodResult {
+  std::map<std::string, std::string> plant, fsw;  // plant summary, fsw exit line
+  std::uint64_t sent{0};
+};
+
+std::map<std::string, std::string> fsw_exit_line(const std::string& log) {
+  std::map<std::string, std::string> kv;
+  const std::size_t at = log.find("fsw exit: ");
+  if (at == std::string::npos) return kv;
+  std::istringstream line(log.substr(at + 10, log.find('\n', at) - at - 10));
+  std::string item;
+  while (line >> item) {
+    const std::size_t eq = item.find('=');
+    if (eq != std::string::npos) kv[item.substr(0, eq)] = item.substr(eq + 1);
+  }
+  return kv;
+}
+
+FloodResult run_flooded_pil(const std::string& name, int port, bool separate_ground_bus,
+                            FastCase* out_case) {
+  const std::string dir = scratch_dir(name);
+  const FastCase fc = make_fast_case(dir);
+  *out_case = fc;
+  const std::string url = lcm_url(port);
+  const std::string ground_url = separate_ground_bus ? lcm_url(port + 1) : url;
+  std::vector<std::string> fx = {"--law",        "ntcl",     "--tlm-every",        "10",
+                                 "--start-mode", "DETUMBLE", "--ground-drain-max", "4"};
+  std::vector<std::string> px = {"--truth-every", "10"};
+  if (separate_ground_bus) {
+    fx.insert(fx.end(), {"--ground-lcm-url", ground_url});
+    px.insert(px.end(), {"--ground-lcm-url", ground_url});
+  }
+  FloodResult res;
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> sent{0};
+  std::thread flooder([&] {
+    lcm_t* lcm = lcm_create(ground_url.c_str());
+    if (lcm == nullptr) return;
+    std::vector<std::uint8_t> junk(200);
+    std::uint32_t x = 12345;
+    while (!stop.load()) {
+      for (auto& b : junk) b = static_cast<std::uint8_t>((x = x * 1103515245u + 12345u) >> 24);
+      if (lcm_publish(lcm, channels::kGroundCmd, junk.data(), static_cast<unsigned>(junk.size())) ==
+          0) {
+        ++sent;
+      }
+    }
+    lcm_destroy(lcm);
+  });
+  {
+    Process fsw(fsw_args(url, fc.mission, fc.gnc, fc.case_file, fx), dir + "/fsw.log");
+    Process plant(plant_args(url, fc.mission, fc.gnc, fc.case_file, px), dir + "/plant.log");
+    int status = -1;
+    EXPECT_TRUE(plant.wait(180.0, &status)) << "plant did not finish";
+    EXPECT_EQ(status, 0) << read_file(plant.log_path());
+    stop.store(true);
+    flooder.join();
+    fsw.signal(SIGTERM);
+    EXPECT_TRUE(fsw.wait(10.0, &status));
+    EXPECT_EQ(status, 0) << read_file(fsw.log_path());
+    res.plant = plant_summary(read_file(plant.log_path()));
+    res.fsw = fsw_exit_line(read_file(fsw.log_path()));
+  }
+  if (flooder.joinable()) {
+    stop.store(true);
+    flooder.join();
+  }
+  res.sent = sent.load();
+  return res;
+}
+
+void expect_flood_survived(const FloodResult& f, const FastCase& fc) {
+  ASSERT_FALSE(f.plant.empty()) << "no plant summary";
+  ASSERT_FALSE(f.fsw.empty()) << "no fsw exit line";
+  std::printf(
+      "flood: %llu garbage messages sent; fsw %s ticks, %s frames, %s frameless, "
+      "%s rx rejected, %s ground dropped in %s bound-reaching ticks; plant timeouts %s\n",
+      static_cast<unsigned long long>(f.sent), f.fsw.at("ticks").c_str(),
+      f.fsw.at("frames").c_str(), f.fsw.at("frameless").c_str(), f.fsw.at("rx_rejected").c_str(),
+      f.fsw.at("ground_dropped").c_str(), f.fsw.at("ground_bound_ticks").c_str(),
+      f.plant.at("timeouts").c_str());
+  EXPECT_GT(f.sent, 1000u) << "no flood";
+  EXPECT_EQ(f.plant.at("holds"), "0");
+  EXPECT_EQ(f.fsw.at("ticks"), f.plant.at("periods"));  // one tick per frame, no other tick
+  EXPECT_EQ(f.fsw.at("frameless"), "0");
+  // The garbage was seen: decoded and rejected within the bound, the rest dropped undecoded.
+  EXPECT_GT(std::stoull(f.fsw.at("rx_rejected")) + std::stoull(f.fsw.at("ground_dropped")), 0u);
+  EXPECT_LE(std::stoull(f.fsw.at("rx_rejected")),
+            4 * (std::stoull(f.fsw.at("ticks")) + 1000));  // the bound, plus idle base periods
+  campaign::FswFlightSide side;
+  const campaign::RunResult r = run_in_process(fc, side);
+  ASSERT_EQ(r.status, campaign::RunStatus::kOk) << r.note;
+  expect_same_figures(f.plant, r);
+}
+
+TEST(PilBusFlood, AGroundFloodOnTheOneBusStarvesNoTickAndChangesNothing) {
+  FastCase fc;
+  expect_flood_survived(run_flooded_pil("flood_one_bus", 7845, false, &fc), fc);
+}
+
+TEST(PilBusFlood, AGroundFloodOnASeparateGroundBusStarvesNoTickAndChangesNothing) {
+  FastCase fc;
+  expect_flood_survived(run_flooded_pil("flood_ground_bus", 7847, true, &fc), fc);
 }
 
 // ---------------------------------------------------------------------------------------------
