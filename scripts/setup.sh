@@ -13,6 +13,8 @@ packages=(
   gnuplot-nox
   iproute2 util-linux
   clang libclang-rt-14-dev
+  nlohmann-json3-dev
+  slurm-wlm munge
 )
 cross=0
 if [[ "${1:-}" == "--cross" ]]; then
