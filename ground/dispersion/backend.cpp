@@ -153,6 +153,7 @@ LocalStats run_local(const Inputs& in, const std::string& dir, const std::vector
     const long n = sysconf(_SC_NPROCESSORS_ONLN);
     jobs = n > 0 ? static_cast<int>(n) : 1;
   }
+  st.jobs = jobs;
   const auto t0 = Clock::now();
   std::map<pid_t, int> running;
   std::size_t next = 0;
@@ -171,7 +172,11 @@ LocalStats run_local(const Inputs& in, const std::string& dir, const std::vector
       ++st.crashed;
     }
     if (auto r = read_draw(dir, index)) {
-      for (const StrategyOutcome& o : r->runs) st.simulated_s += o.sim_s;
+      for (const StrategyOutcome& o : r->runs) {
+        st.simulated_s += o.sim_s;
+        st.closed_loop_s += o.wall_s;
+      }
+      st.plan_s += r->plan_wall_s;
     }
     log << "[dispersion] " << done << "/" << draws.size() << " draws\n" << std::flush;
   };

@@ -35,6 +35,9 @@ struct LocalStats {
   int crashed{0};
   double wall_s{0.0};
   double simulated_s{0.0};
+  double closed_loop_s{0.0};  // summed over the workers: the closed loops alone
+  double plan_s{0.0};         // summed over the workers: planning
+  int jobs{1};
 };
 LocalStats run_local(const Inputs& in, const std::string& dir, const std::vector<int>& draws,
                      int jobs, std::ostream& log);

@@ -146,7 +146,10 @@ int run(const CliState& s, const std::string& mission_file, const std::string& g
         std::cerr << "[dispersion] ran " << st.ran << " draws in " << st.wall_s
                   << " s wall: " << st.simulated_s << " simulated s, "
                   << (st.wall_s > 0 ? st.simulated_s / st.wall_s : 0.0)
-                  << " simulated s per wall s (planning included)"
+                  << " simulated s per wall s (planning included); closed loops alone "
+                  << (st.closed_loop_s > 0 ? st.simulated_s / st.closed_loop_s * st.jobs : 0.0)
+                  << " simulated s per wall s on " << st.jobs << " workers; planning " << st.plan_s
+                  << " worker-s"
                   << (st.crashed > 0 ? ", " + std::to_string(st.crashed) + " crashed" : "") << "\n";
       }
     }
