@@ -20,6 +20,11 @@ void add_commands(CLI::App& app, CliState& s) {
       "shared per draw. Writes <out>/draws/NNNNNN.json (one per draw, atomically; a restart runs "
       "only the missing draws), then results.csv, summary.json, report.md and plots/. "
       "--draw N re-flies one draw bit for bit with its time series and plots.");
+  s.dispersion->footer(
+      "Mission and GNC files: --config-dir, --mission, --gnc (as for `campaign`). Slurm: sbatch must "
+      "reach the cluster (SLURM_CONF); the output folder, the files and this binary must be on a "
+      "file system the nodes share. Exit status: 0 done, 1 failed or missing draws, 2 bad input. "
+      "Details: ground/dispersion/README.md.");
   s.dispersion->add_option("file", s.file, "dispersion file")->required()->check(CLI::ExistingFile);
   s.dispersion->add_option("--out,-o", s.out_dir, "output folder (default out/dispersion/<name>)");
   s.dispersion->add_option("--draw", s.draw, "re-fly this draw only, with time series and plots");

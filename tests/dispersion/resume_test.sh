@@ -36,3 +36,9 @@ expect="12 draws, $done_before already done, running $((12 - done_before))"
 grep -q "$expect" "$work/run2.log" || { echo "FAIL: expected '$expect'"; exit 1; }
 cmp "$work/ref/results.csv" "$work/run/results.csv"
 echo "resumed results identical to the uninterrupted run"
+
+# One draw re-flown alone (with its time series and plots) is the stored result bit for bit.
+"$exe" dispersion "$work/d.yaml" --config-dir "$src/configs" -o "$work/run" --draw 5 > "$work/draw5.log" 2>&1
+cat "$work/draw5.log"
+grep -q "identical (bit for bit)" "$work/draw5.log"
+[ -s "$work/run/draw-5/dpd/timeseries.csv" ]
