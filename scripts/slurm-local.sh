@@ -65,7 +65,7 @@ case "$cmd" in
     cat > "$conf" <<CONF
 # One-node Slurm written by scripts/slurm-local.sh.
 ClusterName=rocksteady
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmctldPort=$port
 SlurmdPort=$((port + 1))
 SlurmUser=root
@@ -94,7 +94,7 @@ SlurmdTimeout=30
 InactiveLimit=0
 KillWait=5
 MaxArraySize=10001
-NodeName=$host CPUs=$(nproc) RealMemory=1000 State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) RealMemory=1000 State=UNKNOWN
 PartitionName=main Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
     export SLURM_CONF="$conf"

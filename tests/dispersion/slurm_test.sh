@@ -9,6 +9,7 @@ if [ "$(id -u)" -ne 0 ]; then
   echo "SKIP: a local Slurm needs root (munged, slurmd)"
   exit 77
 fi
+"$src/scripts/slurm-local.sh" stop "$work/slurm-state" > /dev/null 2>&1 || true
 rm -rf "$work"
 mkdir -p "$work"
 state="$work/slurm-state"
