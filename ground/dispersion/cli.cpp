@@ -21,7 +21,8 @@ void add_commands(CLI::App& app, CliState& s) {
       "only the missing draws), then results.csv, summary.json, report.md and plots/. "
       "--draw N re-flies one draw bit for bit with its time series and plots.");
   s.dispersion->footer(
-      "Mission and GNC files: --config-dir, --mission, --gnc (as for `campaign`). Slurm: sbatch must "
+      "Mission and GNC files: --config-dir, --mission, --gnc (as for `campaign`). Slurm: sbatch "
+      "must "
       "reach the cluster (SLURM_CONF); the output folder, the files and this binary must be on a "
       "file system the nodes share. Exit status: 0 done, 1 failed or missing draws, 2 bad input. "
       "Details: ground/dispersion/README.md.");

@@ -102,6 +102,7 @@ Readback read_back(const plant::Plant& plant, const gnc::GncParams& flown) {
   b.noise_seed = t.seed;
   b.u_max_true_n = t.rcs.u_max;
   b.u_max_flight_n = flown.rcs.u_max;
+  b.allocator = flown.allocator == gnc::AllocatorKind::kL1 ? "l1" : "pinv";
   return b;
 }
 
@@ -128,6 +129,7 @@ config::RunSetup make_setup(const config::MissionConfig& mission, const config::
   s.flight.mass_hat.j_ast = mission.mass.j_ast - d.delta_j;
   s.flight.mass_hat.r_so_bcm = mission.mass.r_so_bcm - d.delta_r;
   s.mass_hat = s.flight.mass_hat;
+  if (spec.override_allocator) s.flight.allocator = spec.allocator;
   const gnc::ParamCheck check = gnc::validate(s.flight);
   if (!check.ok) throw config::ConfigError(c.file, check.field, check.reason);
   return s;
@@ -258,7 +260,8 @@ json to_json(const DrawResult& r, bool with_timing) {
              {"disturbance_sigma_nm", b.disturbance_sigma_nm},
              {"noise_seed", b.noise_seed},
              {"u_max_true_n", b.u_max_true_n},
-             {"u_max_flight_n", b.u_max_flight_n}};
+             {"u_max_flight_n", b.u_max_flight_n},
+             {"allocator", b.allocator}};
   }
   json runs = json::array();
   json run_wall = json::object();
@@ -337,6 +340,7 @@ DrawResult draw_from_json(const json& top) {
     b.noise_seed = f.at("noise_seed").get<std::uint64_t>();
     b.u_max_true_n = f.at("u_max_true_n").get<double>();
     b.u_max_flight_n = f.at("u_max_flight_n").get<double>();
+    b.allocator = f.value("allocator", "");
     r.flown = b;
   }
   r.eps_trans_rad_s = j.at("eps_trans_rad_s").get<double>();

@@ -31,6 +31,7 @@ struct Readback {
   std::uint64_t noise_seed{0};
   double u_max_true_n{0.0};
   double u_max_flight_n{0.0};
+  std::string allocator;  // the flight software's: pinv or l1
 };
 Readback read_back(const plant::Plant& plant, const gnc::GncParams& flown);
 

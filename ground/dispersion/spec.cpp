@@ -261,6 +261,18 @@ DispersionSpec load_spec(const std::string& path) {
     s.strategies.push_back(*st);
   }
 
+  if (doc.has("allocator")) {
+    const std::string a = doc.text("allocator");
+    s.override_allocator = true;
+    if (a == "pinv") {
+      s.allocator = gnc::AllocatorKind::kPseudoInverse;
+    } else if (a == "l1") {
+      s.allocator = gnc::AllocatorKind::kL1;
+    } else {
+      doc.fail("allocator", "expected pinv or l1, got '" + a + "'");
+    }
+  }
+
   MapReader p = doc.map("parameters");
   s.delta_j_norm = scalar(p, "delta_j_ast_norm_kg_m2", false);
   s.delta_j_direction = direction(p, "delta_j_ast_direction", false, true, false);

@@ -55,6 +55,9 @@ struct DispersionSpec {
   Sampling sampling{Sampling::kRandom};
   double duration_s{1e5};
   std::vector<campaign::Strategy> strategies;
+  // The flight allocator for every run (optional key; default: the GNC file's).
+  bool override_allocator{false};
+  gnc::AllocatorKind allocator{gnc::AllocatorKind::kPseudoInverse};
 
   Scalar delta_j_norm;  // ||dJ_ast||_2, kg m^2 (true minus estimate)
   DirectionKind delta_j_direction{DirectionKind::kMission};

@@ -54,12 +54,23 @@ TEST(DrawFlown, ReadBackFromThePlantAndTheFlightSoftwareAgreesWithTheSampler) {
     EXPECT_EQ(b.noise_seed, d.noise_seed);
     EXPECT_EQ(b.u_max_true_n, d.u_max_n);
     EXPECT_EQ(b.u_max_flight_n, d.u_max_n);
+    EXPECT_EQ(b.allocator, "pinv");  // gnc.yaml's
     // The planner's refusal is a recorded "no plan" with its reason, the other strategy flew.
     ASSERT_EQ(r.runs.size(), 2u);
     EXPECT_EQ(r.runs[0].status, "ok");
     EXPECT_EQ(r.runs[1].status, "no_plan");
     EXPECT_NE(r.runs[1].note.find("test planner refuses"), std::string::npos);
   }
+}
+
+TEST(DrawFlown, AllocatorOfTheDispersionFileIsTheOneFlown) {
+  Fixture f;
+  f.spec.override_allocator = true;
+  f.spec.allocator = gnc::AllocatorKind::kL1;
+  NoPlanner planner;
+  const DrawResult r = fly_draw(f.mission, f.gnc, f.spec, Sampler(f.spec, f.mission), 0, planner);
+  ASSERT_TRUE(r.flown.has_value());
+  EXPECT_EQ(r.flown->allocator, "l1");
 }
 
 TEST(DrawFlown, ReflownDrawIsBitForBitAndJsonRoundTripsExactly) {

@@ -23,6 +23,8 @@ TEST(DispersionFiles, ShippedFilesLoad) {
   EXPECT_EQ(b.delta_j_norm.min, 1e3);
   EXPECT_EQ(b.delta_j_norm.max, 1e7);
   EXPECT_EQ(b.dimensions().size(), 1u);
+  EXPECT_TRUE(b.override_allocator);
+  EXPECT_EQ(b.allocator, gnc::AllocatorKind::kL1);
 }
 
 struct Bad {
@@ -69,6 +71,8 @@ TEST(DispersionFiles, EachMalformedClassNamesFileKeyAndReason) {
        "parameters.u_max_n: must be positive"},
       {"bad seed", "noise_seed: per_draw", "noise_seed: sometimes", "parameters.noise_seed"},
       {"bad name", "name: t", "name: a b", "name: must be a non-empty word"},
+      {"bad allocator", "sampling: random", "sampling: random\nallocator: l2",
+       "allocator: expected pinv or l1"},
   };
   for (const Bad& b : cases) {
     const std::string text = b.to.empty() && b.what == std::string("missing key")
