@@ -15,6 +15,7 @@ packages=(
   stress-ng python3
   clang libclang-rt-14-dev
   libcpp-httplib-dev nlohmann-json3-dev chromium
+  slurm-wlm munge
 )
 cross=0
 if [[ "${1:-}" == "--cross" ]]; then

@@ -1,6 +1,8 @@
 // rocksteady-campaign: closed-loop runs of the study's cases in one process.
 //   rocksteady-campaign run --case 1 --strategy ntcl+dpd_ref
 //   rocksteady-campaign campaign [--cases 1-7] [--strategies study|all|a,b,...] [--jobs 2]
+//   rocksteady-campaign dispersion configs/dispersions/FILE.yaml [--draw N] [--backend local|slurm]
+//   rocksteady-campaign collect DIR
 // Exit status: 0 done (NC is a result, not a failure); 1 a run failed; 2 bad configuration or
 // command line.
 #include <cstdio>
@@ -14,6 +16,7 @@
 
 #include "ground/campaign/campaign.hpp"
 #include "config/config_error.hpp"
+#include "ground/dispersion/cli.hpp"
 
 namespace {
 
@@ -133,7 +136,12 @@ int main(int argc, char** argv) {
                     "folder of verified trajectory files reused per model and case ('' to replan)")
         ->capture_default_str();
   }
+  rocksteady::dispersion::CliState disp;
+  rocksteady::dispersion::add_commands(app, disp);
   CLI11_PARSE(app, argc, argv);
+  if (mission.empty()) mission = config_dir + "/mission.yaml";
+  if (gnc_file.empty()) gnc_file = config_dir + "/gnc.yaml";
+  if (rocksteady::dispersion::parsed(disp)) return rocksteady::dispersion::run(disp, mission, gnc_file);
 
   spec.use_flight_app = flight_arg == "app";
   if (mission.empty()) mission = config_dir + "/mission.yaml";

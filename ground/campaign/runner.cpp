@@ -46,6 +46,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   fs.start_mode = strategy.needs_trajectory() ? gnc::Mode::kTrack : gnc::Mode::kDetumble;
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;
   flight.setup(fs, ports, ports);
+  if (options.on_start) options.on_start(plant);
 
   const double dt = setup.truth.control_period_s;
   const double duration = options.duration_s >= 0.0 ? options.duration_s : setup.duration_s;

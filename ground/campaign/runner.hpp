@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,6 +69,9 @@ struct RunOptions {
   double duration_s{-1.0};       // < 0: the case's duration
   double log_interval_s{50.0};   // time-series decimation (0: no series)
   std::atomic<std::uint64_t>* progress_ticks{nullptr};  // advanced as the run proceeds
+  // Called once before the first tick with the plant as built (after the flight side's setup), so
+  // a caller can read back the models actually flown.
+  std::function<void(const plant::Plant&)> on_start;
 };
 
 // Runs one case with one strategy. `trajectory` is required for fuel_optimal strategies; pass null

@@ -1,0 +1,96 @@
+// Statistics of a dispersion: per strategy success rate with its 95 % Wilson interval, percentiles
+// of the figures of merit, the worst draws, paired fuel differences between strategies on the same
+// draws; and the outputs (per-draw CSV, JSON summary, Markdown report, gnuplot plots).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ground/dispersion/draw.hpp"
+#include "ground/dispersion/spec.hpp"
+
+namespace rocksteady::dispersion {
+
+constexpr double kZ95 = 1.959963984540054;  // the standard normal's 97.5 % quantile
+
+// Wilson score interval for k successes in n trials (n > 0).
+std::pair<double, double> wilson_interval(int k, int n, double z = kZ95);
+// The p-quantile (p in [0, 1]) with linear interpolation between order statistics (Hyndman & Fan
+// type 7: h = (n - 1) p). `values` need not be sorted; empty gives nullopt.
+std::optional<double> percentile(std::vector<double> values, double p);
+
+struct Percentiles {
+  int n{0};
+  std::optional<double> p5, p50, p95, p99;
+};
+Percentiles percentiles(const std::vector<double>& v);
+
+struct WorstDraw {
+  int draw{0};
+  std::string why;  // status / not converged / rate bound / fuel
+  std::optional<double> fuel_kg;
+};
+
+struct StrategyStats {
+  std::string strategy;
+  int draws{0};
+  int flown{0};
+  int successes{0};
+  int no_plan{0};
+  int errors{0};  // error or crashed
+  double success_rate{0.0};
+  std::pair<double, double> wilson{0.0, 0.0};
+  Percentiles t_omega, t_q, fuel;
+  std::vector<WorstDraw> worst;  // five
+};
+
+struct PairedStats {
+  std::string a, b;
+  int n{0};                  // draws where both flew
+  double mean_diff_kg{0.0};  // fuel(a) - fuel(b)
+  Percentiles diff;
+  double frac_a_less{0.0};
+};
+
+// Where law+fuel_optimal stops beating law+dpd_ref in fuel as ||dJ|| grows (SPEC Prop. 5).
+struct Crossover {
+  std::string a, b;
+  std::vector<double> bin_lo, bin_hi;  // ||dJ|| bins (log-spaced)
+  std::vector<int> bin_n;
+  std::vector<double> bin_median_diff;    // fuel(a) - fuel(b), NaN when empty
+  std::optional<double> crossover_kg_m2;  // first sign change of the median, log-interpolated
+};
+
+struct Summary {
+  std::string name;
+  int draws_expected{0};
+  int draws_present{0};
+  std::vector<StrategyStats> strategies;
+  std::vector<PairedStats> paired;
+  std::vector<Crossover> crossovers;
+  double draw_wall_s_sum{0.0};
+  double simulated_s{0.0};
+  double closed_loop_wall_s_sum{0.0};
+  double plan_wall_s_sum{0.0};
+};
+
+Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& draws);
+
+struct OutputPaths {
+  std::string results_csv, summary_json, report_md;
+  std::vector<std::string> plots;
+};
+// Writes results.csv, summary.json, report.md and the plots into `dir`. `reproduce` is the command
+// prefix that re-flies one draw (the draw's index is appended).
+OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
+                          const std::vector<DrawResult>& draws, const Summary& s,
+                          const std::string& reproduce, bool plots);
+void write_results_csv(const std::string& path, const DispersionSpec& spec,
+                       const std::vector<DrawResult>& draws);
+nlohmann::json summary_json(const Summary& s, const std::string& reproduce);
+
+}  // namespace rocksteady::dispersion

@@ -1,0 +1,99 @@
+// Wilson intervals and percentiles against hand-computed values; the summary on synthetic draws.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "ground/dispersion/stats.hpp"
+
+namespace rocksteady::dispersion {
+namespace {
+
+TEST(Wilson, HandComputedValues) {
+  // 8 of 10, z = 1.959964: centre (0.8 + z^2/20) / (1 + z^2/10) = 0.99207 / 1.38415 = 0.716725;
+  // half-width z / 1.38415 * sqrt(0.016 + z^2/400) = 1.41599 * 0.15883 = 0.224904.
+  auto w = wilson_interval(8, 10);
+  EXPECT_NEAR(w.first, 0.4901625, 1e-6);
+  EXPECT_NEAR(w.second, 0.9433178, 1e-6);
+  // 0 of 10: [0, z^2 / (n + z^2)] = [0, 3.841459 / 13.841459] = [0, 0.2775328].
+  w = wilson_interval(0, 10);
+  EXPECT_NEAR(w.first, 0.0, 1e-12);
+  EXPECT_NEAR(w.second, 0.2775328, 1e-6);
+  // n of n mirrors 0 of n.
+  w = wilson_interval(10, 10);
+  EXPECT_NEAR(w.first, 1.0 - 0.2775328, 1e-6);
+  EXPECT_NEAR(w.second, 1.0, 1e-12);
+  // 50 of 100: 0.5 -+ z * sqrt(0.0025 + z^2/40000) / (1 + z^2/100) = 0.5 -+ 0.0961...
+  w = wilson_interval(50, 100);
+  EXPECT_NEAR(w.first, 0.4038315, 1e-6);
+  EXPECT_NEAR(w.second, 0.5961685, 1e-6);
+}
+
+TEST(Percentiles, LinearInterpolationBetweenOrderStatistics) {
+  // Unsorted input; sorted 1..5. h = 4 p: p5 -> 1.2, p50 -> 3, p95 -> 4.8, p99 -> 4.96.
+  const Percentiles p = percentiles({5.0, 1.0, 4.0, 2.0, 3.0});
+  EXPECT_EQ(p.n, 5);
+  EXPECT_NEAR(*p.p5, 1.2, 1e-12);
+  EXPECT_NEAR(*p.p50, 3.0, 1e-12);
+  EXPECT_NEAR(*p.p95, 4.8, 1e-12);
+  EXPECT_NEAR(*p.p99, 4.96, 1e-12);
+  EXPECT_EQ(*percentile({7.0}, 0.99), 7.0);
+  EXPECT_FALSE(percentile({}, 0.5).has_value());
+  // Two values 10, 20: p25 = 12.5.
+  EXPECT_NEAR(*percentile({20.0, 10.0}, 0.25), 12.5, 1e-12);
+}
+
+StrategyOutcome ok(const std::string& s, double fuel, bool success) {
+  StrategyOutcome o;
+  o.strategy = s;
+  o.status = "ok";
+  o.total_fuel_kg = fuel;
+  o.success = success;
+  o.t_omega_conv_s = 1000.0 + fuel;
+  if (success) o.t_q_conv_s = 2000.0 + fuel;
+  return o;
+}
+
+TEST(Summary, SuccessWorstAndPairedDifferencesOnSyntheticDraws) {
+  DispersionSpec spec;
+  spec.name = "syn";
+  spec.draws = 4;
+  spec.strategies = {*campaign::parse_strategy("ntcl+fuel_optimal"),
+                     *campaign::parse_strategy("ntcl+dpd_ref")};
+  std::vector<DrawResult> draws(4);
+  const double dj[] = {1e3, 1e4, 1e5, 1e6};
+  const double fo[] = {80.0, 90.0, 150.0, 300.0};
+  const double dpd[] = {100.0, 100.0, 110.0, 120.0};
+  for (int i = 0; i < 4; ++i) {
+    draws[static_cast<std::size_t>(i)].index = i;
+    draws[static_cast<std::size_t>(i)].sampled.delta_j_norm = dj[i];
+    draws[static_cast<std::size_t>(i)].runs = {ok("ntcl+fuel_optimal", fo[i], i != 3),
+                                               ok("ntcl+dpd_ref", dpd[i], true)};
+  }
+  draws[2].runs[0].status = "no_plan";
+  draws[2].runs[0].success = false;
+  draws[2].runs[0].total_fuel_kg.reset();
+  const Summary s = summarize(spec, draws);
+  ASSERT_EQ(s.strategies.size(), 2u);
+  EXPECT_EQ(s.strategies[0].successes, 2);
+  EXPECT_EQ(s.strategies[0].no_plan, 1);
+  EXPECT_EQ(s.strategies[1].successes, 4);
+  // Worst first: the no-plan draw, then the unsuccessful one, then by fuel.
+  ASSERT_GE(s.strategies[0].worst.size(), 3u);
+  EXPECT_EQ(s.strategies[0].worst[0].draw, 2);
+  EXPECT_EQ(s.strategies[0].worst[1].draw, 3);
+  EXPECT_EQ(s.strategies[0].worst[2].draw, 1);
+  // Paired: draws 0, 1, 3 flew both: differences -20, -10, 180.
+  ASSERT_EQ(s.paired.size(), 1u);
+  EXPECT_EQ(s.paired[0].n, 3);
+  EXPECT_NEAR(s.paired[0].mean_diff_kg, 50.0, 1e-12);
+  EXPECT_NEAR(*s.paired[0].diff.p50, -10.0, 1e-12);
+  EXPECT_NEAR(s.paired[0].frac_a_less, 2.0 / 3.0, 1e-12);
+  // Crossover between the 1e4 bin (-10) and the 1e6 bin (+180).
+  ASSERT_EQ(s.crossovers.size(), 1u);
+  ASSERT_TRUE(s.crossovers[0].crossover_kg_m2.has_value());
+  EXPECT_GT(*s.crossovers[0].crossover_kg_m2, 1e4);
+  EXPECT_LT(*s.crossovers[0].crossover_kg_m2, 1e6);
+}
+
+}  // namespace
+}  // namespace rocksteady::dispersion
