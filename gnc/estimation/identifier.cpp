@@ -169,11 +169,13 @@ void Identifier::reset() {
   p_all_.block<3, 3>(6, 6) = p_r_;
   p_all_.bottomRightCorner<kThrusters, kThrusters>() = p_k_;
   reference_.fill(true);
+  joint_ = JointStep{};
   acc_ = Window{};
   latched_ = Window{};
   sample_ = -1;
   phase_ = Phase::kIdle;
   latched_noise_ = 1.0;
+  residual_cov_ = Mat3::Identity();
   exc_ = IdentifierExcitation{};
   obs_ = IdentifierObservability{};
   counters_ = IdentifierCounters{};
@@ -192,6 +194,8 @@ void reinflate_block(Eigen::Matrix<double, N, N>& p, int first, int n, double va
 }  // namespace
 
 void Identifier::reinflate_inertia() {
+  joint_.pending = false;  // a gain from the old covariance is dropped
+  joint_.started = false;
   const double v = c_.j_prior_sigma * c_.j_prior_sigma;
   reinflate_block<6>(p_j_, 0, 6, v);
   reinflate_block<kIdParams>(p_all_, 0, 6, v);
@@ -199,6 +203,8 @@ void Identifier::reinflate_inertia() {
 }
 
 void Identifier::reinflate_offset() {
+  joint_.pending = false;  // a gain from the old covariance is dropped
+  joint_.started = false;
   const double v = c_.r_prior_sigma * c_.r_prior_sigma;
   reinflate_block<3>(p_r_, 0, 3, v);
   reinflate_block<kIdParams>(p_all_, 6, 3, v);
@@ -207,6 +213,8 @@ void Identifier::reinflate_offset() {
 
 void Identifier::reinflate_thruster(int i) {
   if (i < 0 || i >= kThrusters) return;
+  joint_.pending = false;
+  joint_.started = false;
   const double v = c_.k_prior_sigma * c_.k_prior_sigma;
   reinflate_block<kThrusters>(p_k_, i, 1, v);
   reinflate_block<kIdParams>(p_all_, 9 + i, 1, v);
@@ -228,21 +236,25 @@ void Identifier::sync_blocks() {
   p_k_ = p_all_.bottomRightCorner<kThrusters, kThrusters>();
 }
 
-void Identifier::update_joint() {
+void Identifier::joint_gain() {
   // (I13): e(x) = A_J a - sum_i k_i [(p_i + r) x e_i] ∫ w F_i dt = noise, linearised at the
   // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat)], one extended-RLS step on all 25 parameters.
+  // The gain takes two ticks (joint_gain, joint_gain_finish), the update a third (joint_apply),
+  // so no tick carries more than a third of the 25-parameter step.
+  joint_.pending = false;
+  joint_.started = false;
   const Vec3 force = net_force_impulse();
   const Mat316 phi_k = strength_regressor();
-  const Vec3 e0 = latched_.a_j * a_ - phi_k * k_;
-  const double motion = latched_.a_j.norm() * a_.norm();
   const Vec3 tau = phi_k * k_;
+  joint_.e0 = latched_.a_j * a_ - tau;
+  const double motion = latched_.a_j.norm() * a_.norm();
   exc_.inertia_motion = motion >= c_.min_torque_impulse;
   exc_.inertia_scale = tau.norm() >= c_.min_torque_impulse;
   exc_.offset = force.norm() >= c_.min_force_impulse;
-  bool any_thruster = false;
+  joint_.any_thruster = false;
   for (int i = 0; i < kThrusters; ++i) {
     exc_.thruster[i] = latched_.impulse(i) >= c_.min_thruster_impulse;
-    any_thruster = any_thruster || exc_.thruster[i];
+    joint_.any_thruster = joint_.any_thruster || exc_.thruster[i];
   }
   if (!exc_.inertia_motion && !exc_.inertia_scale) return;
   Eigen::Matrix<double, 3, kIdParams> h;
@@ -250,50 +262,50 @@ void Identifier::update_joint() {
   h.middleCols<3>(6) = skew(force);
   h.rightCols<kThrusters>() = -phi_k;
 
-  // Forgetting per group (I8): P <- D P D, D = diag(lambda_g^-1/2) on the excited groups.
-  VecId d = VecId::Ones();
-  if (exc_.inertia_scale && c_.j_forget_s > 0.0)
+  // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
+  VecId& d = joint_.d;
+  d.setOnes();
+  if (exc_.inertia_scale && c_.j_forget_s > 0.0) {
     d.head<6>().setConstant(std::exp(0.5 * c_.window_s / c_.j_forget_s));
-  if (exc_.offset && c_.r_forget_s > 0.0)
+  }
+  if (exc_.offset && c_.r_forget_s > 0.0) {
     d.segment<3>(6).setConstant(std::exp(0.5 * c_.window_s / c_.r_forget_s));
-  if (any_thruster && c_.k_forget_s > 0.0)
+  }
+  if (joint_.any_thruster && c_.k_forget_s > 0.0) {
     d.tail<kThrusters>().setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
-  const VecId a_keep_x = (VecId() << a_, r_, k_).finished();
-  const MatId p_keep = p_all_;
-  p_all_ = d.asDiagonal() * p_all_ * d.asDiagonal();
-  // No variance above its prior (no wind-up).
-  const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
-                          c_.k_prior_sigma * c_.k_prior_sigma};
-  VecId shrink = VecId::Ones();
-  for (int i = 0; i < kIdParams; ++i) {
-    const double cap = caps[i < 6 ? 0 : (i < 9 ? 1 : 2)];
-    if (p_all_(i, i) > cap) shrink(i) = std::sqrt(cap / p_all_(i, i));
   }
-  p_all_ = shrink.asDiagonal() * p_all_ * shrink.asDiagonal();
+  // P_f H' = D P D H' without forming P_f; the first rows now, the rest next tick.
+  joint_.h = h;
+  joint_.dht = d.asDiagonal() * h.transpose();
+  joint_.p_ht.topRows<kSplit>() =
+      d.head<kSplit>().asDiagonal() * (p_all_.topRows<kSplit>() * joint_.dht);
+  joint_.started = true;
+}
 
-  VecId x = a_keep_x;
-  const Eigen::Matrix<double, kIdParams, 3> p_ht = p_all_ * h.transpose();
-  const Mat3 s = latched_noise_ * Mat3::Identity() + h * p_ht;
-  const Eigen::LDLT<Mat3> ldlt(s);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
-    p_all_ = p_keep;
-    return;
-  }
-  Eigen::Matrix<double, kIdParams, 3> k = ldlt.solve(p_ht.transpose()).transpose();
-  if (exc_.offset) {
-    p_all_.noalias() -= k * p_ht.transpose();
-  } else {
-    // Without a net force r is not estimated (I10): it stays a consider parameter, its gain is
-    // zero, P = P - K H P - (K H P)' + K S K' (valid for any gain).
-    k.middleRows<3>(6).setZero();
-    const Eigen::Matrix<double, kIdParams, kIdParams> khp = k * p_ht.transpose();
-    p_all_ -= khp + khp.transpose();
-    p_all_.noalias() += k * s * k.transpose();
-  }
-  x -= k * e0;
-  p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+void Identifier::joint_gain_finish() {
+  if (!joint_.started) return;
+  joint_.started = false;
+  constexpr int kRest = kIdParams - kSplit;
+  joint_.p_ht.bottomRows<kRest>() =
+      joint_.d.tail<kRest>().asDiagonal() * (p_all_.bottomRows<kRest>() * joint_.dht);
+  joint_.s = latched_noise_ * Mat3::Identity() + joint_.h * joint_.p_ht;
+  residual_cov_ = joint_.s;
+  const Eigen::LDLT<Mat3> ldlt(joint_.s);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return;
+  joint_.k = ldlt.solve(joint_.p_ht.transpose()).transpose();
+  // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
+  if (!exc_.offset) joint_.k.middleRows<3>(6).setZero();
+  joint_.pending = true;
+}
 
-  // Guards (I14): J positive definite and physical, r within bounds; else the update is refused.
+void Identifier::joint_apply() {
+  if (!joint_.pending) return;
+  joint_.pending = false;
+  VecId x;
+  x << a_, r_, k_;
+  x -= joint_.k * joint_.e0;
+  // Guards (I14): J positive definite and physical, r within bounds; else the update is refused
+  // and the covariance left as it was.
   const Mat3 j = inertia_matrix(x.head<6>());
   bool physical = j.allFinite() && Eigen::LLT<Mat3>(j).info() == Eigen::Success;
   if (physical) {
@@ -305,11 +317,31 @@ void Identifier::update_joint() {
   const bool r_ok =
       x.segment<3>(6).allFinite() && (x.segment<3>(6) - c_.r0).norm() <= c_.r_max_offset;
   if (!physical || !r_ok) {
-    p_all_ = p_keep;
     if (!physical) ++counters_.inertia_refused;
     if (!r_ok) ++counters_.offset_refused;
-    sync_blocks();
     return;
+  }
+  // P = D P D - K H P_f - (K H P_f)' + K S K' (valid for any gain; the optimal one reduces it
+  // to D P D - K H P_f).
+  p_all_ = joint_.d.asDiagonal() * p_all_ * joint_.d.asDiagonal();
+  const Eigen::Matrix<double, kIdParams, kIdParams> khp = joint_.k * joint_.p_ht.transpose();
+  if (exc_.offset) {
+    p_all_ -= khp;
+  } else {
+    p_all_ -= khp + khp.transpose();
+    p_all_.noalias() += joint_.k * joint_.s * joint_.k.transpose();
+  }
+  p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+  // No variance above its prior (no wind-up while a direction is not excited).
+  const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
+                          c_.k_prior_sigma * c_.k_prior_sigma};
+  for (int i = 0; i < kIdParams; ++i) {
+    const double cap = caps[i < 6 ? 0 : (i < 9 ? 1 : 2)];
+    if (p_all_(i, i) > cap) {
+      const double f = std::sqrt(cap / p_all_(i, i));
+      p_all_.row(i) *= f;
+      p_all_.col(i) *= f;
+    }
   }
   a_ = x.head<6>();
   r_ = x.segment<3>(6);
@@ -323,9 +355,7 @@ void Identifier::update_joint() {
   }
   ++counters_.inertia_updates;
   if (exc_.offset) ++counters_.offset_updates;
-  if (any_thruster) ++counters_.strength_updates;
-  anchor_scale();
-  sync_blocks();
+  if (joint_.any_thruster) ++counters_.strength_updates;
 }
 
 void Identifier::anchor_scale() {
@@ -415,18 +445,31 @@ void Identifier::update(const IdentifierInput& in) {
   switch (phase_) {
     case Phase::kInertia:
       if (c_.mode == IdentifierMode::kJoint) {
-        update_joint();
+        joint_gain();
       } else {
         update_inertia();
       }
+      phase_ = Phase::kGain;
+      break;
+    case Phase::kGain:
+      if (c_.mode == IdentifierMode::kJoint) joint_gain_finish();
       phase_ = Phase::kOffset;
       break;
     case Phase::kOffset:
-      if (c_.mode == IdentifierMode::kConcurrent) update_offset();
+      if (c_.mode == IdentifierMode::kJoint) {
+        joint_apply();
+      } else {
+        update_offset();
+      }
       phase_ = Phase::kStrength;
       break;
     case Phase::kStrength:
-      if (c_.mode == IdentifierMode::kConcurrent) update_strengths();
+      if (c_.mode == IdentifierMode::kJoint) {
+        anchor_scale();
+        sync_blocks();
+      } else {
+        update_strengths();
+      }
       phase_ = Phase::kReport;
       break;
     case Phase::kReport:
@@ -526,6 +569,7 @@ void Identifier::update_inertia() {
   if (exc_.inertia_scale) forget<6>(p_j_, c_.window_s, c_.j_forget_s, prior_var);
   // The other groups' uncertainty enters as measurement noise (I7).
   const Mat3 r_noise = latched_noise_ * Mat3::Identity() + consider_offset() + consider_strengths();
+  residual_cov_ = r_noise + consider_inertia();
   rls_update<6>(a_, p_j_, latched_.a_j, y, r_noise);
   // Guard: positive definite, principal moments obey the triangle inequality.
   const Mat3 j = inertia_matrix(a_);
@@ -644,9 +688,9 @@ void Identifier::report() {
   if (latched_.weight > 0.0) {
     const Vec3 res = latched_.a_j * a_ - model_torque_impulse(k_, r_);
     est_.residual_torque = res / latched_.weight;
-    const Mat3 cov = latched_noise_ * Mat3::Identity() + consider_inertia() + consider_offset() +
-                     consider_strengths();
-    est_.residual_chi2 = res.dot(cov.ldlt().solve(res));
+    // Against the window's innovation covariance before the update (joint: S; concurrent: the
+    // inertia group's noise plus its own consider term).
+    est_.residual_chi2 = res.dot(residual_cov_.ldlt().solve(res));
   }
 }
 

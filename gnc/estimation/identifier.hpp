@@ -10,8 +10,8 @@
 //   -∫ w' J omega dt + ∫ w omega x (J omega) dt = ∫ w tau dt,
 //   tau = sum_i k_i (p_i + r) x e_i F_i                       (SPEC §4, per physical thruster)
 // The per-tick work is accumulation; at a window's end the data are latched and the groups are
-// updated on the following ticks, one group per tick (J, then r, then k, then the report), so no
-// tick does more than one group's work.
+// updated on the following ticks in small steps (joint: gain in two halves, apply, scale anchor,
+// report; concurrent: J, r, k, report), so no tick does more than one step.
 //
 // Flight code: fixed-size Eigen, no heap, no exceptions, no I/O.
 #pragma once
@@ -197,7 +197,7 @@ class Identifier {
     double sum_alpha2{0.0};        // sum of the per-sample weights on L(omega), squared (I5)
     double sum_gyro2{0.0};         // sum of (w dt |omega|)^2 (I5)
   };
-  enum class Phase : std::uint8_t { kIdle, kInertia, kOffset, kStrength, kReport };
+  enum class Phase : std::uint8_t { kIdle, kInertia, kGain, kOffset, kStrength, kReport };
 
   void accumulate(const IdentifierInput& in);
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
@@ -209,9 +209,11 @@ class Identifier {
   Mat3 consider_inertia() const;      // (I7)
   Mat3 consider_offset() const;
   Mat3 consider_strengths() const;
-  void update_joint();
-  void sync_blocks();   // joint covariance -> per-group blocks
-  void anchor_scale();  // (I15)
+  void joint_gain();         // (I13) gain of the joint step, first part
+  void joint_gain_finish();  // ... second part
+  void joint_apply();        // (I13), (I14) apply it, guarded
+  void sync_blocks();        // joint covariance -> per-group blocks
+  void anchor_scale();       // (I15)
   void update_inertia();
   void update_offset();
   void update_strengths();
@@ -232,6 +234,20 @@ class Identifier {
   Mat16 p_k_{Mat16::Identity()};
   MatId p_all_{MatId::Identity()};            // kJoint: [a; r; k]
   std::array<bool, kThrusters> reference_{};  // thrusters that define the thrust scale
+  static constexpr int kSplit = 13;           // rows of P H' computed on the first gain tick
+  struct JointStep {                          // computed over two ticks, applied on the third
+    bool started{false};
+    bool pending{false};
+    Eigen::Matrix<double, 3, kIdParams> h{Eigen::Matrix<double, 3, kIdParams>::Zero()};
+    Eigen::Matrix<double, kIdParams, 3> dht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
+    bool any_thruster{false};
+    VecId d{VecId::Ones()};
+    Vec3 e0{Vec3::Zero()};
+    Mat3 s{Mat3::Identity()};
+    Eigen::Matrix<double, kIdParams, 3> p_ht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
+    Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
+  };
+  JointStep joint_{};
 
   // Window in progress and the latched one.
   Window acc_{};
@@ -240,6 +256,7 @@ class Identifier {
   Vec8 last_force_{Vec8::Zero()};
   Phase phase_{Phase::kIdle};
   double latched_noise_{1.0};
+  Mat3 residual_cov_{Mat3::Identity()};  // innovation covariance of the latched window
 
   IdentifierEstimate est_{};
   IdentifierExcitation exc_{};
