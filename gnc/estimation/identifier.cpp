@@ -130,6 +130,7 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   }
   if (!finite_non_negative(c.min_torque_impulse)) return bad("min_torque_impulse", "must be >= 0");
   if (!finite_non_negative(c.min_force_impulse)) return bad("min_force_impulse", "must be >= 0");
+  if (!finite_non_negative(c.min_snr)) return bad("min_snr", "must be >= 0");
   if (!finite_non_negative(c.min_thruster_impulse)) {
     return bad("min_thruster_impulse", "must be >= 0");
   }
@@ -247,9 +248,8 @@ void Identifier::joint_gain() {
   const Mat316 phi_k = strength_regressor();
   const Vec3 tau = phi_k * k_;
   joint_.e0 = latched_.a_j * a_ - tau;
-  const double motion = latched_.a_j.norm() * a_.norm();
-  exc_.inertia_motion = motion >= c_.min_torque_impulse;
-  exc_.inertia_scale = tau.norm() >= c_.min_torque_impulse;
+  exc_.inertia_motion = latched_.a_j.norm() * a_.norm() >= torque_threshold();
+  exc_.inertia_scale = tau.norm() >= torque_threshold();
   exc_.offset = force.norm() >= c_.min_force_impulse;
   joint_.any_thruster = false;
   for (int i = 0; i < kThrusters; ++i) {
@@ -501,6 +501,13 @@ void Identifier::update(const IdentifierInput& in) {
   }
 }
 
+double Identifier::torque_threshold() const {
+  // (I16): a window counts only when its torque impulse stands well above the window noise.
+  // Below that, in a closed loop, the commands mostly answer the disturbance and are correlated
+  // with it, which biases least squares (the classic closed-loop identification bias).
+  return std::fmax(c_.min_torque_impulse, c_.min_snr * std::sqrt(latched_noise_));
+}
+
 double Identifier::window_noise() const {
   // (I5): variance of one row of the window equation.
   const double jn = inertia_matrix(a_).norm();
@@ -559,9 +566,8 @@ Mat3 Identifier::consider_strengths() const {
 void Identifier::update_inertia() {
   // (I9): A_J a = ∫ w tau dt with the latest r_hat, k_hat.
   const Vec3 y = model_torque_impulse(k_, r_);
-  const double motion = latched_.a_j.norm() * a_.norm();
-  exc_.inertia_motion = motion >= c_.min_torque_impulse;
-  exc_.inertia_scale = y.norm() >= c_.min_torque_impulse;
+  exc_.inertia_motion = latched_.a_j.norm() * a_.norm() >= torque_threshold();
+  exc_.inertia_scale = y.norm() >= torque_threshold();
   if (!exc_.inertia_motion && !exc_.inertia_scale) return;
   const Vec6 a_keep = a_;
   const Mat6 p_keep = p_j_;

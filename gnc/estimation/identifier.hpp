@@ -83,6 +83,10 @@ struct IdentifierConfig {
   // thruster i when its impulse exceeds min_thruster_impulse (N s).
   double min_torque_impulse{50.0};
   double min_force_impulse{20.0};
+  // ... and the torque impulse (commanded, or inertial for the ratios) must also exceed min_snr
+  // times the window's noise sigma (I16): in a closed loop, windows where the commands only
+  // answer the disturbance bias the estimate.
+  double min_snr{10.0};
   double min_thruster_impulse{5.0};
   // Guards: a J update that leaves J not positive definite or violating the triangle inequality
   // of the principal moments is refused; r must stay within r_max_offset of r0 (else refused);
@@ -203,6 +207,7 @@ class Identifier {
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
   double sample_weight(int i) const;  // w(t_i)
   double window_noise() const;        // row variance of the latched window (I5)
+  double torque_threshold() const;    // (I16)
   Vec3 model_torque_impulse(const Vec16& k, const Vec3& r) const;  // ∫ w tau dt (I6)
   Vec3 net_force_impulse() const;     // sum k_i e_i ∫ w F_i dt with k_hat
   Mat316 strength_regressor() const;  // (I11) with r_hat
