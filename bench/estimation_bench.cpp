@@ -37,9 +37,10 @@ void BM_MekfUpdate(benchmark::State& state) {
 BENCHMARK(BM_MekfUpdate);
 
 // The identifier's tick: phase 0 = every tick in turn (the average over a 20-tick window cycle);
-// phase n > 0 = the n-th tick after a window closes (joint: 1, 2 gain halves, 3 apply, 4 scale
-// anchor, 5 report; concurrent: 1 J group, 3 r group, 4 k group), timed on a copy of the identifier
-// taken just before that tick (the copy is timed too: see BM_IdentifierCopy, subtract it).
+// phase n > 0 = the n-th tick after a window closes (joint: 1, 2 gain halves, 3, 4 apply halves,
+// 5 scale anchor, 6 report; concurrent: 1 J group, 3 r group, 5 k group), timed on a copy of the
+// identifier taken just before that tick (the copy is timed too: see BM_IdentifierCopy, subtract
+// it).
 struct IdentifierRig {
   explicit IdentifierRig(IdentifierMode mode) {
     IdentifierConfig c;
@@ -81,7 +82,7 @@ struct IdentifierRig {
 
 void BM_IdentifierTick(benchmark::State& state, IdentifierMode mode, int phase) {
   IdentifierRig rig(mode);
-  for (int w = 0; w < 5; ++w) rig.to_phase(6);  // a few windows in
+  for (int w = 0; w < 5; ++w) rig.to_phase(8);  // a few windows in
   if (phase == 0) {
     for (auto _ : state) {
       rig.next();
@@ -102,13 +103,14 @@ BENCHMARK_CAPTURE(BM_IdentifierTick, joint_average, IdentifierMode::kJoint, 0);
 BENCHMARK_CAPTURE(BM_IdentifierTick, joint_gain_tick, IdentifierMode::kJoint, 1);
 BENCHMARK_CAPTURE(BM_IdentifierTick, joint_gain_finish_tick, IdentifierMode::kJoint, 2);
 BENCHMARK_CAPTURE(BM_IdentifierTick, joint_apply_tick, IdentifierMode::kJoint, 3);
-BENCHMARK_CAPTURE(BM_IdentifierTick, joint_anchor_tick, IdentifierMode::kJoint, 4);
-BENCHMARK_CAPTURE(BM_IdentifierTick, joint_report_tick, IdentifierMode::kJoint, 5);
-BENCHMARK_CAPTURE(BM_IdentifierTick, joint_accumulate_tick, IdentifierMode::kJoint, 7);
+BENCHMARK_CAPTURE(BM_IdentifierTick, joint_apply_finish_tick, IdentifierMode::kJoint, 4);
+BENCHMARK_CAPTURE(BM_IdentifierTick, joint_anchor_tick, IdentifierMode::kJoint, 5);
+BENCHMARK_CAPTURE(BM_IdentifierTick, joint_report_tick, IdentifierMode::kJoint, 6);
+BENCHMARK_CAPTURE(BM_IdentifierTick, joint_accumulate_tick, IdentifierMode::kJoint, 8);
 BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_average, IdentifierMode::kConcurrent, 0);
 BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_j_tick, IdentifierMode::kConcurrent, 1);
 BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_r_tick, IdentifierMode::kConcurrent, 3);
-BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_k_tick, IdentifierMode::kConcurrent, 4);
+BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_k_tick, IdentifierMode::kConcurrent, 5);
 
 void BM_IdentifierCopy(benchmark::State& state) {
   IdentifierRig rig(IdentifierMode::kJoint);

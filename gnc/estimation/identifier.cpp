@@ -195,6 +195,7 @@ void reinflate_block(Eigen::Matrix<double, N, N>& p, int first, int n, double va
 }  // namespace
 
 void Identifier::reinflate_inertia() {
+  joint_finish_covariance();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.j_prior_sigma * c_.j_prior_sigma;
@@ -204,6 +205,7 @@ void Identifier::reinflate_inertia() {
 }
 
 void Identifier::reinflate_offset() {
+  joint_finish_covariance();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.r_prior_sigma * c_.r_prior_sigma;
@@ -214,6 +216,7 @@ void Identifier::reinflate_offset() {
 
 void Identifier::reinflate_thruster(int i) {
   if (i < 0 || i >= kThrusters) return;
+  joint_finish_covariance();
   joint_.pending = false;
   joint_.started = false;
   const double v = c_.k_prior_sigma * c_.k_prior_sigma;
@@ -321,28 +324,9 @@ void Identifier::joint_apply() {
     if (!r_ok) ++counters_.offset_refused;
     return;
   }
-  // P = D P D - K H P_f - (K H P_f)' + K S K' (valid for any gain; the optimal one reduces it
-  // to D P D - K H P_f).
-  p_all_ = joint_.d.asDiagonal() * p_all_ * joint_.d.asDiagonal();
-  const Eigen::Matrix<double, kIdParams, kIdParams> khp = joint_.k * joint_.p_ht.transpose();
-  if (exc_.offset) {
-    p_all_ -= khp;
-  } else {
-    p_all_ -= khp + khp.transpose();
-    p_all_.noalias() += joint_.k * joint_.s * joint_.k.transpose();
-  }
-  p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
-  // No variance above its prior (no wind-up while a direction is not excited).
-  const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
-                          c_.k_prior_sigma * c_.k_prior_sigma};
-  for (int i = 0; i < kIdParams; ++i) {
-    const double cap = caps[i < 6 ? 0 : (i < 9 ? 1 : 2)];
-    if (p_all_(i, i) > cap) {
-      const double f = std::sqrt(cap / p_all_(i, i));
-      p_all_.row(i) *= f;
-      p_all_.col(i) *= f;
-    }
-  }
+  // The covariance is updated row block by row block: the first rows now, the rest next tick.
+  joint_covariance_rows(0, kSplit);
+  joint_.rows_pending = true;
   a_ = x.head<6>();
   r_ = x.segment<3>(6);
   k_ = x.tail<kThrusters>();
@@ -356,6 +340,39 @@ void Identifier::joint_apply() {
   ++counters_.inertia_updates;
   if (exc_.offset) ++counters_.offset_updates;
   if (joint_.any_thruster) ++counters_.strength_updates;
+}
+
+void Identifier::joint_covariance_rows(int first, int n) {
+  // P = D P D - K H P_f - (K H P_f)' + K S K' (valid for any gain; with the optimal gain it is
+  // D P D - K H P_f). Row i needs only row i of P, so the rows can be done in blocks.
+  const VecId& d = joint_.d;
+  for (int i = first; i < first + n; ++i) {
+    Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
+    row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
+    if (!exc_.offset) {
+      row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
+      row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();
+    }
+    p_all_.row(i) = row;
+  }
+}
+
+void Identifier::joint_finish_covariance() {
+  if (!joint_.rows_pending) return;
+  joint_.rows_pending = false;
+  joint_covariance_rows(kSplit, kIdParams - kSplit);
+  p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+  // No variance above its prior (no wind-up while a direction is not excited).
+  const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
+                          c_.k_prior_sigma * c_.k_prior_sigma};
+  for (int i = 0; i < kIdParams; ++i) {
+    const double cap = caps[i < 6 ? 0 : (i < 9 ? 1 : 2)];
+    if (p_all_(i, i) > cap) {
+      const double f = std::sqrt(cap / p_all_(i, i));
+      p_all_.row(i) *= f;
+      p_all_.col(i) *= f;
+    }
+  }
 }
 
 void Identifier::anchor_scale() {
@@ -461,6 +478,10 @@ void Identifier::update(const IdentifierInput& in) {
       } else {
         update_offset();
       }
+      phase_ = Phase::kApply;
+      break;
+    case Phase::kApply:
+      if (c_.mode == IdentifierMode::kJoint) joint_finish_covariance();
       phase_ = Phase::kStrength;
       break;
     case Phase::kStrength:

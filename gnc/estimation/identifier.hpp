@@ -10,8 +10,8 @@
 //   -∫ w' J omega dt + ∫ w omega x (J omega) dt = ∫ w tau dt,
 //   tau = sum_i k_i (p_i + r) x e_i F_i                       (SPEC §4, per physical thruster)
 // The per-tick work is accumulation; at a window's end the data are latched and the groups are
-// updated on the following ticks in small steps (joint: gain in two halves, apply, scale anchor,
-// report; concurrent: J, r, k, report), so no tick does more than one step.
+// updated on the following ticks in small steps (joint: gain in two halves, apply in two halves,
+// scale anchor, report; concurrent: J, r, k, report), so no tick does more than one step.
 //
 // Flight code: fixed-size Eigen, no heap, no exceptions, no I/O.
 #pragma once
@@ -201,7 +201,7 @@ class Identifier {
     double sum_alpha2{0.0};        // sum of the per-sample weights on L(omega), squared (I5)
     double sum_gyro2{0.0};         // sum of (w dt |omega|)^2 (I5)
   };
-  enum class Phase : std::uint8_t { kIdle, kInertia, kGain, kOffset, kStrength, kReport };
+  enum class Phase : std::uint8_t { kIdle, kInertia, kGain, kOffset, kApply, kStrength, kReport };
 
   void accumulate(const IdentifierInput& in);
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
@@ -216,9 +216,12 @@ class Identifier {
   Mat3 consider_strengths() const;
   void joint_gain();         // (I13) gain of the joint step, first part
   void joint_gain_finish();  // ... second part
-  void joint_apply();        // (I13), (I14) apply it, guarded
-  void sync_blocks();        // joint covariance -> per-group blocks
-  void anchor_scale();       // (I15)
+  void joint_apply();
+  void joint_covariance_rows(int first, int n);  // rows [first, first + n) of the P update
+  void joint_finish_covariance();  // the remaining rows, symmetrise, cap        // (I13), (I14)
+                                   // apply it, guarded
+  void sync_blocks();              // joint covariance -> per-group blocks
+  void anchor_scale();             // (I15)
   void update_inertia();
   void update_offset();
   void update_strengths();
@@ -243,6 +246,7 @@ class Identifier {
   struct JointStep {                          // computed over two ticks, applied on the third
     bool started{false};
     bool pending{false};
+    bool rows_pending{false};  // the covariance's last rows are still to be updated
     Eigen::Matrix<double, 3, kIdParams> h{Eigen::Matrix<double, 3, kIdParams>::Zero()};
     Eigen::Matrix<double, kIdParams, 3> dht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
     bool any_thruster{false};
