@@ -6,8 +6,8 @@
 #include <sstream>
 #include <string>
 
-#include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
 
 #include "ground/config/config.hpp"
 
@@ -19,9 +19,7 @@ namespace fs = std::filesystem;
 const std::string kConfigs = std::string(ROCKSTEADY_SOURCE_DIR) + "/configs";
 const std::string kMission = kConfigs + "/mission.yaml";
 const std::string kGnc = kConfigs + "/gnc.yaml";
-std::string case_file(int n) {
-  return kConfigs + "/cases/case" + std::to_string(n) + ".yaml";
-}
+std::string case_file(int n) { return kConfigs + "/cases/case" + std::to_string(n) + ".yaml"; }
 
 std::string read(const std::string& path) {
   std::ifstream in(path);
@@ -34,10 +32,9 @@ std::string read(const std::string& path) {
 class TempFile {
  public:
   TempFile(const std::string& name, const std::string& text) {
-    dir_ =
-        fs::temp_directory_path() /
-        ("rocksteady_config_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-         "_" + std::to_string(counter_++));
+    dir_ = fs::temp_directory_path() /
+           ("rocksteady_config_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+            "_" + std::to_string(counter_++));
     fs::create_directories(dir_);
     path_ = (dir_ / name).string();
     std::ofstream(path_) << text;
@@ -87,9 +84,9 @@ TEST(ConfigShipped, MissionIsTheStudysTrueSpacecraftAndAsteroid) {
   // The RCS layout matches the SPEC §4 layout built by the flight core's model.
   const gnc::RcsLayout ours = rcs_layout(m, 200.0);
   const gnc::RcsLayout study = gnc::study_rcs_layout(200.0);
-  EXPECT_LT(
-      (gnc::torque_matrix(ours, truth.r_so_bcm) - gnc::torque_matrix(study, truth.r_so_bcm)).norm(),
-      1e-12);
+  EXPECT_LT((gnc::torque_matrix(ours, truth.r_so_bcm) - gnc::torque_matrix(study, truth.r_so_bcm))
+                .norm(),
+            1e-12);
 }
 
 TEST(ConfigShipped, EveryCaseAssemblesWithTable3ErrorsAlongSpecDirections) {
@@ -121,8 +118,8 @@ TEST(ConfigShipped, EveryCaseAssemblesWithTable3ErrorsAlongSpecDirections) {
     EXPECT_EQ(s.truth.rcs.u_max, table_umax[i]);
     EXPECT_EQ(s.flight.rcs.u_max, table_umax[i]);
     // estimator: auto = filter exactly where the sensors are noisy (SPEC §6).
-    EXPECT_EQ(s.flight.estimator.kind,
-              table_pw[i] > 0 ? gnc::EstimatorKind::kFilter : gnc::EstimatorKind::kPassThrough);
+    EXPECT_EQ(s.flight.estimator.kind, table_pw[i] > 0 ? gnc::EstimatorKind::kFilter
+                                                       : gnc::EstimatorKind::kPassThrough);
     EXPECT_TRUE(gnc::validate(s.flight).ok);
     EXPECT_NEAR(s.flight.dt, 0.1, 1e-15);
   }
@@ -169,19 +166,17 @@ TEST(ConfigErrors, MissingKey) {
 }
 
 TEST(ConfigErrors, UnknownKey) {
-  TempFile f("mission.yaml",
-             replaced(read(kMission), "  hold_s: 10.0", "  hold_s: 10.0\n  hold_ss: 3"));
+  TempFile f("mission.yaml", replaced(read(kMission), "  hold_s: 10.0", "  hold_s: 10.0\n  hold_ss: 3"));
   expect_error([&] { load_mission(f.path()); }, f.path(), "disturbance.hold_ss", "unknown key");
   TempFile g("case.yaml", read(case_file(1)) + "u_maxx: 3\n");
   expect_error([&] { load_case(g.path()); }, g.path(), "u_maxx", "unknown key");
 }
 
 TEST(ConfigErrors, WrongShape) {
-  TempFile f("mission.yaml", replaced(read(kMission), "r_so_bcm_m: [-0.0495, -0.0004, 3.5456]",
-                                      "r_so_bcm_m: [1, 2]"));
+  TempFile f("mission.yaml",
+             replaced(read(kMission), "r_so_bcm_m: [-0.0495, -0.0004, 3.5456]", "r_so_bcm_m: [1, 2]"));
   expect_error([&] { load_mission(f.path()); }, f.path(), "asteroid.r_so_bcm_m", "list of 3");
-  TempFile g("gnc.yaml",
-             replaced(read(kGnc), "ntcl:        {K: 1.0e4,", "ntcl:        {K: [1, 2],"));
+  TempFile g("gnc.yaml", replaced(read(kGnc), "ntcl:        {K: 1.0e4,", "ntcl:        {K: [1, 2],"));
   expect_error([&] { load_gnc(g.path()); }, g.path(), "laws.ntcl.K", "3x3 matrix");
   TempFile h("case.yaml", replaced(read(case_file(1)), "u_max_n: 200", "u_max_n: lots"));
   expect_error([&] { load_case(h.path()); }, h.path(), "u_max_n", "expected a number");
@@ -193,8 +188,8 @@ TEST(ConfigErrors, NonPositiveDefiniteInertia) {
   TempFile f("mission.yaml", replaced(read(kMission), "- [ 0.8658e7,", "- [ -0.8658e7,"));
   expect_error([&] { load_mission(f.path()); }, f.path(), "asteroid.inertia_kg_m2",
                "not positive definite");
-  TempFile g("mission.yaml",
-             replaced(read(kMission), "[5.584e4, 5.584e4, 1.568e4]", "[5.584e4, 0.0, 1.568e4]"));
+  TempFile g("mission.yaml", replaced(read(kMission), "[5.584e4, 5.584e4, 1.568e4]",
+                                      "[5.584e4, 0.0, 1.568e4]"));
   expect_error([&] { load_mission(g.path()); }, g.path(), "spacecraft.inertia_kg_m2",
                "not positive definite");
   // An error so large that the flight software's estimate J_ast - dJ is not positive definite.
@@ -208,8 +203,8 @@ TEST(ConfigErrors, NegativeNoisePower) {
   TempFile f("case.yaml", replaced(read(case_file(6)), "gyro_noise_psd_rad2_s2: 1.0e-10",
                                    "gyro_noise_psd_rad2_s2: -1.0e-10"));
   expect_error([&] { load_case(f.path()); }, f.path(), "gyro_noise_psd_rad2_s2", "negative");
-  TempFile g("case.yaml",
-             replaced(read(case_file(6)), "star_noise_psd: 1.0e-6", "star_noise_psd: -1.0e-6"));
+  TempFile g("case.yaml", replaced(read(case_file(6)), "star_noise_psd: 1.0e-6",
+                                   "star_noise_psd: -1.0e-6"));
   expect_error([&] { load_case(g.path()); }, g.path(), "star_noise_psd", "negative");
 }
 
@@ -218,14 +213,12 @@ TEST(ConfigErrors, BadValues) {
   expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough or filter");
   TempFile a("gnc.yaml", replaced(read(kGnc), "allocator: pinv", "allocator: simplex"));
   expect_error([&] { load_gnc(a.path()); }, a.path(), "allocator", "pinv or l1");
-  TempFile g("gnc.yaml",
-             replaced(read(kGnc), "{K_d: 1.0e4, k_p: 10.0}", "{K_d: -1.0e4, k_p: 10.0}"));
+  TempFile g("gnc.yaml", replaced(read(kGnc), "{K_d: 1.0e4, k_p: 10.0}", "{K_d: -1.0e4, k_p: 10.0}"));
   expect_error([&] { load_gnc(g.path()); }, g.path(), "laws.dpd.K_d", "not positive definite");
   TempFile h("case.yaml", replaced(read(case_file(1)), "seed: 1001", "seed: -4"));
   expect_error([&] { load_case(h.path()); }, h.path(), "seed", "non-negative integer");
   // Caught by the flight core's own validation, reported against gnc.yaml.
-  TempFile k("gnc.yaml",
-             replaced(read(kGnc), "omega_switch_rad_s: 5.0e-4", "omega_switch_rad_s: 1.0"));
+  TempFile k("gnc.yaml", replaced(read(kGnc), "omega_switch_rad_s: 5.0e-4", "omega_switch_rad_s: 1.0"));
   expect_error([&] { load_run(kMission, k.path(), case_file(1)); }, k.path(),
                "guidance.omega_switch", "below eps_trans");
 }
