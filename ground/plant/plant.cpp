@@ -159,7 +159,10 @@ void Plant::advance(const Vec8& force, bool enabled) {
     ++disturbance_index_;
   }
 
-  const Vec3 torque = thruster_torque(applied_) + disturbance_ + p_.disturbance.bias_nm;  // Eq. (2)
+  // Eq. (2): B u + d. The study's unit strengths keep the original expression, bit for bit.
+  const Vec3 torque = unit_strengths_
+                          ? Vec3(b_ * applied_ + disturbance_ + p_.disturbance.bias_nm)
+                          : Vec3(thruster_torque(applied_) + disturbance_ + p_.disturbance.bias_nm);
   const double h = p_.control_period_s / p_.substeps;
   for (int s = 0; s < p_.substeps; ++s) {
     Vec4 k1b, k2b, k3b, k4b;

@@ -10,8 +10,10 @@
 // - sensors (SPEC §5, Table 3): gyro with per-axis noise sigma = sqrt(P(dw)/T_s), star tracker with
 //   per-axis MRP noise sigma = sqrt(P(dq)/T_s) added to the true (shadow-normalised) MRP and delivered
 //   as a unit quaternion; a new sample every sensor period T_s, held in between;
-// - every random stream (gyro, star tracker, disturbance) seeded from the run's seed: a run is
-//   bit-for-bit repeatable.
+// - a gyro bias (constant + random walk on its own stream) and a strength factor per physical
+//   thruster (16), both off by default (zero, one), in which case the code path is the study's;
+// - every random stream (gyro, star tracker, disturbance, gyro bias) seeded from the run's seed: a
+//   run is bit-for-bit repeatable.
 #pragma once
 
 #include <cstdint>
