@@ -20,9 +20,7 @@ void StateFilter::predict(Vec3& q, Vec3& omega, const Vec3& torque) const {
   // Eq. (2) with J_hat, no disturbance; Eq. (4) kinematics; RK4 with predict_substeps steps.
   const int n = p_.predict_substeps > 0 ? p_.predict_substeps : 1;
   const double h = dt_ / n;
-  auto w_dot = [&](const Vec3& w) -> Vec3 {
-    return j_hat_inv_ * ((j_hat_ * w).cross(w) + torque);
-  };
+  auto w_dot = [&](const Vec3& w) -> Vec3 { return j_hat_inv_ * ((j_hat_ * w).cross(w) + torque); };
   for (int i = 0; i < n; ++i) {
     const Vec3 k1w = w_dot(omega);
     const Vec3 k1q = mrp::rate(q, omega);

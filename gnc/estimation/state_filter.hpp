@@ -1,6 +1,6 @@
 // The study's state filter (SPEC §6): predict through the model (J_hat, MRP kinematics, last
-// commanded torque), then add K times the innovation, K = 1 - exp(-omega_c T_s). With perfect sensors
-// the estimate is the measurement (pass-through).
+// commanded torque), then add K times the innovation, K = 1 - exp(-omega_c T_s). With perfect
+// sensors the estimate is the measurement (pass-through).
 #pragma once
 
 #include <cstdint>
@@ -41,7 +41,8 @@ class StateFilter {
   const Vec3& q() const { return q_; }
   double gain() const { return gain_; }
 
-  // Model propagation used by the prediction (RK4 of Eq. 2 with J_hat and Eq. 4), exposed for tests.
+  // Model propagation used by the prediction (RK4 of Eq. 2 with J_hat and Eq. 4), exposed for
+  // tests.
   void predict(Vec3& q, Vec3& omega, const Vec3& torque) const;
 
  private:

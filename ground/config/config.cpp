@@ -57,4 +57,27 @@ RunSetup load_run(const std::string& mission_path, const std::string& gnc_path,
   return assemble(m, g, c);
 }
 
+void apply_plant_truth(const YAML::Node& node, const std::string& file, plant::PlantParams& truth) {
+  MapReader r(node, file, "plant_truth");
+  plant::PlantParams t = truth;
+  if (r.has("gyro_bias_rad_s")) t.sensors.gyro_bias = r.vec3("gyro_bias_rad_s");
+  if (r.has("gyro_bias_random_walk")) {
+    t.sensors.gyro_bias_rw = r.non_negative("gyro_bias_random_walk");
+  }
+  if (r.has("thruster_strength")) {
+    const Eigen::VectorXd k = r.list("thruster_strength", 16);
+    for (int i = 0; i < 16; ++i) {
+      if (!(k(i) >= 0.0)) r.fail("thruster_strength", "every factor must be >= 0");
+      t.thruster_strength(i) = k(i);
+    }
+  }
+  r.finish();
+  try {
+    plant::validate(t);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(file, "plant_truth", e.what());
+  }
+  truth = t;
+}
+
 }  // namespace rocksteady::config

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "config/config_files.hpp"
+#include "config/yaml_reader.hpp"
 #include "ground/plant/plant.hpp"
 
 namespace rocksteady::config {
@@ -27,5 +28,15 @@ struct RunSetup {
 RunSetup assemble(const MissionConfig& mission, const GncConfig& gnc, const CaseConfig& c);
 RunSetup load_run(const std::string& mission_path, const std::string& gnc_path,
                   const std::string& case_path);
+
+// Optional plant truth beyond the study's cases, a `plant_truth` mapping (every key optional;
+// absent keys keep the study's truth: no gyro bias, every thruster at strength 1):
+//   plant_truth:
+//     gyro_bias_rad_s: [bx, by, bz]        # initial gyro bias, rad/s
+//     gyro_bias_random_walk: 1.0e-9        # rad/s^(3/2)
+//     thruster_strength: [k0, ..., k15]    # thruster 2c = channel c's "+", 2c+1 its "-"
+// `node` is that mapping, `file` names it in errors (ConfigError: file, plant_truth.<key>,
+// reason). The result is validated with the plant's own checks.
+void apply_plant_truth(const YAML::Node& node, const std::string& file, plant::PlantParams& truth);
 
 }  // namespace rocksteady::config

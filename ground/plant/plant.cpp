@@ -14,6 +14,7 @@ namespace {
 constexpr std::uint64_t kGyroStream = 1;
 constexpr std::uint64_t kStarStream = 2;
 constexpr std::uint64_t kDisturbanceStream = 3;
+constexpr std::uint64_t kGyroBiasStream = 4;
 
 [[noreturn]] void fail(const std::string& field, const std::string& reason) {
   throw std::invalid_argument("plant parameter " + field + ": " + reason);
@@ -74,6 +75,15 @@ void validate(const PlantParams& p) {
   if (!std::isfinite(p.sensors.star_psd) || p.sensors.star_psd < 0.0) {
     fail("sensors.star_psd", "noise power must be >= 0");
   }
+  if (!p.sensors.gyro_bias.allFinite()) fail("sensors.gyro_bias", "non-finite value");
+  if (!std::isfinite(p.sensors.gyro_bias_rw) || p.sensors.gyro_bias_rw < 0.0) {
+    fail("sensors.gyro_bias_rw", "must be >= 0");
+  }
+  for (int i = 0; i < 16; ++i) {
+    if (!std::isfinite(p.thruster_strength(i)) || p.thruster_strength(i) < 0.0) {
+      fail("thruster_strength", "every factor must be finite and >= 0");
+    }
+  }
   if (!p.beta0.allFinite() || std::fabs(p.beta0.norm() - 1.0) > 1e-6) {
     fail("beta0", "not a unit quaternion");
   }
@@ -86,6 +96,7 @@ Plant::Plant(const PlantParams& p) : p_(p) {
   j_inv_ = j_.inverse();
   b_ = gnc::torque_matrix(p_.rcs, p_.mass.r_so_bcm);  // SPEC §4, true r_SO/BCM
   sensor_every_ = static_cast<std::uint64_t>(std::llround(p_.sensors.period_s / p_.control_period_s));
+  unit_strengths_ = (p_.thruster_strength.array() == 1.0).all();
   reset();
 }
 
@@ -105,6 +116,9 @@ void Plant::reset() {
   gyro_rng_.seed(stream_seed(p_.seed, kGyroStream));
   star_rng_.seed(stream_seed(p_.seed, kStarStream));
   dist_rng_.seed(stream_seed(p_.seed, kDisturbanceStream));
+  bias_rng_.seed(stream_seed(p_.seed, kGyroBiasStream));
+  bias_normal_.reset();
+  gyro_bias_ = p_.sensors.gyro_bias;
   gyro_normal_.reset();
   star_normal_.reset();
   dist_normal_.reset();
@@ -139,12 +153,24 @@ void Plant::advance(const Vec8& force, bool enabled) {
     ++disturbance_index_;
   }
 
-  const Vec3 torque = b_ * applied_ + disturbance_ + p_.disturbance.bias_nm;  // Eq. (2): B u + d
+  // Eq. (2): B u + d. The study's unit strengths keep the original expression, bit for bit.
+  const Vec3 torque = unit_strengths_
+                          ? Vec3(b_ * applied_ + disturbance_ + p_.disturbance.bias_nm)
+                          : Vec3(thruster_torque(applied_) + disturbance_ + p_.disturbance.bias_nm);
   const double h = p_.control_period_s / p_.substeps;
   for (int s = 0; s < p_.substeps; ++s) att::rk4_step(j_, j_inv_, torque, h, beta_, omega_);
   // Eq. (54): exact for forces held over the period.
   fuel_kg_ += applied_.lpNorm<1>() / (p_.isp_s * p_.g0) * p_.control_period_s;
   ++ticks_;
+}
+
+Vec3 Plant::thruster_torque(const Vec8& f) const {
+  if (unit_strengths_) return b_ * f;  // B u (the study: every thruster at its nominal strength)
+  Vec8 delivered;
+  for (int c = 0; c < gnc::kChannels; ++c) {
+    delivered(c) = f(c) * p_.thruster_strength(f(c) >= 0.0 ? 2 * c : 2 * c + 1);
+  }
+  return b_ * delivered;
 }
 
 void Plant::advance(const hal::ThrusterOutputs& thrusters) {
@@ -187,6 +213,11 @@ hal::RawSensors Plant::read_sensors() {
   hal::GyroReading& g = frame.gyro;
   g.t = frame.t;
   g.rate = omega_;
+  if (p_.sensors.gyro_bias_rw > 0.0 && sample_tick_ > 0) {
+    const double step = p_.sensors.gyro_bias_rw * std::sqrt(ts);
+    for (int a = 0; a < 3; ++a) gyro_bias_(a) += step * bias_normal_(bias_rng_);
+  }
+  if (p_.sensors.gyro_bias_rw > 0.0 || !p_.sensors.gyro_bias.isZero(0.0)) g.rate += gyro_bias_;
   if (sigma_w > 0.0) {
     for (int a = 0; a < 3; ++a) g.rate(a) += sigma_w * gyro_normal_(gyro_rng_);
   }

@@ -10,8 +10,10 @@
 // - sensors (SPEC §5, Table 3): gyro with per-axis noise sigma = sqrt(P(dw)/T_s), star tracker with
 //   per-axis MRP noise sigma = sqrt(P(dq)/T_s) added to the true (shadow-normalised) MRP and delivered
 //   as a unit quaternion; a new sample every sensor period T_s, held in between;
-// - every random stream (gyro, star tracker, disturbance) seeded from the run's seed: a run is
-//   bit-for-bit repeatable.
+// - a gyro bias (constant + random walk on its own stream) and a strength factor per physical
+//   thruster (16), both off by default (zero, one), in which case the code path is the study's;
+// - every random stream (gyro, star tracker, disturbance, gyro bias) seeded from the run's seed: a
+//   run is bit-for-bit repeatable.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +39,14 @@ struct SensorParams {
   double period_s{0.1};    // T_s; an integer multiple of the control period
   double gyro_psd{0.0};    // P(dw), rad^2/s^2 (per axis)
   double star_psd{0.0};    // P(dq), MRP^2 (per axis)
+  // Gyro bias (Farrenkopf's model): b(0) = gyro_bias, b advancing by a random walk of
+  // gyro_bias_rw rad/s^(3/2) (a draw per sensor sample from its own stream). Zero in the study.
+  Vec3 gyro_bias{Vec3::Zero()};  // rad/s
+  double gyro_bias_rw{0.0};
 };
+
+// Sixteen physical thrusters: thruster 2c is channel c's "+" thruster, 2c+1 its "-" (SPEC §4).
+using Vec16 = Eigen::Matrix<double, 16, 1>;
 
 struct PlantParams {
   gnc::MassProperties mass{gnc::study_true_mass_properties()};  // true mass properties
@@ -48,6 +57,9 @@ struct PlantParams {
   int substeps{1};               // RK4 steps per control period
   DisturbanceParams disturbance{};
   SensorParams sensors{};
+  // True strength factor of each physical thruster: the force it delivers is k_i times the
+  // commanded one (1 in the study; fuel is counted on the commanded force).
+  Vec16 thruster_strength{Vec16::Ones()};
   Vec4 beta0{0.0, 0.0, 0.0, 1.0};  // initial attitude, unit quaternion of F_B in F_I
   Vec3 omega0{Vec3::Zero()};        // initial body rate, rad/s
   std::uint64_t seed{1};
@@ -89,6 +101,10 @@ class Plant {
   std::uint64_t clipped_periods() const { return clipped_periods_; }
   const Vec3& disturbance() const { return disturbance_; }  // random part held last period
   const Mat3& inertia() const { return j_; }
+  const Vec3& gyro_bias() const { return gyro_bias_; }  // true bias of the current sample
+  // The body torque the thrusters deliver for channel forces f (after clipping), with the true
+  // strength factors.
+  Vec3 thruster_torque(const Vec8& f) const;
   const Mat38& torque_matrix() const { return b_; }
   Vec3 angular_momentum_inertial() const { return att::quat_to_matrix(beta_) * (j_ * omega_); }
   double kinetic_energy() const { return 0.5 * omega_.dot(j_ * omega_); }
@@ -121,6 +137,10 @@ class Plant {
   std::mt19937_64 gyro_rng_;
   std::mt19937_64 star_rng_;
   std::mt19937_64 dist_rng_;
+  std::mt19937_64 bias_rng_;
+  std::normal_distribution<double> bias_normal_{0.0, 1.0};
+  Vec3 gyro_bias_{Vec3::Zero()};
+  bool unit_strengths_{true};
   std::normal_distribution<double> gyro_normal_{0.0, 1.0};
   std::normal_distribution<double> star_normal_{0.0, 1.0};
   std::normal_distribution<double> dist_normal_{0.0, 1.0};

@@ -223,5 +223,40 @@ TEST(ConfigErrors, BadValues) {
                "guidance.omega_switch", "below eps_trans");
 }
 
+TEST(PlantTruthExtras, AbsentKeysKeepTheStudyTruthAndGivenOnesApply) {
+  const RunSetup run = load_run(kMission, kGnc, case_file(5));
+  plant::PlantParams t = run.truth;
+  apply_plant_truth(YAML::Load("{}"), "x.yaml", t);
+  EXPECT_EQ(t.sensors.gyro_bias, Vec3::Zero());
+  EXPECT_EQ(t.sensors.gyro_bias_rw, 0.0);
+  EXPECT_EQ(t.thruster_strength, plant::Vec16::Ones());
+  apply_plant_truth(
+      YAML::Load("{gyro_bias_rad_s: [1.0e-5, -2.0e-5, 0], gyro_bias_random_walk: 1.0e-9, "
+                 "thruster_strength: [1, 1, 1, 1, 0.5, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0.9]}"),
+      "x.yaml", t);
+  EXPECT_EQ(t.sensors.gyro_bias, Vec3(1e-5, -2e-5, 0.0));
+  EXPECT_EQ(t.sensors.gyro_bias_rw, 1e-9);
+  EXPECT_EQ(t.thruster_strength(4), 0.5);
+  EXPECT_EQ(t.thruster_strength(15), 0.9);
+  EXPECT_EQ(t.thruster_strength(0), 1.0);
+}
+
+TEST(PlantTruthExtras, BadValuesNameFileAndKey) {
+  plant::PlantParams t = load_run(kMission, kGnc, case_file(1)).truth;
+  expect_error([&] { apply_plant_truth(YAML::Load("{gyro_bias_random_walk: -1}"), "x.yaml", t); },
+               "x.yaml", "plant_truth.gyro_bias_random_walk", "negative");
+  expect_error([&] { apply_plant_truth(YAML::Load("{thruster_strength: [1, 2]}"), "x.yaml", t); },
+               "x.yaml", "plant_truth.thruster_strength", "16");
+  expect_error(
+      [&] {
+        apply_plant_truth(
+            YAML::Load("{thruster_strength: [1, 1, 1, 1, -0.5, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1]}"),
+            "x.yaml", t);
+      },
+      "x.yaml", "plant_truth.thruster_strength", ">= 0");
+  expect_error([&] { apply_plant_truth(YAML::Load("{gyro_bias: [0, 0, 0]}"), "x.yaml", t); },
+               "x.yaml", "plant_truth.gyro_bias", "unknown key");
+}
+
 }  // namespace
 }  // namespace rocksteady::config

@@ -318,6 +318,60 @@ TEST(PlantThrusters, PhysicalThrustersMapOntoTheirChannels) {
   EXPECT_EQ(a.fuel_kg(), b.fuel_kg());
 }
 
+TEST(PlantSensors, GyroBiasIsAddedAndWalksWithItsOwnStream) {
+  PlantParams p = quiet_params();
+  p.sensors.gyro_bias = Vec3(1e-4, -2e-4, 5e-5);
+  Plant constant(p);
+  EXPECT_LT((constant.read_sensors().gyro.rate - constant.omega() - p.sensors.gyro_bias).norm(), 1e-16);
+  // Random walk: increments per sensor period have sigma rw sqrt(T_s) per axis.
+  p.sensors.gyro_bias_rw = 1e-6;
+  p.sensors.star_psd = 1e-8;
+  Plant walking(p);
+  PlantParams q = p;
+  q.sensors.gyro_bias_rw = 0.0;
+  q.sensors.gyro_bias.setZero();
+  Plant plain(q);
+  double sum2 = 0.0;
+  const int n = 20000;
+  Vec3 last = walking.gyro_bias();
+  for (int k = 0; k < n; ++k) {
+    const hal::RawSensors a = walking.read_sensors();
+    const hal::RawSensors b = plain.read_sensors();
+    // The other streams are untouched: the star tracker sees the same noise.
+    ASSERT_EQ(a.star.quat, b.star.quat);
+    EXPECT_LT((a.gyro.rate - walking.omega() - walking.gyro_bias()).norm(), 1e-16);
+    sum2 += (walking.gyro_bias() - last).squaredNorm();
+    last = walking.gyro_bias();
+    walking.advance(Vec8::Zero(), false);
+    plain.advance(Vec8::Zero(), false);
+  }
+  const double sigma = std::sqrt(sum2 / (3.0 * (n - 1)));
+  EXPECT_NEAR(sigma, 1e-6 * std::sqrt(0.1), 0.02 * 1e-6 * std::sqrt(0.1));
+}
+
+TEST(PlantActuators, ThrusterStrengthScalesThatThrustersForceOnly) {
+  PlantParams p = quiet_params();
+  p.omega0.setZero();
+  p.thruster_strength(4) = 0.5;   // channel 2 "+"
+  p.thruster_strength(7) = 0.25;  // channel 3 "-"
+  Plant plant(p);
+  const Vec8 u = (Vec8() << 100, 0, 50, -20, 0, 0, 180, -10).finished();
+  // Independent: the + thruster of channel 2 delivers half its force; channel 3 fires "-".
+  Vec8 delivered = u;
+  delivered(2) *= 0.5;
+  delivered(3) *= 0.25;
+  const Mat38 b = gnc::torque_matrix(p.rcs, p.mass.r_so_bcm);
+  EXPECT_LT((plant.thruster_torque(u) - b * delivered).norm(), 1e-12 * (b * delivered).norm());
+  // A "-" firing of channel 2 is not affected by the "+" thruster's factor.
+  const Vec8 minus = (Vec8() << 0, 0, -50, 0, 0, 0, 0, 0).finished();
+  EXPECT_LT((plant.thruster_torque(minus) - b * minus).norm(), 1e-12);
+  plant.advance(u, true);
+  const Vec3 expected = plant.inertia().inverse() * (b * delivered) * 0.1;
+  EXPECT_LT((plant.omega() - expected).norm(), 1e-5 * expected.norm());
+  // Fuel is counted on the commanded force.
+  EXPECT_NEAR(plant.fuel_kg(), u.cwiseAbs().sum() * 0.1 / (287.0 * 9.8), 1e-15);
+}
+
 TEST(PlantParams, RejectsBadValuesNamingTheField) {
   auto rejects = [](PlantParams p, const char* field) {
     try {
@@ -333,6 +387,15 @@ TEST(PlantParams, RejectsBadValuesNamingTheField) {
   p = quiet_params();
   p.mass.j_ast(0, 0) = -1e7;
   rejects(p, "mass.j_ast");
+  p = quiet_params();
+  p.sensors.gyro_bias_rw = -1.0;
+  rejects(p, "sensors.gyro_bias_rw");
+  p = quiet_params();
+  p.sensors.gyro_bias.x() = NAN;
+  rejects(p, "sensors.gyro_bias");
+  p = quiet_params();
+  p.thruster_strength(3) = -0.1;
+  rejects(p, "thruster_strength");
   p = quiet_params();
   p.sensors.period_s = 0.15;
   rejects(p, "sensors.period_s");

@@ -1,0 +1,724 @@
+#include "gnc/estimation/identifier.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "gnc/math/rotation.hpp"
+
+namespace rocksteady::gnc {
+
+namespace {
+
+bool finite_positive(double v) {
+  return std::isfinite(v) && v > 0.0;
+}
+bool finite_non_negative(double v) {
+  return std::isfinite(v) && v >= 0.0;
+}
+
+// Weighted recursive least squares with a vector measurement (I7): Phi theta = y + v,
+// cov(v) = R (the window noise plus what the other groups' uncertainty contributes).
+template <int N>
+void rls_update(Eigen::Matrix<double, N, 1>& theta, Eigen::Matrix<double, N, N>& p,
+                const Eigen::Matrix<double, 3, N>& phi, const Vec3& y, const Mat3& r) {
+  const Eigen::Matrix<double, N, 3> p_phi_t = p * phi.transpose();
+  const Mat3 s = r + phi * p_phi_t;
+  const Eigen::LDLT<Mat3> ldlt(s);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return;
+  const Eigen::Matrix<double, N, 3> k = ldlt.solve(p_phi_t.transpose()).transpose();
+  theta += k * (y - phi * theta);
+  p.noalias() -= k * p_phi_t.transpose();
+  p = 0.5 * (p + p.transpose()).eval();
+}
+
+// Exponential forgetting over one window (I8): P <- P / lambda, lambda = exp(-T / tau), capped so
+// no variance exceeds its prior (no covariance wind-up while a direction is not excited).
+template <int N>
+void forget(Eigen::Matrix<double, N, N>& p, double window_s, double tau_s, double prior_var) {
+  if (tau_s <= 0.0) return;
+  p *= std::exp(window_s / tau_s);
+  const double worst = p.diagonal().maxCoeff();
+  if (worst > prior_var) p *= prior_var / worst;
+}
+
+}  // namespace
+
+Vec6 inertia_params(const Mat3& j) {
+  Vec6 a;
+  a << j(0, 0), j(1, 1), j(2, 2), j(0, 1), j(0, 2), j(1, 2);
+  return a;
+}
+
+Mat3 inertia_matrix(const Vec6& a) {
+  Mat3 j;
+  j << a(0), a(3), a(4),  //
+      a(3), a(1), a(5),   //
+      a(4), a(5), a(2);
+  return j;
+}
+
+Mat36 inertia_regressor(const Vec3& v) {
+  // (I1): J v = L(v) a, a = [Jxx Jyy Jzz Jxy Jxz Jyz].
+  Mat36 l;
+  l << v.x(), 0.0, 0.0, v.y(), v.z(), 0.0,  //
+      0.0, v.y(), 0.0, v.x(), 0.0, v.z(),   //
+      0.0, 0.0, v.z(), 0.0, v.x(), v.y();
+  return l;
+}
+
+Vec3 thruster_direction(const RcsLayout& l, int i) {
+  const Vec3& d = l.channel_direction[i / 2];
+  return (i % 2 == 0) ? d : Vec3(-d);
+}
+
+Vec3 thruster_position(const RcsLayout& l, int i) {
+  return l.pod_position[l.channel_pod[i / 2]];
+}
+
+IdentifierConfigCheck validate(const IdentifierConfig& c) {
+  auto bad = [](const char* field, const char* reason) {
+    return IdentifierConfigCheck{false, field, reason};
+  };
+  if (!finite_positive(c.dt)) return bad("dt", "must be positive and finite");
+  if (!finite_positive(c.window_s)) return bad("window_s", "must be positive and finite");
+  const double ticks = c.window_s / c.dt;
+  const long n = std::lround(ticks);
+  if (std::fabs(ticks - static_cast<double>(n)) > 1e-6 || n < 8 || n % 2 != 0 || n > 1000000) {
+    return bad("window_s", "must be an even number of ticks, at least 8");
+  }
+  for (int ch = 0; ch < kChannels; ++ch) {
+    if (!c.rcs.channel_direction[ch].allFinite() ||
+        std::fabs(c.rcs.channel_direction[ch].norm() - 1.0) > 1e-6) {
+      return bad("rcs.channel_direction", "not a unit vector");
+    }
+    if (c.rcs.channel_pod[ch] < 0 || c.rcs.channel_pod[ch] >= kPods) {
+      return bad("rcs.channel_pod", "pod index out of range");
+    }
+  }
+  for (int k = 0; k < kPods; ++k) {
+    if (!c.rcs.pod_position[k].allFinite()) return bad("rcs.pod_position", "non-finite value");
+  }
+  if (!c.j0.allFinite() || (c.j0 - c.j0.transpose()).norm() > 1e-9 * (1.0 + c.j0.norm()) ||
+      Eigen::LLT<Mat3>(c.j0).info() != Eigen::Success) {
+    return bad("j0", "not symmetric positive definite");
+  }
+  if (!c.r0.allFinite()) return bad("r0", "non-finite value");
+  if (!c.k0.allFinite()) return bad("k0", "non-finite value");
+  if (!finite_positive(c.j_prior_sigma)) return bad("j_prior_sigma", "must be positive and finite");
+  if (!finite_positive(c.r_prior_sigma)) return bad("r_prior_sigma", "must be positive and finite");
+  if (!finite_positive(c.k_prior_sigma)) return bad("k_prior_sigma", "must be positive and finite");
+  if (!finite_non_negative(c.gyro_sigma)) return bad("gyro_sigma", "must be >= 0 and finite");
+  if (!finite_non_negative(c.disturbance_sigma)) {
+    return bad("disturbance_sigma", "must be >= 0 and finite");
+  }
+  if (!finite_positive(c.disturbance_corr_s)) {
+    return bad("disturbance_corr_s", "must be positive and finite");
+  }
+  if (!finite_positive(c.torque_floor)) return bad("torque_floor", "must be positive and finite");
+  if (!finite_non_negative(c.j_forget_s))
+    return bad("j_forget_s", "must be >= 0 (0: no forgetting)");
+  if (!finite_non_negative(c.r_forget_s))
+    return bad("r_forget_s", "must be >= 0 (0: no forgetting)");
+  if (!finite_non_negative(c.k_forget_s))
+    return bad("k_forget_s", "must be >= 0 (0: no forgetting)");
+  if ((c.j_forget_s > 0.0 && c.j_forget_s < c.window_s) ||
+      (c.r_forget_s > 0.0 && c.r_forget_s < c.window_s) ||
+      (c.k_forget_s > 0.0 && c.k_forget_s < c.window_s)) {
+    return bad("j_forget_s", "a forgetting time shorter than one window forgets everything");
+  }
+  if (!finite_non_negative(c.min_torque_impulse)) return bad("min_torque_impulse", "must be >= 0");
+  if (!finite_non_negative(c.min_force_impulse)) return bad("min_force_impulse", "must be >= 0");
+  if (!finite_non_negative(c.min_snr)) return bad("min_snr", "must be >= 0");
+  if (!finite_non_negative(c.min_thruster_impulse)) {
+    return bad("min_thruster_impulse", "must be >= 0");
+  }
+  if (!finite_positive(c.r_max_offset)) return bad("r_max_offset", "must be positive and finite");
+  if (!std::isfinite(c.k_min) || !std::isfinite(c.k_max) || c.k_min < 0.0 || c.k_max <= c.k_min) {
+    return bad("k_min", "need 0 <= k_min < k_max");
+  }
+  if (!(c.unobservable_ratio > 0.0 && c.unobservable_ratio < 1.0)) {
+    return bad("unobservable_ratio", "must be in (0, 1)");
+  }
+  if (!finite_positive(c.j_confident_rel)) return bad("j_confident_rel", "must be positive");
+  if (!finite_positive(c.r_confident)) return bad("r_confident", "must be positive");
+  if (!finite_positive(c.k_confident)) return bad("k_confident", "must be positive");
+  return {};
+}
+
+void Identifier::configure(const IdentifierConfig& c) {
+  c_ = c;
+  n_ = static_cast<int>(std::lround(c.window_s / c.dt));
+  for (int i = 0; i < kThrusters; ++i) {
+    e_[i] = thruster_direction(c.rcs, i);
+    p_pos_[i] = thruster_position(c.rcs, i);
+    p_cross_e_[i] = p_pos_[i].cross(e_[i]);
+  }
+  reset();
+}
+
+void Identifier::reset() {
+  a_ = inertia_params(c_.j0);
+  r_ = c_.r0;
+  k_ = c_.k0;
+  p_j_ = c_.j_prior_sigma * c_.j_prior_sigma * Mat6::Identity();
+  p_r_ = c_.r_prior_sigma * c_.r_prior_sigma * Mat3::Identity();
+  p_k_ = c_.k_prior_sigma * c_.k_prior_sigma * Mat16::Identity();
+  p_all_.setZero();
+  p_all_.topLeftCorner<6, 6>() = p_j_;
+  p_all_.block<3, 3>(6, 6) = p_r_;
+  p_all_.bottomRightCorner<kThrusters, kThrusters>() = p_k_;
+  reference_.fill(true);
+  joint_ = JointStep{};
+  acc_ = Window{};
+  latched_ = Window{};
+  sample_ = -1;
+  phase_ = Phase::kIdle;
+  latched_noise_ = 1.0;
+  residual_cov_ = Mat3::Identity();
+  exc_ = IdentifierExcitation{};
+  obs_ = IdentifierObservability{};
+  counters_ = IdentifierCounters{};
+  est_ = IdentifierEstimate{};
+  report();
+}
+
+namespace {
+// Back to the prior for parameters [first, first + n) of a covariance: cross terms cleared.
+template <int N>
+void reinflate_block(Eigen::Matrix<double, N, N>& p, int first, int n, double var) {
+  p.middleRows(first, n).setZero();
+  p.middleCols(first, n).setZero();
+  for (int i = first; i < first + n; ++i) p(i, i) = var;
+}
+}  // namespace
+
+void Identifier::reinflate_inertia() {
+  joint_finish_covariance();
+  joint_.pending = false;  // a gain from the old covariance is dropped
+  joint_.started = false;
+  const double v = c_.j_prior_sigma * c_.j_prior_sigma;
+  reinflate_block<6>(p_j_, 0, 6, v);
+  reinflate_block<kIdParams>(p_all_, 0, 6, v);
+  ++counters_.reinflations;
+}
+
+void Identifier::reinflate_offset() {
+  joint_finish_covariance();
+  joint_.pending = false;  // a gain from the old covariance is dropped
+  joint_.started = false;
+  const double v = c_.r_prior_sigma * c_.r_prior_sigma;
+  reinflate_block<3>(p_r_, 0, 3, v);
+  reinflate_block<kIdParams>(p_all_, 6, 3, v);
+  ++counters_.reinflations;
+}
+
+void Identifier::reinflate_thruster(int i) {
+  if (i < 0 || i >= kThrusters) return;
+  joint_finish_covariance();
+  joint_.pending = false;
+  joint_.started = false;
+  const double v = c_.k_prior_sigma * c_.k_prior_sigma;
+  reinflate_block<kThrusters>(p_k_, i, 1, v);
+  reinflate_block<kIdParams>(p_all_, 9 + i, 1, v);
+  reference_[i] = false;  // a changed thruster no longer defines the thrust scale
+  ++counters_.reinflations;
+}
+
+void Identifier::reinflate_all() {
+  reinflate_inertia();
+  reinflate_offset();
+  for (int i = 0; i < kThrusters; ++i) reinflate_thruster(i);
+  counters_.reinflations -= 2 + kThrusters;
+  ++counters_.reinflations;
+}
+
+void Identifier::sync_blocks() {
+  p_j_ = p_all_.topLeftCorner<6, 6>();
+  p_r_ = p_all_.block<3, 3>(6, 6);
+  p_k_ = p_all_.bottomRightCorner<kThrusters, kThrusters>();
+}
+
+void Identifier::joint_gain() {
+  // (I13): e(x) = A_J a - sum_i k_i [(p_i + r) x e_i] ∫ w F_i dt = noise, linearised at the
+  // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat)], one extended-RLS step on all 25 parameters.
+  // The gain takes two ticks (joint_gain, joint_gain_finish), the update a third (joint_apply),
+  // so no tick carries more than a third of the 25-parameter step.
+  joint_.pending = false;
+  joint_.started = false;
+  const Vec3 force = net_force_impulse();
+  const Mat316 phi_k = strength_regressor();
+  const Vec3 tau = phi_k * k_;
+  joint_.e0 = latched_.a_j * a_ - tau;
+  exc_.inertia_motion = latched_.a_j.norm() * a_.norm() >= torque_threshold();
+  exc_.inertia_scale = tau.norm() >= torque_threshold();
+  exc_.offset = force.norm() >= c_.min_force_impulse;
+  joint_.any_thruster = false;
+  for (int i = 0; i < kThrusters; ++i) {
+    exc_.thruster[i] = latched_.impulse(i) >= c_.min_thruster_impulse;
+    joint_.any_thruster = joint_.any_thruster || exc_.thruster[i];
+  }
+  if (!exc_.inertia_motion && !exc_.inertia_scale) return;
+  Eigen::Matrix<double, 3, kIdParams> h;
+  h.leftCols<6>() = latched_.a_j;
+  h.middleCols<3>(6) = skew(force);
+  h.rightCols<kThrusters>() = -phi_k;
+
+  // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
+  VecId& d = joint_.d;
+  d.setOnes();
+  if (exc_.inertia_scale && c_.j_forget_s > 0.0) {
+    d.head<6>().setConstant(std::exp(0.5 * c_.window_s / c_.j_forget_s));
+  }
+  if (exc_.offset && c_.r_forget_s > 0.0) {
+    d.segment<3>(6).setConstant(std::exp(0.5 * c_.window_s / c_.r_forget_s));
+  }
+  if (joint_.any_thruster && c_.k_forget_s > 0.0) {
+    d.tail<kThrusters>().setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
+  }
+  // P_f H' = D P D H' without forming P_f; the first rows now, the rest next tick.
+  joint_.h = h;
+  joint_.dht = d.asDiagonal() * h.transpose();
+  joint_.p_ht.topRows<kSplit>() =
+      d.head<kSplit>().asDiagonal() * (p_all_.topRows<kSplit>() * joint_.dht);
+  joint_.started = true;
+}
+
+void Identifier::joint_gain_finish() {
+  if (!joint_.started) return;
+  joint_.started = false;
+  constexpr int kRest = kIdParams - kSplit;
+  joint_.p_ht.bottomRows<kRest>() =
+      joint_.d.tail<kRest>().asDiagonal() * (p_all_.bottomRows<kRest>() * joint_.dht);
+  joint_.s = latched_noise_ * Mat3::Identity() + joint_.h * joint_.p_ht;
+  residual_cov_ = joint_.s;
+  const Eigen::LDLT<Mat3> ldlt(joint_.s);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return;
+  joint_.k = ldlt.solve(joint_.p_ht.transpose()).transpose();
+  // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
+  if (!exc_.offset) joint_.k.middleRows<3>(6).setZero();
+  joint_.pending = true;
+}
+
+void Identifier::joint_apply() {
+  if (!joint_.pending) return;
+  joint_.pending = false;
+  VecId x;
+  x << a_, r_, k_;
+  x -= joint_.k * joint_.e0;
+  // Guards (I14): J positive definite and physical, r within bounds; else the update is refused
+  // and the covariance left as it was.
+  const Mat3 j = inertia_matrix(x.head<6>());
+  bool physical = j.allFinite() && Eigen::LLT<Mat3>(j).info() == Eigen::Success;
+  if (physical) {
+    Eigen::SelfAdjointEigenSolver<Mat3> es;
+    es.computeDirect(j, Eigen::EigenvaluesOnly);
+    const Vec3 m = es.eigenvalues();
+    physical = m(0) > 0.0 && m(0) + m(1) >= m(2);
+  }
+  const bool r_ok =
+      x.segment<3>(6).allFinite() && (x.segment<3>(6) - c_.r0).norm() <= c_.r_max_offset;
+  if (!physical || !r_ok) {
+    if (!physical) ++counters_.inertia_refused;
+    if (!r_ok) ++counters_.offset_refused;
+    return;
+  }
+  // The covariance is updated row block by row block: the first rows now, the rest next tick.
+  joint_covariance_rows(0, kSplit);
+  joint_.rows_pending = true;
+  a_ = x.head<6>();
+  r_ = x.segment<3>(6);
+  k_ = x.tail<kThrusters>();
+  for (int i = 0; i < kThrusters; ++i) {
+    const double clamped = std::fmin(std::fmax(k_(i), c_.k_min), c_.k_max);
+    if (clamped != k_(i)) {
+      k_(i) = clamped;
+      ++counters_.strength_clamped;
+    }
+  }
+  ++counters_.inertia_updates;
+  if (exc_.offset) ++counters_.offset_updates;
+  if (joint_.any_thruster) ++counters_.strength_updates;
+}
+
+void Identifier::joint_covariance_rows(int first, int n) {
+  // P = D P D - K H P_f - (K H P_f)' + K S K' (valid for any gain; with the optimal gain it is
+  // D P D - K H P_f). Row i needs only row i of P, so the rows can be done in blocks.
+  const VecId& d = joint_.d;
+  for (int i = first; i < first + n; ++i) {
+    Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
+    row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
+    if (!exc_.offset) {
+      row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
+      row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();
+    }
+    p_all_.row(i) = row;
+  }
+}
+
+void Identifier::joint_finish_covariance() {
+  if (!joint_.rows_pending) return;
+  joint_.rows_pending = false;
+  joint_covariance_rows(kSplit, kIdParams - kSplit);
+  p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+  // No variance above its prior (no wind-up while a direction is not excited).
+  const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
+                          c_.k_prior_sigma * c_.k_prior_sigma};
+  for (int i = 0; i < kIdParams; ++i) {
+    const double cap = caps[i < 6 ? 0 : (i < 9 ? 1 : 2)];
+    if (p_all_(i, i) > cap) {
+      const double f = std::sqrt(cap / p_all_(i, i));
+      p_all_.row(i) *= f;
+      p_all_.col(i) *= f;
+    }
+  }
+}
+
+void Identifier::anchor_scale() {
+  // (I15): a perfect pseudo-measurement c'x = b, c = mean over the reference thrusters, b = the
+  // same mean of k0: x <- x - P c (c'x - b) / (c'P c), P <- P - P c c'P / (c'P c).
+  if (!c_.anchor_thrust_scale) return;
+  VecId c = VecId::Zero();
+  int n = 0;
+  double b = 0.0;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (!reference_[i]) continue;
+    c(9 + i) = 1.0;
+    b += c_.k0(i);
+    ++n;
+  }
+  if (n == 0) return;
+  c /= n;
+  b /= n;
+  if (c_.mode == IdentifierMode::kJoint) {
+    const VecId pc = p_all_ * c;
+    const double cpc = c.dot(pc);
+    if (!(cpc > 0.0)) return;
+    VecId x;
+    x << a_, r_, k_;
+    x -= pc * ((c.dot(x) - b) / cpc);
+    p_all_.noalias() -= pc * pc.transpose() / cpc;
+    p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+    a_ = x.head<6>();
+    r_ = x.segment<3>(6);
+    k_ = x.tail<kThrusters>();
+  } else {
+    const Vec16 ck = c.tail<kThrusters>();
+    const Vec16 pc = p_k_ * ck;
+    const double cpc = ck.dot(pc);
+    if (!(cpc > 0.0)) return;
+    k_ -= pc * ((ck.dot(k_) - b) / cpc);
+    p_k_.noalias() -= pc * pc.transpose() / cpc;
+    p_k_ = 0.5 * (p_k_ + p_k_.transpose()).eval();
+  }
+}
+
+double Identifier::sample_weight(int i) const {
+  // Triangular modulating window (I2): w(0) = w(T) = 0, w(T/2) = 1.
+  return 1.0 - std::fabs(2.0 * i / n_ - 1.0);
+}
+
+double Identifier::sample_alpha(int i) const {
+  // (I4): coefficient of L(omega_i) in -∫ w' J omega dt with the trapezoid rule on each tick;
+  // w' = +2/T on the first half, -2/T on the second; sign s of the interval ending at sample j.
+  auto slope_sign = [this](int j) -> double {
+    if (j < 1 || j > n_) return 0.0;
+    return j <= n_ / 2 ? 1.0 : -1.0;
+  };
+  return -(slope_sign(i) + slope_sign(i + 1)) / n_;
+}
+
+void Identifier::accumulate(const IdentifierInput& in) {
+  const double dt = c_.dt;
+  if (sample_ >= 0) {
+    // The interval ending at this sample, forces held over it (zero-order hold, SPEC §4):
+    // ∫ w F_i dt = (w_(j-1) + w_j) / 2 dt F_i, exact for the linear w.
+    const int j = sample_ + 1;
+    const double wi = 0.5 * (sample_weight(j - 1) + sample_weight(j)) * dt;
+    for (int ch = 0; ch < kChannels; ++ch) {
+      const double f = in.force(ch);
+      if (f > 0.0) {
+        acc_.impulse(2 * ch) += wi * f;
+      } else if (f < 0.0) {
+        acc_.impulse(2 * ch + 1) -= wi * f;
+      }
+    }
+    acc_.weight += wi;
+  }
+  sample_ += 1;
+  const int i = sample_;
+  const double alpha = sample_alpha(i);
+  const double wdt = sample_weight(i) * dt;
+  const Mat36 l = inertia_regressor(in.omega);
+  // (I3): A_J += alpha_i L(omega_i) + w_i dt S(omega_i) L(omega_i).
+  acc_.a_j += alpha * l + wdt * (skew(in.omega) * l);
+  acc_.sum_alpha2 += alpha * alpha;
+  acc_.sum_gyro2 += wdt * wdt * in.omega.squaredNorm();
+}
+
+void Identifier::update(const IdentifierInput& in) {
+  // Work on the latched window first: one group per tick (J, r, k, report).
+  switch (phase_) {
+    case Phase::kInertia:
+      if (c_.mode == IdentifierMode::kJoint) {
+        joint_gain();
+      } else {
+        update_inertia();
+      }
+      phase_ = Phase::kGain;
+      break;
+    case Phase::kGain:
+      if (c_.mode == IdentifierMode::kJoint) joint_gain_finish();
+      phase_ = Phase::kOffset;
+      break;
+    case Phase::kOffset:
+      if (c_.mode == IdentifierMode::kJoint) {
+        joint_apply();
+      } else {
+        update_offset();
+      }
+      phase_ = Phase::kApply;
+      break;
+    case Phase::kApply:
+      if (c_.mode == IdentifierMode::kJoint) joint_finish_covariance();
+      phase_ = Phase::kStrength;
+      break;
+    case Phase::kStrength:
+      if (c_.mode == IdentifierMode::kJoint) {
+        anchor_scale();
+        sync_blocks();
+      } else {
+        update_strengths();
+      }
+      phase_ = Phase::kReport;
+      break;
+    case Phase::kReport:
+      report();
+      phase_ = Phase::kIdle;
+      break;
+    case Phase::kIdle:
+      break;
+  }
+
+  const bool ok = in.omega_valid && in.omega.allFinite() &&
+                  (sample_ < 0 || (in.force_valid && in.force.allFinite()));
+  if (!ok) {
+    if (sample_ > 0) ++counters_.windows_discarded;
+    acc_ = Window{};
+    sample_ = -1;
+    return;
+  }
+  accumulate(in);
+  if (sample_ == n_) {
+    latched_ = acc_;
+    latched_noise_ = window_noise();
+    ++counters_.windows;
+    phase_ = Phase::kInertia;
+    // This sample also opens the next window (w = 0 here, so it only enters through alpha_0).
+    acc_ = Window{};
+    sample_ = -1;
+    accumulate(in);
+  }
+}
+
+double Identifier::torque_threshold() const {
+  // (I16): a window counts only when its torque impulse stands well above the window noise.
+  // Below that, in a closed loop, the commands mostly answer the disturbance and are correlated
+  // with it, which biases least squares (the classic closed-loop identification bias).
+  return std::fmax(c_.min_torque_impulse, c_.min_snr * std::sqrt(latched_noise_));
+}
+
+double Identifier::window_noise() const {
+  // (I5): variance of one row of the window equation.
+  const double jn = inertia_matrix(a_).norm();
+  const double g2 = c_.gyro_sigma * c_.gyro_sigma;
+  const double gyro = g2 * jn * jn * (latched_.sum_alpha2 + 4.0 * latched_.sum_gyro2);
+  const double t = c_.window_s;
+  const double dist = c_.disturbance_sigma * c_.disturbance_sigma * c_.disturbance_corr_s * t / 3.0;
+  const double floor = c_.torque_floor * latched_.weight;
+  return gyro + dist + floor * floor;
+}
+
+Vec3 Identifier::model_torque_impulse(const Vec16& k, const Vec3& r) const {
+  // (I6): ∫ w tau dt = sum_i k_i (p_i + r) x e_i ∫ w F_i dt.
+  Vec3 tau = Vec3::Zero();
+  Vec3 force = Vec3::Zero();
+  for (int i = 0; i < kThrusters; ++i) {
+    const double ki = k(i) * latched_.impulse(i);
+    if (ki == 0.0) continue;
+    tau += ki * p_cross_e_[i];
+    force += ki * e_[i];
+  }
+  return tau + r.cross(force);
+}
+
+Vec3 Identifier::net_force_impulse() const {
+  Vec3 force = Vec3::Zero();
+  for (int i = 0; i < kThrusters; ++i) force += k_(i) * latched_.impulse(i) * e_[i];
+  return force;
+}
+
+Mat316 Identifier::strength_regressor() const {
+  // (I11): column i = [(p_i + r_hat) x e_i] ∫ w F_i dt.
+  Mat316 phi;
+  for (int i = 0; i < kThrusters; ++i) {
+    phi.col(i) = (p_cross_e_[i] + r_.cross(e_[i])) * latched_.impulse(i);
+  }
+  return phi;
+}
+
+// (I7): what each group's own uncertainty adds to the window equation when another group holds it
+// at its estimate (the "consider" covariance).
+Mat3 Identifier::consider_inertia() const {
+  return latched_.a_j * p_j_ * latched_.a_j.transpose();
+}
+
+Mat3 Identifier::consider_offset() const {
+  const Mat3 s = skew(net_force_impulse());
+  return s * p_r_ * s.transpose();
+}
+
+Mat3 Identifier::consider_strengths() const {
+  const Mat316 phi = strength_regressor();
+  return phi * p_k_ * phi.transpose();
+}
+
+void Identifier::update_inertia() {
+  // (I9): A_J a = ∫ w tau dt with the latest r_hat, k_hat.
+  const Vec3 y = model_torque_impulse(k_, r_);
+  exc_.inertia_motion = latched_.a_j.norm() * a_.norm() >= torque_threshold();
+  exc_.inertia_scale = y.norm() >= torque_threshold();
+  if (!exc_.inertia_motion && !exc_.inertia_scale) return;
+  const Vec6 a_keep = a_;
+  const Mat6 p_keep = p_j_;
+  const double prior_var = c_.j_prior_sigma * c_.j_prior_sigma;
+  if (exc_.inertia_scale) forget<6>(p_j_, c_.window_s, c_.j_forget_s, prior_var);
+  // The other groups' uncertainty enters as measurement noise (I7).
+  const Mat3 r_noise = latched_noise_ * Mat3::Identity() + consider_offset() + consider_strengths();
+  residual_cov_ = r_noise + consider_inertia();
+  rls_update<6>(a_, p_j_, latched_.a_j, y, r_noise);
+  // Guard: positive definite, principal moments obey the triangle inequality.
+  const Mat3 j = inertia_matrix(a_);
+  bool physical = j.allFinite() && Eigen::LLT<Mat3>(j).info() == Eigen::Success;
+  if (physical) {
+    Eigen::SelfAdjointEigenSolver<Mat3> es;
+    es.computeDirect(j, Eigen::EigenvaluesOnly);
+    const Vec3 m = es.eigenvalues();  // ascending
+    physical = m(0) > 0.0 && m(0) + m(1) >= m(2);
+  }
+  if (!physical) {
+    a_ = a_keep;
+    p_j_ = p_keep;
+    ++counters_.inertia_refused;
+    return;
+  }
+  ++counters_.inertia_updates;
+}
+
+void Identifier::update_offset() {
+  // (I10): A_J a_hat - sum k_i (p_i x e_i) I_i = r x F = -S(F) r, F = sum k_i e_i I_i.
+  Vec3 tau_p = Vec3::Zero();
+  Vec3 force = Vec3::Zero();
+  for (int i = 0; i < kThrusters; ++i) {
+    const double ki = k_(i) * latched_.impulse(i);
+    tau_p += ki * p_cross_e_[i];
+    force += ki * e_[i];
+  }
+  exc_.offset = force.norm() >= c_.min_force_impulse;
+  if (!exc_.offset) return;
+  const Vec3 y = latched_.a_j * a_ - tau_p;
+  const Mat3 phi = -skew(force);
+  const Vec3 r_keep = r_;
+  const Mat3 p_keep = p_r_;
+  const Mat3 r_noise =
+      latched_noise_ * Mat3::Identity() + consider_inertia() + consider_strengths();
+  forget<3>(p_r_, c_.window_s, c_.r_forget_s, c_.r_prior_sigma * c_.r_prior_sigma);
+  rls_update<3>(r_, p_r_, phi, y, r_noise);
+  if (!r_.allFinite() || (r_ - c_.r0).norm() > c_.r_max_offset) {
+    r_ = r_keep;
+    p_r_ = p_keep;
+    ++counters_.offset_refused;
+    return;
+  }
+  ++counters_.offset_updates;
+}
+
+void Identifier::update_strengths() {
+  // (I11): A_J a_hat = sum_i k_i [(p_i + r_hat) x e_i] I_i.
+  bool any = false;
+  for (int i = 0; i < kThrusters; ++i) {
+    exc_.thruster[i] = latched_.impulse(i) >= c_.min_thruster_impulse;
+    any = any || exc_.thruster[i];
+  }
+  if (!any) return;
+  const Mat316 phi = strength_regressor();
+  const Vec3 y = latched_.a_j * a_;
+  const Mat3 r_noise = latched_noise_ * Mat3::Identity() + consider_inertia() + consider_offset();
+  forget<kThrusters>(p_k_, c_.window_s, c_.k_forget_s, c_.k_prior_sigma * c_.k_prior_sigma);
+  rls_update<kThrusters>(k_, p_k_, phi, y, r_noise);
+  for (int i = 0; i < kThrusters; ++i) {
+    const double clamped = std::fmin(std::fmax(k_(i), c_.k_min), c_.k_max);
+    if (clamped != k_(i) || !std::isfinite(k_(i))) {
+      k_(i) = std::isfinite(k_(i)) ? clamped : c_.k0(i);
+      ++counters_.strength_clamped;
+    }
+  }
+  ++counters_.strength_updates;
+  anchor_scale();
+}
+
+void Identifier::report() {
+  // Estimates and 1 sigma.
+  est_.j = inertia_matrix(a_);
+  est_.j_sigma = p_j_.diagonal().cwiseMax(0.0).cwiseSqrt();
+  est_.r = r_;
+  est_.r_sigma = p_r_.diagonal().cwiseMax(0.0).cwiseSqrt();
+  est_.k = k_;
+  est_.k_sigma = p_k_.diagonal().cwiseMax(0.0).cwiseSqrt();
+
+  // Observability (§I.3): directions still near their prior are reported, not estimated.
+  const double ratio2 = c_.unobservable_ratio * c_.unobservable_ratio;
+  Eigen::SelfAdjointEigenSolver<Mat3> es;
+  es.computeDirect(p_r_);
+  const double r_var0 = c_.r_prior_sigma * c_.r_prior_sigma;
+  obs_.offset_unobservable = 0;
+  double r_worst_observed = 0.0;
+  for (int d = 2; d >= 0; --d) {  // largest variance first
+    if (es.eigenvalues()(d) >= ratio2 * r_var0) {
+      obs_.offset_directions[obs_.offset_unobservable++] = es.eigenvectors().col(d);
+    } else {
+      r_worst_observed =
+          std::fmax(r_worst_observed, std::sqrt(std::fmax(es.eigenvalues()(d), 0.0)));
+    }
+  }
+  const double j_var0 = c_.j_prior_sigma * c_.j_prior_sigma;
+  const Vec6 u = a_.normalized();
+  obs_.inertia_scale_unobservable = u.dot(p_j_ * u) >= ratio2 * j_var0;
+  obs_.inertia_unobservable = 0;
+  for (int d = 0; d < 6; ++d) {
+    if (p_j_(d, d) >= ratio2 * j_var0) ++obs_.inertia_unobservable;
+  }
+  const double k_var0 = c_.k_prior_sigma * c_.k_prior_sigma;
+  for (int i = 0; i < kThrusters; ++i) {
+    obs_.thruster_unobservable[i] = p_k_(i, i) >= ratio2 * k_var0;
+    est_.thruster_confident[i] =
+        !obs_.thruster_unobservable[i] && est_.k_sigma(i) <= c_.k_confident;
+  }
+  obs_.thrust_scale_anchored = true;
+
+  est_.inertia_confident = !obs_.inertia_scale_unobservable && obs_.inertia_unobservable == 0 &&
+                           est_.j_sigma.maxCoeff() <= c_.j_confident_rel * est_.j.norm();
+  est_.offset_confident = obs_.offset_unobservable == 0 && r_worst_observed <= c_.r_confident;
+
+  // Residual of the last window with the latest estimates (I12).
+  if (latched_.weight > 0.0) {
+    const Vec3 res = latched_.a_j * a_ - model_torque_impulse(k_, r_);
+    est_.residual_torque = res / latched_.weight;
+    // Against the window's innovation covariance before the update (joint: S; concurrent: the
+    // inertia group's noise plus its own consider term).
+    est_.residual_chi2 = res.dot(residual_cov_.ldlt().solve(res));
+  }
+}
+
+}  // namespace rocksteady::gnc

@@ -1,0 +1,276 @@
+// On-line identification of the body the flight software flies: J_tot (6 unique entries),
+// r_SO/BCM (3) and a strength factor k_i per physical thruster (16), by three concurrent recursive
+// least-squares estimators, one per group, each using the others' latest estimates (Wilson, Lages &
+// Mah 2002). Design note with the equations and the observability analysis: README.md beside this
+// file (§I). Equation tags (I1)... refer to it.
+//
+// Data: the body rate (gyro or estimate) each tick and the channel forces actually commanded over
+// the previous tick. The model is Eq. (2) integrated against a triangular modulating window w(t)
+// over windows of length T, so no differentiated gyro is needed (I2):
+//   -∫ w' J omega dt + ∫ w omega x (J omega) dt = ∫ w tau dt,
+//   tau = sum_i k_i (p_i + r) x e_i F_i                       (SPEC §4, per physical thruster)
+// The per-tick work is accumulation; at a window's end the data are latched and the groups are
+// updated on the following ticks in small steps (joint: gain in two halves, apply in two halves,
+// scale anchor, report; concurrent: J, r, k, report), so no tick does more than one step.
+//
+// Flight code: fixed-size Eigen, no heap, no exceptions, no I/O.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gnc/model/rcs.hpp"
+#include "gnc/types.hpp"
+
+namespace rocksteady::gnc {
+
+// Sixteen physical thrusters: thruster 2c fires channel c's "+" direction, 2c+1 its "-" (SPEC §4).
+inline constexpr int kThrusters = 2 * kChannels;
+
+using Vec16 = Eigen::Matrix<double, kThrusters, 1>;
+using Mat16 = Eigen::Matrix<double, kThrusters, kThrusters>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat316 = Eigen::Matrix<double, 3, kThrusters>;
+
+// Inertia parameters a = [Jxx Jyy Jzz Jxy Jxz Jyz] and back (I1).
+Vec6 inertia_params(const Mat3& j);
+Mat3 inertia_matrix(const Vec6& a);
+// L(v) with L(v) a = J v (I1).
+Mat36 inertia_regressor(const Vec3& v);
+// Unit force direction e_i and position p_i (F_S, relative to SO) of physical thruster i.
+Vec3 thruster_direction(const RcsLayout& l, int i);
+Vec3 thruster_position(const RcsLayout& l, int i);
+
+// How the three groups are estimated (§I.5). kConcurrent: one RLS per group, each holding the
+// others at their latest estimates and counting their uncertainty as noise (Wilson, Lages & Mah
+// 2002). kJoint: the same window equation linearised in all 25 parameters at once (an extended
+// RLS), which keeps the cross-covariances the concurrent form drops.
+enum class IdentifierMode : std::uint8_t { kConcurrent = 0, kJoint = 1 };
+
+inline constexpr int kIdParams = 6 + 3 + kThrusters;
+using VecId = Eigen::Matrix<double, kIdParams, 1>;
+using MatId = Eigen::Matrix<double, kIdParams, kIdParams>;
+
+struct IdentifierConfig {
+  IdentifierMode mode{IdentifierMode::kJoint};
+  double dt{0.1};         // s, tick period
+  double window_s{20.0};  // s, modulating-window length T (an even number of ticks)
+  RcsLayout rcs{};        // thruster geometry (positions, directions); u_max unused
+  // Priors (the table's values) and their 1 sigma.
+  Mat3 j0{Mat3::Identity()};   // kg m^2
+  Vec3 r0{Vec3::Zero()};       // m
+  Vec16 k0{Vec16::Ones()};     // -
+  double j_prior_sigma{1e7};   // kg m^2, per inertia parameter
+  double r_prior_sigma{1.0};   // m, per axis
+  double k_prior_sigma{0.05};  // per thruster; also anchors the common thrust scale (§I.4)
+  // Noise of the window equation (I5): gyro white noise per sample (rad/s), the external
+  // disturbance (N m per axis, held for disturbance_corr_s), and a floor (N m).
+  double gyro_sigma{0.0};
+  double disturbance_sigma{0.57735026918962576};
+  double disturbance_corr_s{10.0};
+  double torque_floor{0.1};
+  // Exponential forgetting time constants per group (s); 0 = no forgetting. The strengths do not
+  // forget by default: their prior is what fixes the common scale of J and k (§I.4).
+  double j_forget_s{3000.0};
+  double r_forget_s{3000.0};
+  double k_forget_s{0.0};
+  // The common scale of J and k is not in the data (§I.4). true: it is fixed by the thrusters'
+  // calibration, the mean strength of the reference thrusters (all, minus those declared changed)
+  // held at the mean of k0 by a constraint after each update; false: only the k prior holds it.
+  bool anchor_thrust_scale{true};
+  // Excitation: a window excites the inertia scale when its weighted torque impulse exceeds
+  // min_torque_impulse (N m s), r when the net-force impulse exceeds min_force_impulse (N s),
+  // thruster i when its impulse exceeds min_thruster_impulse (N s).
+  double min_torque_impulse{50.0};
+  double min_force_impulse{20.0};
+  // ... and the torque impulse (commanded, or inertial for the ratios) must also exceed min_snr
+  // times the window's noise sigma (I16): in a closed loop, windows where the commands only
+  // answer the disturbance bias the estimate.
+  double min_snr{10.0};
+  double min_thruster_impulse{5.0};
+  // Guards: a J update that leaves J not positive definite or violating the triangle inequality
+  // of the principal moments is refused; r must stay within r_max_offset of r0 (else refused);
+  // k_i is clamped to [k_min, k_max].
+  double r_max_offset{5.0};
+  double k_min{0.0};
+  double k_max{1.5};
+  // Observability: a direction whose 1 sigma is still above unobservable_ratio times its prior
+  // is reported unobservable (not estimated).
+  double unobservable_ratio{0.5};
+  // Confidence: J's largest 1 sigma relative to ||J_hat|| (Frobenius), r's largest observable
+  // 1 sigma (m), k_i's 1 sigma.
+  double j_confident_rel{0.01};
+  double r_confident{0.02};
+  double k_confident{0.02};
+};
+
+struct IdentifierConfigCheck {
+  bool ok{true};
+  const char* field{""};
+  const char* reason{""};
+};
+
+// The first bad field and why, or ok.
+IdentifierConfigCheck validate(const IdentifierConfig& c);
+
+struct IdentifierInput {
+  Vec3 omega{Vec3::Zero()};  // body rate at this tick, rad/s (gyro or estimate)
+  bool omega_valid{false};
+  Vec8 force{Vec8::Zero()};  // channel forces commanded over the previous tick, N (SPEC §4)
+  bool force_valid{true};    // false: the previous tick's thrust is unknown (window discarded)
+};
+
+struct IdentifierExcitation {
+  bool inertia_motion{false};               // the window carried rotation (inertia ratios)
+  bool inertia_scale{false};                // ... and enough commanded torque (inertia scale)
+  bool offset{false};                       // enough net force (r, normal to it)
+  std::array<bool, kThrusters> thruster{};  // thruster i fired enough
+};
+
+// What can and cannot be told from the data so far (§I.3).
+struct IdentifierObservability {
+  int offset_unobservable{0};               // how many directions of r are unobservable
+  std::array<Vec3, 3> offset_directions{};  // their unit vectors (first offset_unobservable)
+  bool inertia_scale_unobservable{true};    // sigma along a_hat / prior above the ratio
+  int inertia_unobservable{0};              // inertia parameters still near their prior sigma
+  std::array<bool, kThrusters> thruster_unobservable{};
+  // The common scale of J and all k_i never shows in gyro + commanded-thrust data (§I.4): it is
+  // anchored by the thrusters' calibration prior, not estimated. Always true; reported so nobody
+  // reads the inertia scale as measured independently of the thrust calibration.
+  bool thrust_scale_anchored{true};
+};
+
+struct IdentifierCounters {
+  std::uint32_t windows{0};            // windows completed
+  std::uint32_t windows_discarded{0};  // a missing rate or thrust sample broke the window
+  std::uint32_t inertia_updates{0};
+  std::uint32_t offset_updates{0};
+  std::uint32_t strength_updates{0};
+  std::uint32_t inertia_refused{0};  // guard refusals
+  std::uint32_t offset_refused{0};
+  std::uint32_t strength_clamped{0};
+  std::uint32_t reinflations{0};
+};
+
+struct IdentifierEstimate {
+  Mat3 j{Mat3::Identity()};
+  Vec6 j_sigma{Vec6::Zero()};  // 1 sigma of [Jxx Jyy Jzz Jxy Jxz Jyz]
+  Vec3 r{Vec3::Zero()};
+  Vec3 r_sigma{Vec3::Zero()};
+  Vec16 k{Vec16::Ones()};
+  Vec16 k_sigma{Vec16::Zero()};
+  bool inertia_confident{false};
+  bool offset_confident{false};  // every observable direction within r_confident
+  std::array<bool, kThrusters> thruster_confident{};
+  // Mean residual torque of the last window with the latest estimates (N m, F_B), and its
+  // squared norm normalised by the window noise (a fault detector's input).
+  Vec3 residual_torque{Vec3::Zero()};
+  double residual_chi2{0.0};
+};
+
+class Identifier {
+ public:
+  // Takes a validated config; sets the estimates to the priors.
+  void configure(const IdentifierConfig& c);
+  // Back to the priors and empty windows.
+  void reset();
+  // One tick.
+  void update(const IdentifierInput& in);
+
+  // Re-inflation on a declared change (a fault, a table switch): the group's covariance goes
+  // back to its prior; the estimate is kept as the starting point.
+  void reinflate_inertia();
+  void reinflate_offset();
+  void reinflate_thruster(int i);
+  void reinflate_all();
+
+  const IdentifierEstimate& estimate() const { return est_; }
+  const IdentifierExcitation& excitation() const { return exc_; }
+  const IdentifierObservability& observability() const { return obs_; }
+  const IdentifierCounters& counters() const { return counters_; }
+  const Mat6& inertia_covariance() const { return p_j_; }
+  const Mat3& offset_covariance() const { return p_r_; }
+  const Mat16& strength_covariance() const { return p_k_; }
+
+ private:
+  // The data of one window, latched at its end.
+  struct Window {
+    Mat36 a_j{Mat36::Zero()};      // A_J of (I3): A_J a = -∫ w' J omega + ∫ w omega x J omega
+    Vec16 impulse{Vec16::Zero()};  // ∫ w F_i dt per thruster, N s
+    double weight{0.0};            // ∫ w dt, s
+    double sum_alpha2{0.0};        // sum of the per-sample weights on L(omega), squared (I5)
+    double sum_gyro2{0.0};         // sum of (w dt |omega|)^2 (I5)
+  };
+  enum class Phase : std::uint8_t { kIdle, kInertia, kGain, kOffset, kApply, kStrength, kReport };
+
+  void accumulate(const IdentifierInput& in);
+  double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
+  double sample_weight(int i) const;  // w(t_i)
+  double window_noise() const;        // row variance of the latched window (I5)
+  double torque_threshold() const;    // (I16)
+  Vec3 model_torque_impulse(const Vec16& k, const Vec3& r) const;  // ∫ w tau dt (I6)
+  Vec3 net_force_impulse() const;     // sum k_i e_i ∫ w F_i dt with k_hat
+  Mat316 strength_regressor() const;  // (I11) with r_hat
+  Mat3 consider_inertia() const;      // (I7)
+  Mat3 consider_offset() const;
+  Mat3 consider_strengths() const;
+  void joint_gain();         // (I13) gain of the joint step, first part
+  void joint_gain_finish();  // ... second part
+  void joint_apply();
+  void joint_covariance_rows(int first, int n);  // rows [first, first + n) of the P update
+  void joint_finish_covariance();  // the remaining rows, symmetrise, cap        // (I13), (I14)
+                                   // apply it, guarded
+  void sync_blocks();              // joint covariance -> per-group blocks
+  void anchor_scale();             // (I15)
+  void update_inertia();
+  void update_offset();
+  void update_strengths();
+  void report();
+
+  IdentifierConfig c_{};
+  int n_{200};                                // ticks per window
+  std::array<Vec3, kThrusters> e_{};          // thruster directions
+  std::array<Vec3, kThrusters> p_pos_{};      // thruster positions
+  std::array<Vec3, kThrusters> p_cross_e_{};  // p_i x e_i
+
+  // Estimates and covariances.
+  Vec6 a_{Vec6::Zero()};
+  Mat6 p_j_{Mat6::Identity()};
+  Vec3 r_{Vec3::Zero()};
+  Mat3 p_r_{Mat3::Identity()};
+  Vec16 k_{Vec16::Ones()};
+  Mat16 p_k_{Mat16::Identity()};
+  MatId p_all_{MatId::Identity()};            // kJoint: [a; r; k]
+  std::array<bool, kThrusters> reference_{};  // thrusters that define the thrust scale
+  static constexpr int kSplit = 13;           // rows of P H' computed on the first gain tick
+  struct JointStep {                          // computed over two ticks, applied on the third
+    bool started{false};
+    bool pending{false};
+    bool rows_pending{false};  // the covariance's last rows are still to be updated
+    Eigen::Matrix<double, 3, kIdParams> h{Eigen::Matrix<double, 3, kIdParams>::Zero()};
+    Eigen::Matrix<double, kIdParams, 3> dht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
+    bool any_thruster{false};
+    VecId d{VecId::Ones()};
+    Vec3 e0{Vec3::Zero()};
+    Mat3 s{Mat3::Identity()};
+    Eigen::Matrix<double, kIdParams, 3> p_ht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
+    Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
+  };
+  JointStep joint_{};
+
+  // Window in progress and the latched one.
+  Window acc_{};
+  Window latched_{};
+  int sample_{-1};  // index of the last accumulated sample in the window, -1 = not started
+  Vec8 last_force_{Vec8::Zero()};
+  Phase phase_{Phase::kIdle};
+  double latched_noise_{1.0};
+  Mat3 residual_cov_{Mat3::Identity()};  // innovation covariance of the latched window
+
+  IdentifierEstimate est_{};
+  IdentifierExcitation exc_{};
+  IdentifierObservability obs_{};
+  IdentifierCounters counters_{};
+};
+
+}  // namespace rocksteady::gnc

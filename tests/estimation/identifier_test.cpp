@@ -1,0 +1,335 @@
+// Mass-property identification against an independent truth (tests/common rigid body driven by
+// sixteen thrusters with strength factors, tests/estimation/identification_truth.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "estimation_truth.hpp"
+#include "gnc/estimation/identifier.hpp"
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
+#include "identification_truth.hpp"
+
+namespace rocksteady::gnc {
+namespace {
+
+using test::TruthRun;
+using test::TruthSetup;
+
+constexpr double kDt = 0.1;
+
+Mat3 study_j() {
+  return total_inertia(study_true_mass_properties());
+}
+
+// Truth strengths 1 + delta with sum(delta) = 0 (the common scale is anchored, §I.4).
+Vec16 spread_strengths() {
+  Vec16 k;
+  for (int i = 0; i < kThrusters; ++i)
+    k(i) = 1.0 + 0.04 * ((i % 2 == 0) ? 1.0 : -1.0) * ((i / 2) % 3 == 0 ? 1.0 : 0.5);
+  k.array() -= k.mean() - 1.0;
+  return k;
+}
+
+IdentifierConfig config_with_priors(const Mat3& j0, const Vec3& r0) {
+  IdentifierConfig c;
+  c.dt = kDt;
+  c.window_s = 20.0;
+  c.rcs = study_rcs_layout(200.0);
+  c.j0 = j0;
+  c.r0 = r0;
+  return c;
+}
+
+// Channel forces: each channel a seeded piecewise-constant level in [-u, u], a new level every
+// `hold` seconds (rich excitation).
+struct RandomFiring {
+  explicit RandomFiring(unsigned long long seed, double u = 200.0, double hold = 7.0)
+      : rng(seed), u_max(u), hold_s(hold) {}
+  test::V8 operator()(double t, const test::V3&) {
+    if (t >= next - 1e-9) {
+      for (int c = 0; c < 8; ++c) level(c) = u_max * uni(rng);
+      next += hold_s;
+    }
+    return level;
+  }
+  std::mt19937_64 rng;
+  std::uniform_real_distribution<double> uni{-1.0, 1.0};
+  double u_max, hold_s, next{0.0};
+  test::V8 level{test::V8::Zero()};
+};
+
+IdentifierInput id_input(const test::V3& omega, const test::V8& force) {
+  IdentifierInput in;
+  in.omega = omega;
+  in.omega_valid = true;
+  in.force = force;
+  return in;
+}
+
+double j_error(const Identifier& id, const Mat3& j) {
+  return (id.estimate().j - j).norm() / j.norm();
+}
+double k_error(const Identifier& id, const Vec16& k) {
+  return (id.estimate().k - k).cwiseAbs().maxCoeff();
+}
+
+TEST(IdentifierConfig, DefaultsAreValidAndTheFirstBadFieldIsNamed) {
+  IdentifierConfig ok = config_with_priors(study_j(), Vec3::Zero());
+  EXPECT_TRUE(validate(ok).ok);
+  struct Case {
+    void (*mutate)(IdentifierConfig&);
+    const char* field;
+  };
+  const Case cases[] = {
+      {[](IdentifierConfig& c) { c.dt = -0.1; }, "dt"},
+      {[](IdentifierConfig& c) { c.window_s = 2.05; }, "window_s"},
+      {[](IdentifierConfig& c) { c.window_s = 0.3; }, "window_s"},
+      {[](IdentifierConfig& c) { c.rcs.channel_direction[3] = Vec3(0, 0, 2); },
+       "rcs.channel_direction"},
+      {[](IdentifierConfig& c) { c.rcs.channel_pod[1] = 7; }, "rcs.channel_pod"},
+      {[](IdentifierConfig& c) { c.j0(0, 0) = -1.0; }, "j0"},
+      {[](IdentifierConfig& c) { c.j0(0, 1) += 1e6; }, "j0"},
+      {[](IdentifierConfig& c) { c.r0.x() = NAN; }, "r0"},
+      {[](IdentifierConfig& c) { c.k_prior_sigma = 0.0; }, "k_prior_sigma"},
+      {[](IdentifierConfig& c) { c.torque_floor = 0.0; }, "torque_floor"},
+      {[](IdentifierConfig& c) { c.j_forget_s = 5.0; }, "j_forget_s"},
+      {[](IdentifierConfig& c) { c.k_max = 0.0; }, "k_min"},
+      {[](IdentifierConfig& c) { c.unobservable_ratio = 1.0; }, "unobservable_ratio"},
+      {[](IdentifierConfig& c) { c.r_confident = 0.0; }, "r_confident"},
+  };
+  for (const Case& cs : cases) {
+    IdentifierConfig c = ok;
+    cs.mutate(c);
+    const IdentifierConfigCheck r = validate(c);
+    EXPECT_FALSE(r.ok) << cs.field;
+    EXPECT_EQ(std::string(r.field), cs.field);
+    EXPECT_GT(std::string(r.reason).size(), 0u);
+  }
+}
+
+TEST(Identifier, InertiaParametersAndRegressorAgree) {
+  const Mat3 j = study_j();
+  const Vec3 v(0.3, -1.2, 2.0);
+  EXPECT_LT((inertia_matrix(inertia_params(j)) - j).norm(), 1e-9 * j.norm());
+  EXPECT_LT((inertia_regressor(v) * inertia_params(j) - j * v).norm(), 1e-9 * (j * v).norm());
+}
+
+TEST(Identifier, ThrusterGeometryMatchesTheTorqueMatrix) {
+  // sum over the + thrusters of (p + r) x e equals B (SPEC §4) column by column.
+  const RcsLayout l = study_rcs_layout(200.0);
+  const Vec3 r(0.1, -0.2, 3.5);
+  const Mat38 b = torque_matrix(l, r);
+  for (int c = 0; c < kChannels; ++c) {
+    const Vec3 plus = (thruster_position(l, 2 * c) + r).cross(thruster_direction(l, 2 * c));
+    const Vec3 minus =
+        (thruster_position(l, 2 * c + 1) + r).cross(thruster_direction(l, 2 * c + 1));
+    EXPECT_LT((plus - b.col(c)).norm(), 1e-12);
+    EXPECT_LT((minus + b.col(c)).norm(), 1e-12);
+  }
+}
+
+TEST(Identifier, RecoversInertiaOffsetAndStrengthsToTheNoiseFloor) {
+  // Noise-free synthetic trajectory from the study's initial rate, known J, r, k; priors off by
+  // the case-4 errors (||dJ|| = 1e7 kg m^2, ||dr|| = 1 m).
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  s.k = spread_strengths();
+  const Mat3 dj = 1e7 * Vec3(-1.0, 1.0, 0.5).asDiagonal();
+  const Vec3 dr = Vec3(1, 1, 1).normalized();
+  Identifier id;
+  IdentifierConfig c = config_with_priors(s.j - dj, s.r - dr);
+  ASSERT_TRUE(validate(c).ok);
+  id.configure(c);
+  EXPECT_GT(j_error(id, s.j), 0.2);
+  TruthRun truth(s);
+  RandomFiring fire(5);
+  truth.run(static_cast<int>(3000.0 / kDt), fire,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  const double ej = j_error(id, s.j), er = (id.estimate().r - s.r).norm(), ek = k_error(id, s.k);
+  std::printf("noise-free 3000 s: |dJ|/|J| %.3g, |dr| %.3g m, max|dk| %.3g\n", ej, er, ek);
+  // Without noise what is left is the window quadrature (trapezoid, O(dt^2)) and the
+  // information not yet gathered on the strengths; the common scale is anchored (mean k = 1).
+  EXPECT_LT(ej, 2e-4);
+  EXPECT_LT(er, 2e-3);
+  EXPECT_LT(ek, 4e-3);
+  EXPECT_EQ(id.counters().inertia_refused, 0u);
+  EXPECT_EQ(id.observability().offset_unobservable, 0);
+  EXPECT_FALSE(id.observability().inertia_scale_unobservable);
+  EXPECT_TRUE(id.observability().thrust_scale_anchored);
+}
+
+TEST(Identifier, WithNoiseTheErrorsAreConsistentWithTheReportedSigma) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  s.k = spread_strengths();
+  s.disturbance_sigma = 1.0 / std::sqrt(3.0);
+  s.gyro_sigma = std::sqrt(1e-10 / kDt);  // case 7 gyro noise
+  s.seed = 9;
+  IdentifierConfig c = config_with_priors(s.j - 1e7 * Mat3(Vec3(-1, 1, 0.5).asDiagonal()),
+                                          s.r - Vec3(1, 1, 1).normalized());
+  c.gyro_sigma = s.gyro_sigma;
+  Identifier id;
+  id.configure(c);
+  TruthRun truth(s);
+  RandomFiring fire(6);
+  truth.run(static_cast<int>(1200.0 / kDt), fire,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  const IdentifierEstimate& e = id.estimate();
+  const Vec6 dj = inertia_params(e.j) - inertia_params(s.j);
+  const Vec3 dr = e.r - s.r;
+  std::printf("noisy 1200 s: |dJ|/|J| %.3g, |dr| %.3g m, max|dk| %.3g\n", j_error(id, s.j),
+              dr.norm(), k_error(id, s.k));
+  double nees_j = dj.dot(id.inertia_covariance().ldlt().solve(dj));
+  double nees_r = dr.dot(id.offset_covariance().ldlt().solve(dr));
+  std::printf("normalised errors: J %.3g (6 dof), r %.3g (3 dof)\n", nees_j, nees_r);
+  EXPECT_LT(j_error(id, s.j), 0.01);
+  // Consistency (loose, one run): below the chi-square 0.999 quantile.
+  EXPECT_LT(nees_j, test::chi2_quantile(6, 3.09));
+  EXPECT_LT(nees_r, test::chi2_quantile(3, 3.09));
+}
+
+// Couples only: every firing pattern has zero net force, so r cannot show (I10).
+test::V8 pure_couples(double t, const test::V3&) {
+  test::V8 u = test::V8::Zero();
+  const double a = 150.0 * std::sin(0.05 * t), b = 150.0 * std::cos(0.031 * t);
+  const double c = 100.0 * std::sin(0.017 * t + 1.0);
+  for (int k = 0; k < 4; ++k) u(2 * k) = c;  // tangential, all the same: pure z couple
+  u(1) = a;                                  // axial, pod 0 against pod 2
+  u(5) = -a;
+  u(3) = b;  // pod 1 against pod 3
+  u(7) = -b;
+  return u;
+}
+
+TEST(Identifier, PureCouplesLeaveTheOffsetReportedUnobservableNotEstimated) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  const Vec3 r0 = s.r - Vec3(0.3, -0.2, 0.5);
+  Identifier id;
+  id.configure(config_with_priors(s.j, r0));
+  TruthRun truth(s);
+  truth.run(static_cast<int>(600.0 / kDt), pure_couples,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  EXPECT_GT(id.counters().windows, 20u);
+  EXPECT_EQ(id.observability().offset_unobservable, 3);
+  EXPECT_EQ(id.counters().offset_updates, 0u);
+  // Not invented: nothing is learned along unobservable directions (round-off of the joint
+  // update's scale anchoring only, below a nanometre).
+  EXPECT_LT((id.estimate().r - r0).norm(), 1e-9) << (id.estimate().r - r0).transpose();
+  EXPECT_FALSE(id.estimate().offset_confident);
+  EXPECT_GT(id.estimate().r_sigma.minCoeff(), 0.9 * 1.0);  // still the prior's 1 m
+  // The inertia is still identified from the couples.
+  EXPECT_LT(j_error(id, s.j), 1e-3);
+}
+
+TEST(Identifier, ANetForceAlongZLeavesOnlyTheZOffsetUnobservable) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  const Vec3 r0 = s.r - Vec3(0.3, -0.2, 0.5);
+  Identifier id;
+  id.configure(config_with_priors(s.j, r0));
+  TruthRun truth(s);
+  auto axial_plus_couples = [](double t, const test::V3& w) {
+    test::V8 u = pure_couples(t, w);
+    for (int k = 0; k < 4; ++k) u(2 * k + 1) += 40.0 + 30.0 * std::sin(0.02 * t + k);
+    return u;
+  };
+  truth.run(static_cast<int>(600.0 / kDt), axial_plus_couples,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  ASSERT_EQ(id.observability().offset_unobservable, 1);
+  EXPECT_GT(std::fabs(id.observability().offset_directions[0].z()), 0.999);
+  EXPECT_NEAR(id.estimate().r.x(), s.r.x(), 5e-3);
+  EXPECT_NEAR(id.estimate().r.y(), s.r.y(), 5e-3);
+  // z stays at the prior: reported, not estimated.
+  EXPECT_NEAR(id.estimate().r.z(), r0.z(), 0.02 * std::fabs(s.r.z() - r0.z()));
+}
+
+TEST(Identifier, TorqueFreeMotionGivesRatiosButNotTheInertiaScale) {
+  TruthSetup s;
+  s.j = study_j();
+  const Mat3 j0 = 1.3 * s.j;  // right ratios, wrong scale
+  Identifier id;
+  id.configure(config_with_priors(j0, Vec3::Zero()));
+  TruthRun truth(s);
+  truth.run(
+      static_cast<int>(300.0 / kDt),
+      [](double, const test::V3&) { return test::V8::Zero().eval(); },
+      [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  EXPECT_GT(id.counters().inertia_updates, 0u);
+  EXPECT_FALSE(id.excitation().inertia_scale);
+  EXPECT_TRUE(id.excitation().inertia_motion);
+  EXPECT_TRUE(id.observability().inertia_scale_unobservable);
+  EXPECT_FALSE(id.estimate().inertia_confident);
+  // The scale is not invented: it stays where the prior put it (the ratios were already right).
+  EXPECT_NEAR(id.estimate().j.norm() / s.j.norm(), 1.3, 1e-3);
+}
+
+TEST(Identifier, AnInertiaUpdateThatWouldNotBePositiveDefiniteIsRefused) {
+  // Commands reported with the wrong sign: the data say J is negative definite.
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  s.omega0 = Vec3(1e-3, -1e-3, 5e-4);
+  Identifier id;
+  IdentifierConfig c = config_with_priors(s.j, s.r);
+  c.j_prior_sigma = 1e8;
+  id.configure(c);
+  TruthRun truth(s);
+  RandomFiring fire(8, 500.0);
+  truth.run(static_cast<int>(300.0 / kDt), fire,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, -f)); });
+  EXPECT_GT(id.counters().inertia_refused, 0u);
+  EXPECT_EQ(Eigen::LLT<Mat3>(id.estimate().j).info(), Eigen::Success);
+}
+
+TEST(Identifier, ReinflationLetsAStrengthEstimateFollowADeclaredFault) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  for (bool declare : {false, true}) {
+    Identifier id;
+    id.configure(config_with_priors(s.j, s.r));
+    TruthRun truth(s);
+    RandomFiring fire(12);
+    double t_fault = 600.0;
+    truth.run(static_cast<int>(1200.0 / kDt), fire,
+              [&](double t, const test::V3& w, const test::V8& f) {
+                if (std::fabs(t - t_fault) < 1e-6) {
+                  truth.set_strength(6, 0.5);  // thruster 6 (pod 1 tangential +) at half thrust
+                  if (declare) id.reinflate_thruster(6);
+                }
+                id.update(id_input(w, f));
+              });
+    std::printf("declared %d: k6 %.4f\n", declare, id.estimate().k(6));
+    if (declare) {
+      EXPECT_NEAR(id.estimate().k(6), 0.5, 0.02);
+      EXPECT_EQ(id.counters().reinflations, 1u);
+    } else {
+      EXPECT_GT(std::fabs(id.estimate().k(6) - 0.5), 0.05);  // without it the old data dominate
+    }
+  }
+}
+
+TEST(Identifier, ADiscardedWindowIsCountedAndLeavesTheEstimateAlone) {
+  Identifier id;
+  id.configure(config_with_priors(study_j(), Vec3::Zero()));
+  for (int k = 0; k < 50; ++k)
+    id.update(id_input(Vec3(0.01, 0.02, 0.03), test::V8::Constant(10.0)));
+  IdentifierInput bad = id_input(Vec3(0.01, 0.02, 0.03), test::V8::Zero());
+  bad.omega_valid = false;
+  id.update(bad);
+  EXPECT_EQ(id.counters().windows_discarded, 1u);
+  EXPECT_EQ(id.counters().windows, 0u);
+  EXPECT_EQ(id.estimate().j, study_j());
+}
+
+}  // namespace
+}  // namespace rocksteady::gnc

@@ -1,0 +1,347 @@
+// The MEKF against an independent truth (tests/common rigid body, tests/estimation sensors).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "estimation_truth.hpp"
+#include "gnc/estimation/mekf.hpp"
+
+namespace rocksteady::gnc {
+namespace {
+
+using test::attitude_error;
+using test::chi2_quantile;
+using test::RigidBody;
+using test::SensorNoise;
+using test::Sensors;
+
+constexpr double kDt = 0.1;
+
+MekfConfig config_for(const SensorNoise& n) {
+  MekfConfig c;
+  c.dt = kDt;
+  c.gyro_arw = n.gyro_arw;
+  c.gyro_bias_rw = n.gyro_bias_rw;
+  c.star_sigma = n.star_sigma;
+  c.init_attitude_sigma = 3.0 * n.star_sigma;
+  c.init_bias_sigma = 1e-3;
+  return c;
+}
+
+MekfInput input(double t, const Vec3& gyro, const Vec4& star) {
+  MekfInput in;
+  in.t = t;
+  in.gyro_rate = gyro;
+  in.gyro_valid = true;
+  in.star_quat = star;
+  in.star_valid = true;
+  return in;
+}
+
+// A seeded run: a body tumbling torque-free (so the rate changes within each tick), sensors with
+// the configured noise, the filter following. Calls `each(k, filter, truth, sensors)` per tick.
+template <typename F>
+void run(const SensorNoise& noise, const MekfConfig& c, unsigned long long seed, int ticks,
+         const Vec3& bias0, F each) {
+  RigidBody body;
+  body.j = Vec3(3.0e7, 3.5e7, 4.0e7).asDiagonal();
+  body.omega = Vec3(2e-3, -1e-3, 1.5e-3);
+  body.beta = test::axis_angle(Vec3(1, 2, 3), 0.7);
+  Sensors s(noise, kDt, seed, bias0);
+  Mekf f;
+  f.configure(c);
+  for (int k = 0; k < ticks; ++k) {
+    if (k > 0) {
+      body.step(kDt, Vec3::Zero());
+      s.step_bias();
+    }
+    f.update(input(k * kDt, s.gyro(body.omega), s.star(body.beta)));
+    each(k, f, body, s);
+  }
+}
+
+TEST(MekfConfig, DefaultsAreValid) {
+  EXPECT_TRUE(validate(MekfConfig{}).ok);
+}
+
+TEST(MekfConfig, NamesTheFirstBadField) {
+  struct Case {
+    void (*mutate)(MekfConfig&);
+    const char* field;
+  };
+  const Case cases[] = {
+      {[](MekfConfig& c) { c.dt = 0.0; }, "dt"},
+      {[](MekfConfig& c) { c.gyro_arw = -1.0; }, "gyro_arw"},
+      {[](MekfConfig& c) { c.gyro_bias_rw = std::nan(""); }, "gyro_bias_rw"},
+      {[](MekfConfig& c) { c.star_sigma = 0.0; }, "star_sigma"},
+      {[](MekfConfig& c) { c.model_sigma = -1.0; }, "model_sigma"},
+      {[](MekfConfig& c) { c.gyro_arw = 0.0; }, "gyro_arw"},  // no attitude process noise
+      {[](MekfConfig& c) { c.init_attitude_sigma = 0.0; }, "init_attitude_sigma"},
+      {[](MekfConfig& c) { c.init_bias_sigma = -1.0; }, "init_bias_sigma"},
+      {[](MekfConfig& c) { c.init_bias.x() = INFINITY; }, "init_bias"},
+      {[](MekfConfig& c) { c.gate_chi2 = 0.0; }, "gate_chi2"},
+      {[](MekfConfig& c) { c.max_consecutive_rejects = 0; }, "max_consecutive_rejects"},
+      {[](MekfConfig& c) { c.gyro_max_rate = 0.0; }, "gyro_max_rate"},
+      {[](MekfConfig& c) { c.quat_norm_tolerance = 1.0; }, "quat_norm_tolerance"},
+  };
+  for (const Case& cs : cases) {
+    MekfConfig c;
+    cs.mutate(c);
+    const MekfConfigCheck r = validate(c);
+    EXPECT_FALSE(r.ok) << cs.field;
+    EXPECT_EQ(std::string(r.field), cs.field);
+    EXPECT_GT(std::string(r.reason).size(), 0u);
+  }
+}
+
+TEST(Mekf, TransitionIsTheMatrixExponentialOfTheErrorDynamics) {
+  // F = [[-S(w), -I], [0, 0]]; Phi = exp(F dt) by a 40-term Taylor series.
+  for (const Vec3& w : {Vec3(0.3, -0.2, 0.5), Vec3(1e-5, 2e-5, -1e-5), Vec3::Zero().eval()}) {
+    for (double dt : {0.1, 2.0}) {
+      Mat6 f = Mat6::Zero();
+      Mat3 s;
+      s << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+      f.topLeftCorner<3, 3>() = -s;
+      f.topRightCorner<3, 3>() = -Mat3::Identity();
+      Mat6 term = Mat6::Identity(), sum = Mat6::Identity();
+      for (int n = 1; n < 40; ++n) {
+        term = term * f * dt / n;
+        sum += term;
+      }
+      EXPECT_LT((Mekf::transition(w, dt) - sum).norm(), 1e-12 * (1.0 + sum.norm()))
+          << w.transpose() << " dt " << dt;
+    }
+  }
+}
+
+TEST(Mekf, InitialisesFromTheFirstSampleAndOutputsTheSameMrpSetAsTheStateFilter) {
+  Mekf f;
+  f.configure(MekfConfig{});
+  MekfInput in = input(0.0, Vec3(1e-3, 2e-3, 3e-3), test::axis_angle(Vec3(0, 0, 1), 3.0));
+  in.star_valid = false;
+  f.update(in);
+  EXPECT_FALSE(f.initialised());
+  in.star_valid = true;
+  f.update(in);
+  ASSERT_TRUE(f.initialised());
+  // 3 rad about z: the |q| <= 1 MRP is tan(3/4) z (the other set, -cot(3/4) z, has |q| > 1).
+  EXPECT_NEAR(f.q().z(), std::tan(3.0 / 4.0), 1e-12);
+  EXPECT_LE(f.q().norm(), 1.0);
+  EXPECT_LT((f.omega() - Vec3(1e-3, 2e-3, 3e-3)).norm(), 1e-15);
+}
+
+TEST(Mekf, NeesWithinChiSquareBoundsOverSeededRuns) {
+  // M independent runs; at each checked time the sum over runs of the 6-state NEES is chi-square
+  // with 6M dof when the filter is consistent. Checked at 50 times: the sum must lie in the
+  // two-sided 95 % band at (nearly) all of them, and the average NEES per state must be ~1.
+  SensorNoise n;
+  n.gyro_arw = 1e-5;
+  n.gyro_bias_rw = 1e-7;
+  n.star_sigma = 1e-3;
+  MekfConfig c = config_for(n);
+  c.init_bias_sigma = 1e-4;
+  const int runs = 30, ticks = 3000, every = 60, first = 60;
+  const int checks = (ticks - first) / every;
+  std::vector<double> sum(checks, 0.0), sum_att(checks, 0.0);
+  for (int m = 0; m < runs; ++m) {
+    std::mt19937_64 init(1000 + m);
+    std::normal_distribution<double> g(0.0, 1.0);
+    const Vec3 bias0 = 1e-4 * Vec3(g(init), g(init), g(init));  // drawn from the filter's prior
+    run(n, c, 77 + m, ticks, bias0,
+        [&](int k, const Mekf& f, const RigidBody& b, const Sensors& s) {
+          if (k < first || (k - first) % every != 0 || (k - first) / every >= checks) return;
+          const int i = (k - first) / every;
+          Vec6 e;
+          e.head<3>() = attitude_error(f.quaternion(), b.beta);
+          e.tail<3>() = s.bias() - f.bias();
+          sum[i] += e.dot(f.covariance().ldlt().solve(e));
+          const Vec3 ea = e.head<3>();
+          sum_att[i] += ea.dot(f.covariance().topLeftCorner<3, 3>().ldlt().solve(ea));
+        });
+  }
+  const double lo = chi2_quantile(6.0 * runs, -1.96), hi = chi2_quantile(6.0 * runs, 1.96);
+  const double lo3 = chi2_quantile(3.0 * runs, -1.96), hi3 = chi2_quantile(3.0 * runs, 1.96);
+  int inside = 0, inside_att = 0;
+  double mean = 0.0, mean_att = 0.0;
+  for (int i = 0; i < checks; ++i) {
+    inside += sum[i] > lo && sum[i] < hi;
+    inside_att += sum_att[i] > lo3 && sum_att[i] < hi3;
+    mean += sum[i] / (6.0 * runs * checks);
+    mean_att += sum_att[i] / (3.0 * runs * checks);
+  }
+  std::printf(
+      "NEES per state %.3f (attitude %.3f); inside the 95%% band at %d and %d of %d times\n", mean,
+      mean_att, inside, inside_att, checks);
+  EXPECT_GE(inside, static_cast<int>(0.85 * checks));
+  EXPECT_GE(inside_att, static_cast<int>(0.85 * checks));
+  EXPECT_NEAR(mean, 1.0, 0.15);
+  EXPECT_NEAR(mean_att, 1.0, 0.15);
+}
+
+TEST(Mekf, CovarianceStaysSymmetricPositiveDefinite) {
+  SensorNoise n;
+  n.gyro_arw = 1e-6;
+  n.gyro_bias_rw = 1e-9;
+  n.star_sigma = 1e-4;
+  MekfConfig c = config_for(n);
+  c.init_bias_sigma = 1e-2;  // a large initial uncertainty: the hard case for the update
+  int bad = 0;
+  run(n, c, 5, 5000, Vec3(3e-3, -2e-3, 1e-3),
+      [&](int, const Mekf& f, const RigidBody&, const Sensors&) {
+        const Mat6& p = f.covariance();
+        if ((p - p.transpose()).norm() != 0.0) ++bad;
+        if (Eigen::LLT<Mat6>(p).info() != Eigen::Success) ++bad;
+        if (p.diagonal().minCoeff() <= 0.0) ++bad;
+      });
+  EXPECT_EQ(bad, 0);
+}
+
+TEST(Mekf, BiasConvergesToTheTruth) {
+  SensorNoise n;
+  n.gyro_arw = 1e-6;  // case 5: P(dw) = 1e-12
+  n.gyro_bias_rw = 0.0;
+  n.star_sigma = 4.0 * std::sqrt(1e-8 / kDt);  // case 5: P(dq) = 1e-8, dtheta = 4 dq
+  MekfConfig c = config_for(n);
+  c.gyro_bias_rw = 1e-10;
+  const Vec3 bias(5e-5, -3e-5, 2e-5);  // ~10 deg/h
+  Vec3 err0 = Vec3::Zero(), err = Vec3::Zero(), sigma = Vec3::Zero(), sigma0 = Vec3::Zero();
+  run(n, c, 11, 18000, bias, [&](int k, const Mekf& f, const RigidBody&, const Sensors& s) {
+    if (k == 0) {
+      err0 = s.bias() - f.bias();
+      sigma0 = f.bias_sigma();
+    }
+    err = s.bias() - f.bias();
+    sigma = f.bias_sigma();
+  });
+  EXPECT_GT(err0.norm(), 5e-5);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(std::fabs(err(a)), 3.0 * sigma(a)) << "axis " << a;
+    EXPECT_LT(sigma(a), 0.01 * sigma0(a));
+  }
+  EXPECT_LT(err.norm(), 0.05 * bias.norm());
+}
+
+TEST(Mekf, GateRejectsAnOutlierAndCountsIt) {
+  SensorNoise n;
+  n.gyro_arw = 1e-6;
+  n.star_sigma = 1e-4;
+  Mekf f;
+  f.configure(config_for(n));
+  RigidBody body;
+  body.omega = Vec3(1e-3, 0, 0);
+  Sensors s(n, kDt, 3, Vec3::Zero());
+  int k = 0;
+  for (; k < 600; ++k) {
+    if (k > 0) body.step(kDt, Vec3::Zero());
+    f.update(input(k * kDt, s.gyro(body.omega), s.star(body.beta)));
+  }
+  const MekfCounters before = f.counters();
+  const double err_before = attitude_error(f.quaternion(), body.beta).norm();
+  // One star sample 2 degrees off.
+  body.step(kDt, Vec3::Zero());
+  const Vec4 outlier = test::qmul(body.beta, test::axis_angle(Vec3(1, -1, 0), 2.0 * M_PI / 180));
+  f.update(input(k * kDt, s.gyro(body.omega), outlier));
+  ++k;
+  EXPECT_EQ(f.counters().gated, before.gated + 1);
+  EXPECT_EQ(f.counters().updates, before.updates);
+  EXPECT_GT(f.innovation_chi2(), 16.27);
+  EXPECT_LT(attitude_error(f.quaternion(), body.beta).norm(), err_before + 5e-5);
+  // The next good sample is used.
+  body.step(kDt, Vec3::Zero());
+  f.update(input(k * kDt, s.gyro(body.omega), s.star(body.beta)));
+  EXPECT_EQ(f.counters().updates, before.updates + 1);
+  EXPECT_EQ(f.counters().gated, before.gated + 1);
+}
+
+TEST(Mekf, APersistentJumpReinitialisesAfterTheConfiguredRejections) {
+  SensorNoise n;
+  n.star_sigma = 1e-4;
+  MekfConfig c = config_for(n);
+  c.max_consecutive_rejects = 5;
+  Mekf f;
+  f.configure(c);
+  Sensors s(n, kDt, 4, Vec3::Zero());
+  const Vec4 truth = test::axis_angle(Vec3(0, 1, 0), 0.3);
+  for (int k = 0; k < 300; ++k) f.update(input(k * kDt, s.gyro(Vec3::Zero()), s.star(truth)));
+  const Vec4 moved = test::qmul(truth, test::axis_angle(Vec3(0, 0, 1), 0.2));
+  for (int k = 300; k < 305; ++k) f.update(input(k * kDt, s.gyro(Vec3::Zero()), s.star(moved)));
+  EXPECT_EQ(f.counters().reinitialised, 1u);
+  EXPECT_LT(attitude_error(f.quaternion(), moved).norm(), 1e-3);
+}
+
+TEST(Mekf, AHeldStarSampleIsNotUsedTwiceAndBadInputIsCounted) {
+  Mekf f;
+  f.configure(MekfConfig{});
+  const Vec4 b = test::axis_angle(Vec3(1, 0, 0), 0.1);
+  f.update(input(0.0, Vec3::Zero(), b));
+  f.update(input(0.1, Vec3::Zero(), b));
+  EXPECT_EQ(f.counters().updates, 1u);
+  f.update(input(0.1, Vec3::Zero(), b));  // same sample time
+  EXPECT_EQ(f.counters().updates, 1u);
+  MekfInput bad = input(0.2, Vec3(5.0, 0, 0), 2.0 * b);  // rate too high, quaternion not unit
+  f.update(bad);
+  EXPECT_EQ(f.counters().rejected_input, 1u);
+  EXPECT_EQ(f.counters().updates, 1u);
+  EXPECT_LT(f.omega().norm(), 1e-15);  // the last good gyro sample is held
+}
+
+// Per-axis steady state of the attitude/bias filter at rest (Farrenkopf 1978): the fixed point of
+// the discrete Riccati recursion for x = [theta, b], written out independently of the MEKF.
+double farrenkopf_post_update_sigma(double arw, double brw, double star, double dt) {
+  double p11 = star * star, p12 = 0.0, p22 = 1e-6;
+  for (int it = 0; it < 2000000; ++it) {
+    // Predict: Phi = [[1, -dt], [0, 1]], Q of the gyro model.
+    const double m11 =
+        p11 - 2 * dt * p12 + dt * dt * p22 + arw * arw * dt + brw * brw * dt * dt * dt / 3;
+    const double m12 = p12 - dt * p22 - 0.5 * brw * brw * dt * dt;
+    const double m22 = p22 + brw * brw * dt;
+    // Update with H = [1 0].
+    const double s = m11 + star * star;
+    const double n11 = m11 - m11 * m11 / s, n12 = m12 - m11 * m12 / s, n22 = m22 - m12 * m12 / s;
+    const bool done = std::fabs(n11 - p11) < 1e-16 * p11 && std::fabs(n22 - p22) <= 1e-16 * p22;
+    p11 = n11;
+    p12 = n12;
+    p22 = n22;
+    if (done) break;
+  }
+  return std::sqrt(p11);
+}
+
+TEST(Mekf, HoldAttitudeErrorMatchesFarrenkopfSteadyState) {
+  // Case 5 noise (SPEC §5) with a small bias random walk, body at rest (HOLD).
+  SensorNoise n;
+  n.gyro_arw = std::sqrt(1e-12);
+  n.gyro_bias_rw = 1e-9;
+  n.star_sigma = 4.0 * std::sqrt(1e-8 / kDt);
+  MekfConfig c = config_for(n);
+  const double analytic =
+      farrenkopf_post_update_sigma(n.gyro_arw, n.gyro_bias_rw, n.star_sigma, kDt);
+  Mekf f;
+  f.configure(c);
+  Sensors s(n, kDt, 21, Vec3(1e-6, -2e-6, 0.5e-6));
+  const Vec4 truth = test::axis_angle(Vec3(0.3, -0.2, 1.0), 0.4);
+  double sq = 0.0;
+  int count = 0;
+  const int ticks = 60000;
+  for (int k = 0; k < ticks; ++k) {
+    s.step_bias();
+    f.update(input(k * kDt, s.gyro(Vec3::Zero()), s.star(truth)));
+    if (k >= 20000) {
+      sq += attitude_error(f.quaternion(), truth).squaredNorm();
+      ++count;
+    }
+  }
+  const double empirical = std::sqrt(sq / (3.0 * count));
+  const double reported = f.attitude_sigma().mean();
+  std::printf("HOLD attitude sigma: empirical %.4g rad, filter %.4g rad, Farrenkopf %.4g rad\n",
+              empirical, reported, analytic);
+  EXPECT_NEAR(reported, analytic, 0.01 * analytic);
+  EXPECT_NEAR(empirical, analytic, 0.25 * analytic);
+}
+
+}  // namespace
+}  // namespace rocksteady::gnc
