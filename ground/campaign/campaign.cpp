@@ -1,4 +1,6 @@
 #include "ground/campaign/campaign.hpp"
+
+#include <nlohmann/json.hpp>
 #include "ground/campaign/fsw_flight_side.hpp"
 
 #include <unistd.h>
@@ -89,6 +91,48 @@ void write_results_csv(const std::string& path, const std::vector<RunResult>& re
         << csv_field(r.fuel_at_t_q_kg, 4) << "," << (ran ? fmt(r.total_fuel_kg, 4) : "") << ","
         << (ran ? fmt_g(r.max_rate_rad_s) : "") << "\n";
   }
+}
+
+void write_results_json(const std::string& path, const CampaignReport& rep) {
+  auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+  };
+  nlohmann::json runs = nlohmann::json::array();
+  for (const RunResult& r : rep.results) {
+    const bool ran = r.status == RunStatus::kOk;
+    runs.push_back({{"case", r.case_name},
+                    {"case_number", r.case_number},
+                    {"strategy", r.strategy},
+                    {"status", to_string(r.status)},
+                    {"note", r.note},
+                    {"t_omega_conv_s", opt(r.t_omega_conv_s)},
+                    {"fuel_at_t_omega_kg", opt(r.fuel_at_t_omega_kg)},
+                    {"t_q_conv_s", opt(r.t_q_conv_s)},
+                    {"fuel_at_t_q_kg", opt(r.fuel_at_t_q_kg)},
+                    {"total_fuel_kg", ran ? nlohmann::json(r.total_fuel_kg) : nlohmann::json(nullptr)},
+                    {"max_rate_rad_s", ran ? nlohmann::json(r.max_rate_rad_s) : nlohmann::json(nullptr)},
+                    {"final_mode", r.final_mode},
+                    {"final_rate_rad_s", r.final_rate_rad_s},
+                    {"final_q_error", r.final_q_error},
+                    {"fuel_estimate_kg", r.fuel_hat_kg},
+                    {"ticks", r.ticks},
+                    {"allocator_saturated_ticks", r.saturated_ticks},
+                    {"plant_clipped_ticks", r.clipped_ticks},
+                    {"simulated_s", r.sim_s},
+                    {"wall_s", r.wall_s},
+                    {"plan_wall_s", r.plan_wall_s},
+                    {"timeseries", r.timeseries_path},
+                    {"plot", r.plot_path}});
+  }
+  const nlohmann::json doc{{"cases", rep.cases},
+                           {"strategies", rep.strategies},
+                           {"threads", rep.threads},
+                           {"plan_wall_s", rep.plan_wall_s},
+                           {"closed_loop_wall_s", rep.sim_wall_s},
+                           {"simulated_s", rep.simulated_s},
+                           {"runs", runs}};
+  std::ofstream out = open_out(path);
+  out << doc.dump(2) << "\n";
 }
 
 void write_runs_csv(const std::string& path, const std::vector<RunResult>& results) {
@@ -280,8 +324,16 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
       req.model = setups[c].flight;
       plant::Plant probe(setups[c].truth);  // the flight software's first measurement
       req.omega_init = probe.read_sensors().gyro.rate;
+      if (spec.progress != ProgressMode::kOff) {
+        log << "planning " << (c + 1) << "/" << setups.size() << ": " << setups[c].case_name
+            << " ..." << std::flush;
+      }
       const PlanOutcome o = source.plan(req);
       plans[c] = Plan{o.table, o.note, o.wall_s};
+      if (spec.progress != ProgressMode::kOff) {
+        log << " " << (o.table ? "done" : "no plan") << " (" << fmt(o.wall_s, 1) << " s"
+            << (o.note.empty() ? "" : ": " + o.note) << ")\n";
+      }
     }
   }
   rep.plan_wall_s = seconds_since(plan0);
@@ -424,8 +476,10 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
   rep.results_csv = (out_dir / "results.csv").string();
   rep.results_md = (out_dir / "results.md").string();
   rep.runs_csv = (out_dir / "runs.csv").string();
+  rep.results_json = (out_dir / "results.json").string();
   write_results_csv(rep.results_csv, rep.results);
   write_runs_csv(rep.runs_csv, rep.results);
+  write_results_json(rep.results_json, rep);
   std::ostringstream pre;
   pre << "Mission `" << spec.mission_file << "`, GNC `" << spec.gnc_file
       << "`. Trajectory source: " << source.name() << ".  \n" << benchmark_line(rep) << ".";

@@ -49,6 +49,7 @@ struct CampaignReport {
   std::string results_csv;
   std::string results_md;
   std::string runs_csv;
+  std::string results_json;  // the same results (and run details) as JSON
 };
 
 // Loads every file first (a ConfigError stops the campaign before any run), plans the trajectories
@@ -64,6 +65,8 @@ void write_results_markdown(const std::string& path, const std::vector<RunResult
                             const std::vector<std::string>& strategies,
                             const std::string& preamble);
 void write_runs_csv(const std::string& path, const std::vector<RunResult>& results);
+// results.csv and runs.csv together as one JSON document (nlohmann-json); NC is null.
+void write_results_json(const std::string& path, const CampaignReport& rep);
 void write_timeseries_csv(const std::string& path, const RunResult& result);
 // gnuplot script + PNG next to the series; returns false (with the reason) if gnuplot failed.
 bool write_plot(const std::string& dir, const RunResult& result, std::string& error);

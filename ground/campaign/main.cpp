@@ -4,9 +4,11 @@
 //   rocksteady-campaign dispersion configs/dispersions/FILE.yaml [--draw N] [--backend local|slurm]
 //   rocksteady-campaign collect DIR
 // Exit status: 0 done (NC is a result, not a failure); 1 a run failed; 2 bad configuration or
-// command line.
+// command line (also for CLI11's own parse errors). Configs are found from any directory
+// (ground/config/config_dir.hpp); the plan cache lives under -o unless --plan-cache says otherwise.
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -15,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ground/campaign/campaign.hpp"
+#include "ground/config/config_dir.hpp"
 #include "config/config_error.hpp"
 #include "ground/dispersion/cli.hpp"
 
@@ -33,8 +36,10 @@ std::vector<std::string> split(const std::string& s, char sep) {
   return out;
 }
 
-// "1-7", "1,4,7", or file paths (anything ending in .yaml).
-std::vector<std::string> case_files(const std::string& spec, const std::string& config_dir) {
+// "1-7", "1,4,7", or file paths (anything ending in .yaml). `option` is the option as the user
+// typed it (--case or --cases), named in every error.
+std::vector<std::string> case_files(const std::string& spec, const std::string& config_dir,
+                                    const std::string& option) {
   std::vector<std::string> files;
   for (const std::string& item : split(spec, ',')) {
     if (item.size() > 5 && item.substr(item.size() - 5) == ".yaml") {
@@ -47,11 +52,15 @@ std::vector<std::string> case_files(const std::string& spec, const std::string& 
       lo = std::stoi(item.substr(0, dash));
       hi = dash == std::string::npos ? lo : std::stoi(item.substr(dash + 1));
     } catch (const std::exception&) {
-      throw CLI::ValidationError("--cases", "'" + item + "' is not a case number, range or file");
+      throw CLI::ValidationError(option, "'" + item + "' is not a case number, range or file");
     }
-    if (lo < 1 || hi < lo) throw CLI::ValidationError("--cases", "bad range '" + item + "'");
+    if (lo < 1 || hi < lo) throw CLI::ValidationError(option, "bad case number or range '" + item + "'");
     for (int n = lo; n <= hi; ++n) {
-      files.push_back(config_dir + "/cases/case" + std::to_string(n) + ".yaml");
+      try {
+        files.push_back(config::case_file(config_dir, std::to_string(n), option));
+      } catch (const std::exception& e) {
+        throw CLI::ValidationError(option, e.what());
+      }
     }
   }
   return files;
@@ -80,6 +89,19 @@ std::vector<Strategy> strategies(const std::string& spec) {
   return out;
 }
 
+// A number > 0 (CLI11's PositiveNumber names the whole double range in its message).
+const CLI::Validator kPositive(
+    [](std::string& v) -> std::string {
+      try {
+        std::size_t used = 0;
+        const double x = std::stod(v, &used);
+        if (used == v.size() && x > 0.0 && x < 1e300) return "";
+      } catch (const std::exception&) {
+      }
+      return "must be a number > 0, got '" + v + "'";
+    },
+    "POSITIVE");
+
 std::string opt_s(const std::optional<double>& v, const char* unit, int d) {
   if (!v) return "NC";
   char buf[64];
@@ -92,11 +114,14 @@ std::string opt_s(const std::optional<double>& v, const char* unit, int d) {
 int main(int argc, char** argv) {
   CLI::App app{"Rocksteady closed-loop runs and campaigns (plant + flight core in one process)"};
   app.require_subcommand(1);
+  app.footer("Exit status (every subcommand): 0 done (NC is a result, not a failure), 1 a run "
+             "failed, 2 usage or configuration error.");
   app.fallthrough();  // --config-dir, --mission, --gnc also after the subcommand
-  std::string config_dir = "configs";
+  std::string config_dir_arg;
   std::string mission, gnc_file;
-  app.add_option("--config-dir", config_dir, "folder with mission.yaml, gnc.yaml, cases/")
-      ->capture_default_str();
+  app.add_option("--config-dir", config_dir_arg,
+                 "folder with mission.yaml, gnc.yaml, cases/ (default: $ROCKSTEADY_CONFIG_DIR, "
+                 "next to the program, or ./configs)");
   app.add_option("--mission", mission, "mission file (default <config-dir>/mission.yaml)");
   app.add_option("--gnc", gnc_file, "GNC file (default <config-dir>/gnc.yaml)");
 
@@ -107,7 +132,7 @@ int main(int argc, char** argv) {
   std::string strategy_arg = "ntcl+dpd_ref";
   bool no_plots = false, no_series = false, quiet = false, progress = false;
   std::string flight_arg = "app";
-  std::string plan_cache = "out/plans";
+  std::string plan_cache = "\x01";  // not given: <out>/plans
 
   CLI::App* run = app.add_subcommand("run", "one case with one strategy");
   run->add_option("--case", case_arg, "case number or case file")->capture_default_str();
@@ -121,9 +146,11 @@ int main(int argc, char** argv) {
   camp->add_option("--jobs,-j", spec.jobs, "worker threads (0: one per core)")->capture_default_str();
   for (CLI::App* sub : {run, camp}) {
     sub->add_option("--out,-o", spec.out_dir, "output folder");
-    sub->add_option("--duration", spec.duration_s, "simulated seconds (default: the case's)");
+    sub->add_option("--duration", spec.duration_s, "simulated seconds (default: the case's)")
+        ->check(kPositive);
     sub->add_option("--log-interval", spec.log_interval_s,
-                    "time-series interval, s (default: duration / 5000)");
+                    "time-series interval, s (default: duration / 5000)")
+        ->check(kPositive);
     sub->add_flag("--no-plots", no_plots, "skip the PNG plots");
     sub->add_flag("--no-timeseries", no_series, "skip the time series (and the plots)");
     sub->add_flag("--quiet,-q", quiet, "no progress display");
@@ -133,19 +160,28 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"app", "core"}))
         ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
-                    "folder of verified trajectory files reused per model and case ('' to replan)")
-        ->capture_default_str();
+                    "folder of verified trajectory files reused per model and case (default "
+                    "<out>/plans; '' to replan)");
   }
   rocksteady::dispersion::CliState disp;
   rocksteady::dispersion::add_commands(app, disp);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;  // one convention for every tool: 2 = usage or configuration
+  }
+  const config::ConfigDir dir = config::find_config_dir(config_dir_arg);
+  if (dir.path.empty() && (mission.empty() || gnc_file.empty())) {
+    std::cerr << "rocksteady-campaign: " << dir.error << "\n";
+    return 2;
+  }
+  const std::string config_dir = dir.path;
   if (mission.empty()) mission = config_dir + "/mission.yaml";
   if (gnc_file.empty()) gnc_file = config_dir + "/gnc.yaml";
   if (rocksteady::dispersion::parsed(disp)) return rocksteady::dispersion::run(disp, mission, gnc_file);
 
   spec.use_flight_app = flight_arg == "app";
-  if (mission.empty()) mission = config_dir + "/mission.yaml";
-  if (gnc_file.empty()) gnc_file = config_dir + "/gnc.yaml";
   spec.mission_file = mission;
   spec.gnc_file = gnc_file;
   spec.write_plots = !no_plots && !no_series;
@@ -155,17 +191,19 @@ int main(int argc, char** argv) {
   const bool single = run->parsed();
   try {
     if (single) {
-      spec.case_files = case_files(case_arg, config_dir);
+      spec.case_files = case_files(case_arg, config_dir, "--case");
       spec.strategies = strategies(strategy_arg);
       if (spec.out_dir == "out/campaign") spec.out_dir = "out/run";
       spec.jobs = 1;
     } else {
-      spec.case_files = case_files(cases_arg, config_dir);
+      spec.case_files = case_files(cases_arg, config_dir, "--cases");
       spec.strategies = strategies(strategies_arg);
     }
   } catch (const CLI::Error& e) {
-    return app.exit(e);
+    app.exit(e);
+    return 2;
   }
+  if (plan_cache == "\x01") plan_cache = (std::filesystem::path(spec.out_dir) / "plans").string();
 
   const auto source = campaign::make_default_trajectory_source(plan_cache);
   campaign::CampaignReport rep;
@@ -204,7 +242,9 @@ int main(int argc, char** argv) {
     }
     if (!r.note.empty()) std::cout << "  note: " << r.note << "\n";
   } else {
-    std::cout << "results: " << rep.results_csv << "\n"
+    std::ifstream table(rep.results_md);
+    std::cout << table.rdbuf() << "\n";
+    std::cout << "results: " << rep.results_csv << " (and " << rep.results_json << ")\n"
               << "table:   " << rep.results_md << "\n"
               << "runs:    " << rep.runs_csv << "\n";
   }
