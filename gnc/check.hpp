@@ -3,6 +3,8 @@
 // tick-free configure() without exceptions or heap.
 #pragma once
 
+#include <cmath>
+
 namespace rocksteady::gnc {
 
 struct Check {
@@ -10,5 +12,9 @@ struct Check {
   const char* field{""};   // the first offending field, e.g. "mode.sensor_timeout"
   const char* reason{""};  // why it was rejected
 };
+
+// The range tests every validator uses.
+inline bool finite_positive(double v) { return std::isfinite(v) && v > 0.0; }
+inline bool finite_non_negative(double v) { return std::isfinite(v) && v >= 0.0; }
 
 }  // namespace rocksteady::gnc

@@ -32,7 +32,6 @@ namespace {
 
 ParamCheck bad(const char* field, const char* reason) { return ParamCheck{false, field, reason}; }
 
-bool positive_finite(double v) { return std::isfinite(v) && v > 0.0; }
 
 // Returns a failed check for `field` if m is not SPD.
 bool check_spd(const Mat3& m, const char* field, ParamCheck& out) {
@@ -51,18 +50,18 @@ bool check_spd(const Mat3& m, const char* field, ParamCheck& out) {
 
 ParamCheck validate(const GncParams& p) {
   ParamCheck r;
-  if (!positive_finite(p.dt)) return bad("dt", "GNC period must be positive and finite");
+  if (!finite_positive(p.dt)) return bad("dt", "GNC period must be positive and finite");
   if (p.dt > 10.0) return bad("dt", "GNC period above 10 s");
 
   const MassProperties& m = p.mass_hat;
-  if (!positive_finite(m.m_sc)) return bad("mass_hat.m_sc", "mass must be positive and finite");
+  if (!finite_positive(m.m_sc)) return bad("mass_hat.m_sc", "mass must be positive and finite");
   if (!m.r_scm_so.allFinite()) return bad("mass_hat.r_scm_so", "non-finite value");
   if (!m.r_so_bcm.allFinite()) return bad("mass_hat.r_so_bcm", "non-finite value");
   if (!check_spd(m.j_sc, "mass_hat.j_sc", r)) return r;
   if (!check_spd(m.j_ast, "mass_hat.j_ast", r)) return r;
   if (!check_spd(total_inertia(m), "mass_hat (J_tot, Eq. 1)", r)) return r;
 
-  if (!positive_finite(p.rcs.u_max)) return bad("rcs.u_max", "must be positive and finite");
+  if (!finite_positive(p.rcs.u_max)) return bad("rcs.u_max", "must be positive and finite");
   for (int k = 0; k < kPods; ++k) {
     if (!p.rcs.pod_position[k].allFinite()) return bad("rcs.pod_position", "non-finite value");
   }
@@ -97,15 +96,15 @@ ParamCheck validate(const GncParams& p) {
       !check_spd(p.integral.k_i, "integral.K_I", r)) {
     return r;
   }
-  if (!positive_finite(p.integral.integral_limit_nm)) {
+  if (!finite_positive(p.integral.integral_limit_nm)) {
     return bad("integral.integral_limit", "must be positive and finite");
   }
   if (!check_spd(p.adaptive.k, "adaptive.K", r) ||
       !check_spd(p.adaptive.lambda, "adaptive.Lambda", r)) {
     return r;
   }
-  if (!positive_finite(p.adaptive.gamma)) return bad("adaptive.Gamma", "must be positive");
-  if (!positive_finite(p.adaptive.eig_floor_ratio) || p.adaptive.eig_floor_ratio >= 1.0) {
+  if (!finite_positive(p.adaptive.gamma)) return bad("adaptive.Gamma", "must be positive");
+  if (!finite_positive(p.adaptive.eig_floor_ratio) || p.adaptive.eig_floor_ratio >= 1.0) {
     return bad("adaptive.eig_floor_ratio", "must be in (0, 1)");
   }
   if (!std::isfinite(p.adaptive.eig_ceiling_ratio) || p.adaptive.eig_ceiling_ratio <= 1.0) {
@@ -113,15 +112,15 @@ ParamCheck validate(const GncParams& p) {
   }
   if (!check_spd(p.so3.k, "so3.K", r) || !check_spd(p.so3.lambda, "so3.Lambda", r)) return r;
   if (!check_spd(p.dpd.k_d, "dpd.K_d", r)) return r;
-  if (!positive_finite(p.dpd.k_p)) return bad("dpd.k_p", "must be positive and finite");
+  if (!finite_positive(p.dpd.k_p)) return bad("dpd.k_p", "must be positive and finite");
 
   const GuidanceParams& g = p.guidance;
-  if (!positive_finite(g.omega_switch)) return bad("guidance.omega_switch", "must be positive");
-  if (!positive_finite(g.eps_trans)) return bad("guidance.eps_trans", "must be positive");
+  if (!finite_positive(g.omega_switch)) return bad("guidance.omega_switch", "must be positive");
+  if (!finite_positive(g.eps_trans)) return bad("guidance.eps_trans", "must be positive");
   if (g.omega_switch >= g.eps_trans) {
     return bad("guidance.omega_switch", "must be below eps_trans");
   }
-  if (!positive_finite(g.k_qd)) return bad("guidance.k_qd", "must be positive");
+  if (!finite_positive(g.k_qd)) return bad("guidance.k_qd", "must be positive");
   if (!g.q_final.allFinite() || g.q_final.norm() > 1.0) {
     return bad("guidance.q_final", "must be a finite MRP with |q| <= 1");
   }
@@ -133,7 +132,7 @@ ParamCheck validate(const GncParams& p) {
   if (e.kind != EstimatorKind::kPassThrough && e.kind != EstimatorKind::kFilter) {
     return bad("estimator.kind", "unknown estimator");
   }
-  if (!positive_finite(e.omega_c)) return bad("estimator.omega_c", "must be positive");
+  if (!finite_positive(e.omega_c)) return bad("estimator.omega_c", "must be positive");
   if (e.omega_c * p.dt > 3.14159265358979323846) {
     return bad("estimator.omega_c", "cutoff above the Nyquist rate of the GNC period");
   }
@@ -141,8 +140,8 @@ ParamCheck validate(const GncParams& p) {
     return bad("estimator.predict_substeps", "must be in [1, 100]");
   }
 
-  if (!positive_finite(e.gyro_max_rate)) return bad("estimator.gyro_max_rate", "must be positive");
-  if (!positive_finite(e.quat_norm_tolerance) || e.quat_norm_tolerance >= 1.0) {
+  if (!finite_positive(e.gyro_max_rate)) return bad("estimator.gyro_max_rate", "must be positive");
+  if (!finite_positive(e.quat_norm_tolerance) || e.quat_norm_tolerance >= 1.0) {
     return bad("estimator.quat_norm_tolerance", "must be in (0, 1)");
   }
 
@@ -150,11 +149,11 @@ ParamCheck validate(const GncParams& p) {
     return bad("mode.initial", "unknown mode");
   }
   if (p.mode.initial == Mode::kTrack) return bad("mode.initial", "cannot boot into TRACK");
-  if (!positive_finite(p.mode.sensor_timeout_s) || p.mode.sensor_timeout_s < p.dt) {
+  if (!finite_positive(p.mode.sensor_timeout_s) || p.mode.sensor_timeout_s < p.dt) {
     return bad("mode.sensor_timeout", "must be at least one GNC period");
   }
-  if (!positive_finite(p.isp_s)) return bad("isp", "must be positive");
-  if (!positive_finite(p.g0)) return bad("g0", "must be positive");
+  if (!finite_positive(p.isp_s)) return bad("isp", "must be positive");
+  if (!finite_positive(p.g0)) return bad("g0", "must be positive");
   return r;
 }
 

@@ -5,18 +5,13 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "gnc/check.hpp"
 #include "gnc/math/rotation.hpp"
 
 namespace rocksteady::gnc {
 
 namespace {
 
-bool finite_positive(double v) {
-  return std::isfinite(v) && v > 0.0;
-}
-bool finite_non_negative(double v) {
-  return std::isfinite(v) && v >= 0.0;
-}
 
 // Weighted recursive least squares with a vector measurement (I7): Phi theta = y + v,
 // cov(v) = R (the window noise plus what the other groups' uncertainty contributes).

@@ -4,18 +4,13 @@
 
 #include <Eigen/LU>
 
+#include "gnc/check.hpp"
 #include "gnc/math/rotation.hpp"
 
 namespace rocksteady::gnc {
 
 namespace {
 
-bool finite_positive(double v) {
-  return std::isfinite(v) && v > 0.0;
-}
-bool finite_non_negative(double v) {
-  return std::isfinite(v) && v >= 0.0;
-}
 
 // Rotation increment of a body rate held over dt, as a quaternion (scalar last): exact for a
 // constant rate, R(t + dt) = R(t) exp(S(omega) dt) (Eq. 5).
