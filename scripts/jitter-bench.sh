@@ -95,16 +95,5 @@ export B_FSW="$fsw" B_PLANT="$plant" B_SECS="$secs" B_RATES="$rates" B_OUT="$out
 } > "$out/table.md"
 cat "$out/table.md"
 if [[ -n "$readme" ]]; then
-  python3 - "$readme" "$out/table.md" <<'PY'
-import sys
-path, table = sys.argv[1], open(sys.argv[2]).read()
-text = open(path).read()
-b, e = "<!-- jitter-bench:begin -->", "<!-- jitter-bench:end -->"
-if b not in text or e not in text:
-    sys.exit(f"jitter-bench.sh: {path} has no {b} ... {e} block")
-head, rest = text.split(b, 1)
-_, tail = rest.split(e, 1)
-open(path, "w").write(head + b + "\n" + table + e + tail)
-print(f"jitter-bench.sh: table written into {path}")
-PY
+  "$(dirname "$0")/put-block.py" "$readme" jitter-bench "$out/table.md"
 fi

@@ -20,19 +20,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
 # Replace the text between a pair of markers in a file.
-put() {  # file name text-file
-  python3 - "$1" "$2" "$3" <<'PY'
-import sys, re
-path, name, text = sys.argv[1], sys.argv[2], open(sys.argv[3]).read().rstrip("\n")
-s = open(path).read()
-begin, end = f"<!-- figures:{name}:begin -->", f"<!-- figures:{name}:end -->"
-if begin not in s or end not in s:
-    sys.exit(f"{path}: markers for '{name}' not found")
-pre, rest = s.split(begin, 1)
-_, post = rest.split(end, 1)
-open(path, "w").write(pre + begin + "\n" + text + "\n" + end + post)
-PY
-}
+put() { scripts/put-block.py "$1" "figures:$2" "$3" > /dev/null; }
 
 machine="$(nproc) cores, $(date -u +%Y-%m-%d)"
 

@@ -112,26 +112,6 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
               id.counters().inertia_refused);
 }
 
-// Per-axis steady state of the attitude/bias filter at rest (Farrenkopf 1978), the fixed point of
-// the discrete Riccati recursion (same model as the MEKF's, written out independently).
-double farrenkopf(double arw, double brw, double star, double dt) {
-  double p11 = star * star, p12 = 0.0, p22 = 1e-12;
-  for (int it = 0; it < 5000000; ++it) {
-    const double m11 =
-        p11 - 2 * dt * p12 + dt * dt * p22 + arw * arw * dt + brw * brw * dt * dt * dt / 3;
-    const double m12 = p12 - dt * p22 - 0.5 * brw * brw * dt * dt;
-    const double m22 = p22 + brw * brw * dt;
-    const double s = m11 + star * star;
-    const double n11 = m11 - m11 * m11 / s, n12 = m12 - m11 * m12 / s, n22 = m22 - m12 * m12 / s;
-    const bool done = std::fabs(n11 - p11) < 1e-15 * p11 && std::fabs(n22 - p22) <= 1e-15 * p22;
-    p11 = n11;
-    p12 = n12;
-    p22 = n22;
-    if (done) break;
-  }
-  return std::sqrt(p11);
-}
-
 void hold(const std::string& dir, int case_number, double gyro_bias, double bias_rw) {
   config::RunSetup run =
       config::load_run(dir + "/mission.yaml", dir + "/gnc.yaml",
@@ -187,7 +167,7 @@ void hold(const std::string& dir, int case_number, double gyro_bias, double bias
     }
     plant.advance(Vec8::Zero(), false);
   }
-  const double analytic = farrenkopf(mc.gyro_arw, mc.gyro_bias_rw, mc.star_sigma, mc.dt);
+  const double analytic = test::farrenkopf_post_update_sigma(mc.gyro_arw, mc.gyro_bias_rw, mc.star_sigma, mc.dt);
   std::printf(
       "case %d HOLD bias %.1e rw %.1e | MEKF attitude sigma %.3e rad (max %.2e), Farrenkopf %.3e "
       "(ratio %.3f); rate RMS %.2e rad/s | SPEC 6 filter attitude sigma %.3e, rate RMS %.2e | bias "

@@ -80,4 +80,26 @@ class Sensors {
   V3 bias_;
 };
 
+// Per-axis steady state of the attitude/bias filter at rest (Farrenkopf 1978): the fixed point of
+// the discrete Riccati recursion for x = [theta, b], written out independently of the MEKF.
+inline double farrenkopf_post_update_sigma(double arw, double brw, double star, double dt) {
+  double p11 = star * star, p12 = 0.0, p22 = 1e-6;
+  for (int it = 0; it < 2000000; ++it) {
+    // Predict: Phi = [[1, -dt], [0, 1]], Q of the gyro model.
+    const double m11 =
+        p11 - 2 * dt * p12 + dt * dt * p22 + arw * arw * dt + brw * brw * dt * dt * dt / 3;
+    const double m12 = p12 - dt * p22 - 0.5 * brw * brw * dt * dt;
+    const double m22 = p22 + brw * brw * dt;
+    // Update with H = [1 0].
+    const double s = m11 + star * star;
+    const double n11 = m11 - m11 * m11 / s, n12 = m12 - m11 * m12 / s, n22 = m22 - m12 * m12 / s;
+    const bool done = std::fabs(n11 - p11) < 1e-16 * p11 && std::fabs(n22 - p22) <= 1e-16 * p22;
+    p11 = n11;
+    p12 = n12;
+    p22 = n22;
+    if (done) break;
+  }
+  return std::sqrt(p11);
+}
+
 }  // namespace rocksteady::test

@@ -289,27 +289,6 @@ TEST(Mekf, AHeldStarSampleIsNotUsedTwiceAndBadInputIsCounted) {
   EXPECT_LT(f.omega().norm(), 1e-15);  // the last good gyro sample is held
 }
 
-// Per-axis steady state of the attitude/bias filter at rest (Farrenkopf 1978): the fixed point of
-// the discrete Riccati recursion for x = [theta, b], written out independently of the MEKF.
-double farrenkopf_post_update_sigma(double arw, double brw, double star, double dt) {
-  double p11 = star * star, p12 = 0.0, p22 = 1e-6;
-  for (int it = 0; it < 2000000; ++it) {
-    // Predict: Phi = [[1, -dt], [0, 1]], Q of the gyro model.
-    const double m11 =
-        p11 - 2 * dt * p12 + dt * dt * p22 + arw * arw * dt + brw * brw * dt * dt * dt / 3;
-    const double m12 = p12 - dt * p22 - 0.5 * brw * brw * dt * dt;
-    const double m22 = p22 + brw * brw * dt;
-    // Update with H = [1 0].
-    const double s = m11 + star * star;
-    const double n11 = m11 - m11 * m11 / s, n12 = m12 - m11 * m12 / s, n22 = m22 - m12 * m12 / s;
-    const bool done = std::fabs(n11 - p11) < 1e-16 * p11 && std::fabs(n22 - p22) <= 1e-16 * p22;
-    p11 = n11;
-    p12 = n12;
-    p22 = n22;
-    if (done) break;
-  }
-  return std::sqrt(p11);
-}
 
 TEST(Mekf, HoldAttitudeErrorMatchesFarrenkopfSteadyState) {
   // Case 5 noise (SPEC §5) with a small bias random walk, body at rest (HOLD).
@@ -319,7 +298,7 @@ TEST(Mekf, HoldAttitudeErrorMatchesFarrenkopfSteadyState) {
   n.star_sigma = 4.0 * std::sqrt(1e-8 / kDt);
   MekfConfig c = config_for(n);
   const double analytic =
-      farrenkopf_post_update_sigma(n.gyro_arw, n.gyro_bias_rw, n.star_sigma, kDt);
+      test::farrenkopf_post_update_sigma(n.gyro_arw, n.gyro_bias_rw, n.star_sigma, kDt);
   Mekf f;
   f.configure(c);
   Sensors s(n, kDt, 21, Vec3(1e-6, -2e-6, 0.5e-6));

@@ -93,16 +93,5 @@ unshare -rn bash -c '
 cat "$out/table.md"
 [[ -f "$out/jitter" ]] && cat "$out/jitter"
 if [[ -n "$readme" ]]; then
-  python3 - "$readme" "$out/table.md" <<'PY'
-import sys
-path, table = sys.argv[1], open(sys.argv[2]).read()
-text = open(path).read()
-b, e = "<!-- pil-bench:begin -->", "<!-- pil-bench:end -->"
-if b not in text or e not in text:
-    sys.exit(f"bench.sh: {path} has no {b} ... {e} block")
-head, rest = text.split(b, 1)
-_, tail = rest.split(e, 1)
-open(path, "w").write(head + b + "\n" + table + e + tail)
-print(f"bench.sh: table written into {path}")
-PY
+  "$(dirname "$0")/../../scripts/put-block.py" "$readme" pil-bench "$out/table.md"
 fi
