@@ -2,6 +2,9 @@
 // and each control law alone. Measures and prints; never asserts a time.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
+
 #include "gnc/control/laws.hpp"
 #include "gnc/gnc.hpp"
 #include "gnc/math/rotation.hpp"
@@ -50,6 +53,52 @@ BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_damping, LawId::kNtcl, Mode::kDetumbl
 BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_hold, LawId::kNtcl, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, so3_hold, LawId::kSo3, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
+
+// Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (joint, study
+// priors, 20 s windows, automatic adoption), fault-free L1 allocation, NTCL in DETUMBLE. The rate
+// changes every tick so the identifier cycles through its windows. Reports the mean per tick and,
+// as a counter, the worst single tick over the run.
+void BM_GncTickAllModules(benchmark::State& state) {
+  GncParams p = study_gnc_params(200.0);
+  p.law = LawId::kNtcl;
+  p.allocator = AllocatorKind::kL1;
+  p.estimator.kind = EstimatorKind::kMekf;
+  p.mekf.gyro_arw = 1e-6;
+  p.mekf.star_sigma = 4e-4;
+  p.identification.enabled = true;
+  p.identification.adopt = ModelAdoption::kAuto;
+  p.mode.auto_hold = false;
+  Gnc gnc;
+  if (!gnc.init(p).ok) {
+    state.SkipWithError("parameters rejected");
+    return;
+  }
+  GncOutput out;
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  double t = 0.0;
+  gnc.step(study_sample(t), c, out);
+  c = GncCommands{};
+  double worst_ns = 0.0;
+  long k = 0;
+  for (auto _ : state) {
+    t += p.dt;
+    SensorSample s = study_sample(t);
+    s.gyro_rate *= 1.0 - 1e-5 * static_cast<double>(k % 10000);
+    ++k;
+    const auto t0 = std::chrono::steady_clock::now();
+    gnc.step(s, c, out);
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(out);
+    worst_ns = std::max(worst_ns, static_cast<double>(
+                                      std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count()));
+  }
+  state.counters["worst_tick_us"] = worst_ns * 1e-3;
+  state.counters["id_windows"] = gnc.identifier().counters().windows;
+  state.SetLabel(to_string(gnc.mode()));
+}
+BENCHMARK(BM_GncTickAllModules)->Iterations(200000);
 
 void BM_LawAlone(benchmark::State& state, LawId law) {
   const GncParams p = study_gnc_params(200.0);

@@ -26,6 +26,8 @@ const char* to_string(Opcode op) {
       return "PARAM_DISCARD";
     case Opcode::kParamDump:
       return "PARAM_DUMP";
+    case Opcode::kParamLoadIdentified:
+      return "PARAM_LOAD_IDENTIFIED";
   }
   return "?";
 }
@@ -136,6 +138,12 @@ const char* to_string(EventId id) {
       return "overrun_safe";
     case EventId::kParamsDumped:
       return "params_dumped";
+    case EventId::kModelAdopted:
+      return "model_adopted";
+    case EventId::kModelRefused:
+      return "model_refused";
+    case EventId::kModelLoaded:
+      return "model_loaded";
   }
   return "?";
 }

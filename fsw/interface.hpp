@@ -30,8 +30,9 @@ enum class Opcode : std::int32_t {
   kParamActivate = 8,   // no arguments                inactive -> active at the next tick
   kParamDiscard = 9,    // no arguments                inactive := active
   kParamDump = 10,      // no arguments                the active table -> telemetry (ParamDump)
+  kParamLoadIdentified = 11,  // no arguments          the identified model -> the inactive table
 };
-inline constexpr int kOpcodeCount = 11;
+inline constexpr int kOpcodeCount = 12;
 const char* to_string(Opcode op);
 
 // The reference of "select law and reference" (second argument of kSetLaw).
@@ -140,6 +141,9 @@ enum class EventId : std::int32_t {
   kCountersReset = 123,
   kOverrunSafe = 124,  // -> SAFE: arg0 = consecutive GNC slips
   kParamsDumped = 125, // the active table read back; arg0 = dump number
+  kModelAdopted = 126,  // the identified model became the active table (automatic policy)
+  kModelRefused = 127,  // a confident identified model failed table validation
+  kModelLoaded = 128,   // PARAM_LOAD_IDENTIFIED: the identified model is in the inactive table
 };
 const char* to_string(EventId id);
 

@@ -13,6 +13,7 @@ bool actuating(Mode m) { return m == Mode::kDetumble || m == Mode::kHold || m ==
 void Gnc::configure_components() {
   const Mat3 j_hat = total_inertia(params_.mass_hat);  // Eq. (1) with the estimates
   filter_.configure(params_.estimator, j_hat, params_.dt);
+  if (params_.estimator.kind == EstimatorKind::kMekf) mekf_.configure(build_mekf_config(params_));
   modes_.configure(params_.mode, params_.guidance.omega_switch);
   refs_.configure(params_.guidance, params_.dt);
   laws_.configure(law_gains(params_), j_hat, params_.dt);
@@ -27,6 +28,10 @@ ParamCheck Gnc::init(const GncParams& params) {
   params_ = params;
   configure_components();
   filter_.reset();
+  mekf_.reset();
+  // The identifier starts from this table's model as its prior; a later table switch keeps its
+  // estimate (set_params).
+  if (params_.identification.enabled) ident_.configure(build_identifier_config(params_));
   modes_.reset(params.mode.initial);
   laws_.reset_state();
   trajectory_valid_ = false;
@@ -36,23 +41,116 @@ ParamCheck Gnc::init(const GncParams& params) {
   have_time_ = false;
   last_torque_.setZero();
   last_saturated_ = false;
+  last_force_.setZero();
+  candidate_status_ = params_.identification.enabled ? ModelCandidate::kNotConfident
+                                                     : ModelCandidate::kDisabled;
+  candidate_windows_ = 0;
+  last_adoption_t_ = 0.0;
+  adopted_once_ = false;
+  adoptions_ = 0;
   return c;
 }
 
-ParamCheck Gnc::set_params(const GncParams& params) {
+ParamCheck Gnc::set_params(const GncParams& params) { return apply_params(params, true); }
+
+ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   const ParamCheck c = validate(params);
   if (!c.ok) return c;
   const Vec3 target = refs_.target();
   const bool target_changed = !(params.guidance.q_final == params_.guidance.q_final);
+  const bool estimator_changed = params.estimator.kind != params_.estimator.kind;
+  const bool identification_started = params.identification.enabled && !params_.identification.enabled;
+  // A table whose model differs from what the identifier believes is a declared change: the
+  // identifier keeps its estimate and goes back to its prior covariance. A table holding the
+  // identified model (adopted automatically or loaded by the ground) changes nothing.
+  bool model_changed = false;
+  if (params_.identification.enabled) {
+    const IdentifierEstimate& e = ident_.estimate();
+    IdentifiedModel m{e.j, e.r, params.rcs.strength};
+    for (int i = 0; i < kThrusters; ++i) {
+      if (e.thruster_confident[static_cast<std::size_t>(i)]) m.k(i) = e.k(i);
+    }
+    model_changed = differs(params, m);
+  }
   params_ = params;
   configure_components();
+  if (estimator_changed) {
+    filter_.reset();
+    mekf_.reset();
+  }
+  if (!params_.identification.enabled) candidate_status_ = ModelCandidate::kDisabled;
+  if (identification_started) {
+    ident_.configure(build_identifier_config(params_));
+    candidate_status_ = ModelCandidate::kNotConfident;
+    candidate_windows_ = 0;
+  } else if (model_changed && declared_change) {
+    candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
+    ident_.reinflate_all();
+  }
   if (!target_changed) refs_.set_target(target);  // keep a ground-commanded target
   return c;
 }
 
 TransitionCheck Gnc::check_mode_request(Mode to) const {
-  const TransitionContext ctx{filter_.initialised(), trajectory_valid_, params_.law};
+  const TransitionContext ctx{estimate_ready(), trajectory_valid_, params_.law};
   return check_transition(modes_.mode(), to, ctx);
+}
+
+bool Gnc::estimate_ready() const {
+  return params_.estimator.kind == EstimatorKind::kMekf ? mekf_.initialised() : filter_.initialised();
+}
+
+ModelCandidate Gnc::identified_model(IdentifiedModel& out) const {
+  if (!params_.identification.enabled) return ModelCandidate::kDisabled;
+  const IdentifierEstimate& e = ident_.estimate();
+  if (!e.inertia_confident || !e.offset_confident) return ModelCandidate::kNotConfident;
+  out.j = e.j;
+  out.r = e.r;
+  // Only the strengths the data have pinned replace the table's; the others keep theirs.
+  out.k = params_.rcs.strength;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (e.thruster_confident[static_cast<std::size_t>(i)]) out.k(i) = e.k(i);
+  }
+  return differs(params_, out) ? ModelCandidate::kOk : ModelCandidate::kUnchanged;
+}
+
+bool Gnc::differs(const GncParams& p, const IdentifiedModel& m) const {
+  const IdentifierConfig& c = params_.identification.config;
+  const Mat3 j = total_inertia(p.mass_hat);
+  return (m.j - j).norm() > c.j_confident_rel * j.norm() ||
+         (m.r - p.mass_hat.r_so_bcm).norm() > c.r_confident ||
+         (m.k - p.rcs.strength).cwiseAbs().maxCoeff() > c.k_confident;
+}
+
+ModelCandidate Gnc::model_candidate(GncParams& out) const {
+  IdentifiedModel m;
+  const ModelCandidate c = identified_model(m);
+  if (c != ModelCandidate::kOk) return c;
+  out = with_model(params_, m.j, m.r, m.k);
+  return validate(out).ok ? ModelCandidate::kOk : ModelCandidate::kInvalid;
+}
+
+void Gnc::adopt_model(double t, ModeEvents& events) {
+  const IdentificationParams& ip = params_.identification;
+  if (!ip.enabled || ip.adopt != ModelAdoption::kAuto) return;
+  if (adopted_once_ && t - last_adoption_t_ < ip.adopt_interval_s) return;
+  const ModelCandidate c = candidate_status_;  // evaluated when the last window closed
+  if (c != ModelCandidate::kOk && c != ModelCandidate::kInvalid) return;
+  adopted_once_ = true;
+  last_adoption_t_ = t;  // a refused model is not retried before the interval either
+  if (c == ModelCandidate::kInvalid) {
+    events.push(ModeEvent{EventId::kModelRefused, modes_.mode(), modes_.mode(),
+                          TransitionCheck::kOk});
+    return;
+  }
+  const LawId law = params_.law;  // the law stays the commanded one
+  candidate_.law = law;
+  candidate_status_ = ModelCandidate::kUnchanged;
+  if (apply_params(candidate_, false).ok) {
+    ++adoptions_;
+    events.push(ModeEvent{EventId::kModelAdopted, modes_.mode(), modes_.mode(),
+                          TransitionCheck::kOk});
+  }
 }
 
 TrajectoryError Gnc::load_trajectory(const TrajectoryTable& table) {
@@ -72,6 +170,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     have_time_ = true;
   }
 
+  // 0. Tick boundary: an identified model adopted by the automatic policy takes effect now.
+  adopt_model(t, out.events);
+
   // 1. Estimator: accept only finite, in-range samples.
   const EstimatorParams& ep = params_.estimator;
   Measurement m;
@@ -88,9 +189,39 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   if (m.omega_valid) m.omega = sample.gyro_rate;
   if (m.q_valid) m.q = mrp::from_quaternion(sample.star_quat / qn);
   if (m.omega_valid && m.q_valid) last_good_t_ = t;
-  filter_.update(m, last_torque_);
-  const Vec3 omega_hat = filter_.omega();
-  const Vec3 q_hat = filter_.q();
+  Vec3 omega_hat;
+  Vec3 q_hat;
+  if (ep.kind == EstimatorKind::kMekf) {
+    MekfInput mi;
+    mi.t = t;
+    mi.gyro_rate = m.omega;
+    mi.gyro_valid = m.omega_valid;
+    if (m.q_valid) mi.star_quat = sample.star_quat / qn;
+    mi.star_valid = m.q_valid;
+    mekf_.update(mi);
+    omega_hat = mekf_.omega();
+    q_hat = mekf_.q();
+  } else {
+    filter_.update(m, last_torque_);
+    omega_hat = filter_.omega();
+    q_hat = filter_.q();
+  }
+
+  // 1b. Identification (gnc/estimation/README.md §I): this tick's rate and the forces commanded
+  // over the previous tick. The MEKF's rate is the gyro less its bias; the SPEC §6 filter's rate
+  // is model-predicted with J_hat, which is what is being identified, so the gyro goes in.
+  if (params_.identification.enabled) {
+    IdentifierInput in;
+    const bool mekf = ep.kind == EstimatorKind::kMekf;
+    in.omega = mekf ? mekf_.omega() : m.omega;
+    in.omega_valid = mekf ? (mekf_.initialised() && m.omega_valid) : m.omega_valid;
+    in.force = last_force_;
+    ident_.update(in);
+    if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
+      candidate_windows_ = ident_.counters().windows;
+      candidate_status_ = model_candidate(candidate_);
+    }
+  }
 
   // 2. Mode manager: ground requests at the tick boundary, then autonomous transitions.
   const Mode before = modes_.mode();
@@ -104,7 +235,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   if (commands.has_target && commands.target_mrp.allFinite()) {
     refs_.set_target(commands.target_mrp);
   }
-  const TransitionContext ctx{filter_.initialised(), trajectory_valid_, params_.law};
+  const TransitionContext ctx{estimate_ready(), trajectory_valid_, params_.law};
   const bool finite = omega_hat.allFinite() && q_hat.allFinite();
   modes_.update(ModeInputs{commands.has_mode_request, commands.mode_request, ctx, omega_hat.norm(),
                            t - last_good_t_, finite},
@@ -131,6 +262,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   }
 
   // 5. Allocator, Eq. (53) or Eq. (52) (params_.allocator); fuel estimate, Eq. (54).
+  // The allocator works in produced force (B_hat's columns are per newton produced); a thruster
+  // of strength k_i is commanded u / k_i, within u_max.
   Vec8 u = Vec8::Zero();
   AllocatorStatus status;
   const bool enabled = actuating(modes_.mode());
@@ -140,11 +273,17 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
   }
-  fuel_kg_ += fuel_rate(u, params_.isp_s, params_.g0) * params_.dt;
+  Vec8 force = Vec8::Zero();
+  for (int c = 0; c < kChannels; ++c) {
+    const double k = u(c) >= 0.0 ? params_.rcs.strength(2 * c) : params_.rcs.strength(2 * c + 1);
+    force(c) = std::fmax(-params_.rcs.u_max, std::fmin(params_.rcs.u_max, u(c) / k));
+  }
+  fuel_kg_ += fuel_rate(force, params_.isp_s, params_.g0) * params_.dt;
   last_torque_ = status.torque_achieved;
   last_saturated_ = status.saturated;
+  last_force_ = force;
 
-  out.command.force = u;
+  out.command.force = force;
   out.command.enabled = enabled;
   GncTelemetry& tl = out.telemetry;
   tl.t = t;
@@ -163,6 +302,44 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   tl.trajectory_loaded = trajectory_valid_;
   tl.a_hat = laws_.a_hat();
   tl.integral = laws_.integral();
+  fill_estimation_telemetry(tl);
+}
+
+void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
+  EstimationTelemetry& e = tl.est;
+  e = EstimationTelemetry{};
+  if (params_.estimator.kind == EstimatorKind::kMekf) {
+    e.mekf = true;
+    e.gyro_bias = mekf_.bias();
+    e.attitude_sigma = mekf_.attitude_sigma();
+    e.bias_sigma = mekf_.bias_sigma();
+    e.star_gated = mekf_.counters().gated;
+  }
+  e.adoptions = adoptions_;
+  if (!params_.identification.enabled) return;
+  const IdentifierEstimate& est = ident_.estimate();
+  const IdentifierExcitation& exc = ident_.excitation();
+  e.identifying = true;
+  e.j = inertia_params(est.j);
+  e.j_sigma = est.j_sigma;
+  e.r = est.r;
+  e.r_sigma = est.r_sigma;
+  e.k = est.k;
+  e.k_sigma = est.k_sigma;
+  e.inertia_confident = est.inertia_confident;
+  e.offset_confident = est.offset_confident;
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto b = static_cast<std::uint16_t>(1u << i);
+    if (est.thruster_confident[static_cast<std::size_t>(i)]) e.thruster_confident |= b;
+    if (exc.thruster[static_cast<std::size_t>(i)]) e.excited_thrusters |= b;
+  }
+  e.excited_inertia = exc.inertia_scale;
+  e.excited_offset = exc.offset;
+  e.offset_unobservable = static_cast<std::uint8_t>(ident_.observability().offset_unobservable);
+  e.residual_torque = est.residual_torque;
+  e.residual_chi2 = est.residual_chi2;
+  e.windows = ident_.counters().windows;
+  e.candidate = candidate_status_;
 }
 
 }  // namespace rocksteady::gnc

@@ -1,4 +1,5 @@
-// The GNC component: one call per tick, estimator -> mode manager -> reference -> law -> allocator.
+// The GNC component: one call per tick, estimator -> identifier -> mode manager -> reference ->
+// law -> allocator (DESIGN.md "One tick as data").
 // Static allocation, no exceptions, no I/O: inputs and outputs are plain structs.
 #pragma once
 
@@ -6,6 +7,8 @@
 
 #include "gnc/allocation/allocator.hpp"
 #include "gnc/control/laws.hpp"
+#include "gnc/estimation/identifier.hpp"
+#include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/guidance/trajectory.hpp"
@@ -15,6 +18,12 @@
 #include "gnc/types.hpp"
 
 namespace rocksteady::gnc {
+
+struct IdentifiedModel {
+  Mat3 j{Mat3::Identity()};  // J_tot, kg m^2
+  Vec3 r{Vec3::Zero()};      // r_SO/BCM, m
+  Vec16 k{Vec16::Ones()};    // thruster strengths
+};
 
 class Gnc {
  public:
@@ -31,14 +40,32 @@ class Gnc {
 
   void step(const SensorSample& sample, const GncCommands& commands, GncOutput& out);
 
+  // The identified model, if confident: J_tot, r_SO/BCM, and the strengths of the thrusters the
+  // data have pinned (the table's for the others). kOk: it differs from the active table.
+  ModelCandidate identified_model(IdentifiedModel& out) const;
+  // The table that would fly the identified model now (the active table with J_tot, r_SO/BCM and
+  // the confident thruster strengths replaced, validated). kOk writes `out`; otherwise why not.
+  ModelCandidate model_candidate(GncParams& out) const;
+
+  bool estimate_ready() const;  // the active estimator has a state
   Mode mode() const { return modes_.mode(); }
   const StateFilter& estimator() const { return filter_; }
+  const Mekf& mekf() const { return mekf_; }
+  const Identifier& identifier() const { return ident_; }
+  std::uint32_t model_adoptions() const { return adoptions_; }
 
  private:
   void configure_components();
+  // Validate and install; declared_change: a table from outside (the identifier re-inflates).
+  ParamCheck apply_params(const GncParams& params, bool declared_change);
+  bool differs(const GncParams& p, const IdentifiedModel& m) const;  // beyond the confidence bounds
+  void adopt_model(double t, ModeEvents& events);  // automatic policy, at the tick boundary
+  void fill_estimation_telemetry(GncTelemetry& tl) const;
 
   GncParams params_{};
   StateFilter filter_{};
+  Mekf mekf_{};
+  Identifier ident_{};
   ModeManager modes_{};
   References refs_{};
   ControlLaws laws_{};
@@ -52,6 +79,13 @@ class Gnc {
   bool have_time_{false};
   Vec3 last_torque_{Vec3::Zero()};  // torque achieved on the previous tick (estimator prediction)
   bool last_saturated_{false};
+  Vec8 last_force_{Vec8::Zero()};  // physical channel forces commanded on the previous tick
+  double last_adoption_t_{0.0};
+  bool adopted_once_{false};
+  std::uint32_t adoptions_{0};
+  ModelCandidate candidate_status_{ModelCandidate::kDisabled};
+  std::uint32_t candidate_windows_{0};
+  GncParams candidate_{};  // scratch for the automatic adoption (too large for a tick's stack)
 };
 
 }  // namespace rocksteady::gnc

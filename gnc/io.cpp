@@ -58,6 +58,19 @@ const char* to_string(EventId e) {
     case EventId::kNonFiniteState: return "non_finite_state";
     case EventId::kRequestRejected: return "request_rejected";
     case EventId::kSensorRejected: return "sensor_rejected";
+    case EventId::kModelAdopted: return "model_adopted";
+    case EventId::kModelRefused: return "model_refused";
+  }
+  return "?";
+}
+
+const char* to_string(ModelCandidate c) {
+  switch (c) {
+    case ModelCandidate::kOk: return "ok";
+    case ModelCandidate::kDisabled: return "identification off";
+    case ModelCandidate::kNotConfident: return "identification not confident";
+    case ModelCandidate::kUnchanged: return "the active table already holds the identified model";
+    case ModelCandidate::kInvalid: return "the identified model fails table validation";
   }
   return "?";
 }

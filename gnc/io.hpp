@@ -58,8 +58,20 @@ enum class EventId : std::uint8_t {
   kNonFiniteState,   // -> SAFE: the estimate or command went non-finite
   kRequestRejected,  // a mode request that failed the check at the tick boundary
   kSensorRejected,   // a sample failed validity / range checks
+  kModelAdopted,     // the identified model became the active table (automatic policy)
+  kModelRefused,     // a confident identified model failed table validation (kept the old one)
 };
 const char* to_string(EventId e);
+
+// Why an identified model is or is not a parameter-table candidate now (Gnc::model_candidate).
+enum class ModelCandidate : std::uint8_t {
+  kOk = 0,
+  kDisabled,       // identification is off
+  kNotConfident,   // inertia or centre-of-mass 1 sigma above the confidence bounds
+  kUnchanged,      // the active table already holds this model (within the confidence bounds)
+  kInvalid,        // the model fails table validation (e.g. J_ast not positive definite)
+};
+const char* to_string(ModelCandidate c);
 
 struct ModeEvent {
   EventId id{EventId::kModeChanged};
@@ -103,6 +115,34 @@ struct ThrusterCommand {
   bool enabled{false};       // false: all thrusters inhibited (IDLE, SAFE)
 };
 
+// What the estimators report each tick (zeros for a module that is off).
+struct EstimationTelemetry {
+  bool mekf{false};                  // the MEKF is the active estimator
+  Vec3 gyro_bias{Vec3::Zero()};      // MEKF gyro bias estimate, rad/s
+  Vec3 attitude_sigma{Vec3::Zero()}; // MEKF attitude 1 sigma per axis, rad
+  Vec3 bias_sigma{Vec3::Zero()};     // MEKF bias 1 sigma per axis, rad/s
+  std::uint32_t star_gated{0};       // MEKF star-tracker samples rejected by the gate
+  bool identifying{false};           // the identifier runs
+  Vec6 j{Vec6::Zero()};              // identified J_tot [Jxx Jyy Jzz Jxy Jxz Jyz], kg m^2
+  Vec6 j_sigma{Vec6::Zero()};
+  Vec3 r{Vec3::Zero()};              // identified r_SO/BCM, m
+  Vec3 r_sigma{Vec3::Zero()};
+  Vec16 k{Vec16::Zero()};            // identified thruster strengths
+  Vec16 k_sigma{Vec16::Zero()};
+  bool inertia_confident{false};
+  bool offset_confident{false};
+  std::uint16_t thruster_confident{0};  // bit i: thruster i within its confidence bound
+  bool excited_inertia{false};          // last window: commanded torque excited the inertia scale
+  bool excited_offset{false};           // last window: net force excited r
+  std::uint16_t excited_thrusters{0};   // bit i: thruster i fired enough in the last window
+  std::uint8_t offset_unobservable{0};  // directions of r not (yet) observable
+  Vec3 residual_torque{Vec3::Zero()};   // N m, last window's mean residual with the estimates
+  double residual_chi2{0.0};            // its squared norm normalised by the window noise
+  std::uint32_t windows{0};
+  ModelCandidate candidate{ModelCandidate::kDisabled};
+  std::uint32_t adoptions{0};           // identified models adopted into the active table
+};
+
 struct GncTelemetry {
   double t{0.0};
   std::uint32_t tick{0};
@@ -120,6 +160,7 @@ struct GncTelemetry {
   bool trajectory_loaded{false};
   Vec6 a_hat{Vec6::Zero()};     // adaptive law's inertia estimate
   Vec3 integral{Vec3::Zero()};  // integral law's state
+  EstimationTelemetry est{};
 };
 
 struct GncOutput {

@@ -9,6 +9,8 @@
 #include "gnc/allocation/allocator.hpp"
 #include "gnc/check.hpp"
 #include "gnc/control/laws.hpp"
+#include "gnc/estimation/identifier.hpp"
+#include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/io.hpp"
@@ -33,6 +35,10 @@ struct GncParams {
   DpdGains dpd{};
   GuidanceParams guidance{};
   EstimatorParams estimator{};
+  // estimator.kind == kMekf: the MEKF's noise model and gate. Its dt, gyro_max_rate and
+  // quat_norm_tolerance are the table's dt and estimator fields (build_mekf_config).
+  MekfConfig mekf{};
+  IdentificationParams identification{};  // on-line identification of J_tot, r_SO/BCM, k_i
   ModeParams mode{};
   // SPEC §4: the study's pseudoinverse, Eq. (53), or the fuel-optimal allocation, Eq. (52).
   AllocatorKind allocator{AllocatorKind::kPseudoInverse};
@@ -45,6 +51,16 @@ GncParams study_gnc_params(double u_max);
 
 // The gains of every law, as ControlLaws takes them.
 LawGains law_gains(const GncParams& p);
+
+// The MEKF's and the identifier's configuration as the table defines them: tuning from
+// p.mekf / p.identification.config, tick, sample checks, geometry and priors from the table.
+MekfConfig build_mekf_config(const GncParams& p);
+IdentifierConfig build_identifier_config(const GncParams& p);
+
+// The model the table flies with a different J_tot, r_SO/BCM and thruster strengths: r_SO/BCM := r,
+// J_ast := J_tot - (the spacecraft's part of Eq. (1) at the new r), strength := k. The result is
+// validated by the caller (validate() refuses a J_ast that is not positive definite).
+GncParams with_model(const GncParams& p, const Mat3& j_tot, const Vec3& r, const Vec16& k);
 
 using ParamCheck = Check;
 

@@ -98,6 +98,31 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   put(out.command.force, m.channel_force);
   m.fuel_kg = g.fuel_kg;
   m.sensor_rejects = g.sensor_rejects;
+  const gnc::EstimationTelemetry& e = g.est;
+  m.mekf_active = e.mekf ? 1 : 0;
+  put(e.gyro_bias, m.gyro_bias);
+  put(e.attitude_sigma, m.attitude_sigma);
+  put(e.bias_sigma, m.gyro_bias_sigma);
+  m.star_gated = e.star_gated;
+  m.identifying = e.identifying ? 1 : 0;
+  put(e.j, m.id_j);
+  put(e.j_sigma, m.id_j_sigma);
+  put(e.r, m.id_r);
+  put(e.r_sigma, m.id_r_sigma);
+  put(e.k, m.id_k);
+  put(e.k_sigma, m.id_k_sigma);
+  m.id_inertia_confident = e.inertia_confident ? 1 : 0;
+  m.id_offset_confident = e.offset_confident ? 1 : 0;
+  m.id_thruster_confident = e.thruster_confident;
+  m.id_excited_inertia = e.excited_inertia ? 1 : 0;
+  m.id_excited_offset = e.excited_offset ? 1 : 0;
+  m.id_excited_thrusters = e.excited_thrusters;
+  m.id_offset_unobservable = static_cast<std::int8_t>(e.offset_unobservable);
+  put(e.residual_torque, m.id_residual_torque);
+  m.id_residual_chi2 = e.residual_chi2;
+  m.id_windows = e.windows;
+  m.id_candidate = static_cast<std::int8_t>(e.candidate);
+  m.model_adoptions = e.adoptions;
 }
 
 }  // namespace rocksteady::wire

@@ -21,6 +21,8 @@ static_assert(static_cast<std::int32_t>(Opcode::kParamLoad) == GroundCmd::OP_PAR
 static_assert(static_cast<std::int32_t>(Opcode::kParamActivate) == GroundCmd::OP_PARAM_ACTIVATE);
 static_assert(static_cast<std::int32_t>(Opcode::kParamDiscard) == GroundCmd::OP_PARAM_DISCARD);
 static_assert(static_cast<std::int32_t>(Opcode::kParamDump) == GroundCmd::OP_PARAM_DUMP);
+static_assert(static_cast<std::int32_t>(Opcode::kParamLoadIdentified) ==
+              GroundCmd::OP_PARAM_LOAD_IDENTIFIED);
 static_assert(kOpcodeCount == GroundCmd::OP_COUNT);
 static_assert(kMaxDumpParams == rocksteady::param_table_t::MAX_PARAMS);
 static_assert(kMaxParamValues == rocksteady::param_table_t::MAX_VALUES);

@@ -38,6 +38,7 @@ constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
     {Opcode::kParamActivate, 0, 0, kAllModes, {}},
     {Opcode::kParamDiscard, 0, 0, kAllModes, {}},
     {Opcode::kParamDump, 0, 0, kAllModes, {}},
+    {Opcode::kParamLoadIdentified, 0, 0, kAllModes, {}},
 }};
 
 constexpr bool rows_in_opcode_order() {

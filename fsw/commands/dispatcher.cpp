@@ -124,6 +124,8 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
       return ctx.params.discard(ctx.core.params(), ctx.log);
     case Opcode::kParamDump:
       return ctx.params.dump(ctx.core.params(), ctx.onboard_time, ctx.log);
+    case Opcode::kParamLoadIdentified:
+      return ctx.params.load_identified(ctx.core, ctx.log);
   }
   return reject(RejectReason::kUnknownOpcode, cmd.opcode, "unknown opcode");
 }
@@ -131,7 +133,7 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
 CommandCheck CommandDispatcher::execute_set_mode(const GroundCommand& cmd,
                                                  const DispatchContext& ctx) {
   const auto to = static_cast<gnc::Mode>(static_cast<int>(cmd.args[0]));
-  const gnc::TransitionContext tc{ctx.core.estimator().initialised(), projected_trajectory(ctx),
+  const gnc::TransitionContext tc{ctx.core.estimate_ready(), projected_trajectory(ctx),
                                   queue_.projected_law(ctx.core.params().law)};
   const gnc::TransitionCheck c = gnc::check_transition(projected_mode(ctx), to, tc);
   if (c != gnc::TransitionCheck::kOk) return refused_transition(c);
@@ -161,7 +163,7 @@ CommandCheck CommandDispatcher::execute_set_law(const GroundCommand& cmd,
     return refused_transition(gnc::TransitionCheck::kLawCannotTrack);
   }
   if (change_mode) {
-    const gnc::TransitionContext tc{ctx.core.estimator().initialised(), projected_trajectory(ctx),
+    const gnc::TransitionContext tc{ctx.core.estimate_ready(), projected_trajectory(ctx),
                                     law};
     const gnc::TransitionCheck c = gnc::check_transition(pm, to, tc);
     if (c != gnc::TransitionCheck::kOk) return refused_transition(c);

@@ -24,7 +24,7 @@ struct Row {
   const char* text;  // printf with %s: from, to, detail (in that order; each may be unused)
 };
 
-constexpr std::array<Row, 6> kRows{{
+constexpr std::array<Row, 8> kRows{{
     {gnc::EventId::kModeChanged, EventId::kModeChanged, Severity::kInfo, Args::kFromTo,
      Detail::kCause, "mode %s -> %s (%s)"},
     {gnc::EventId::kAutoHold, EventId::kAutoHold, Severity::kInfo, Args::kFromTo, Detail::kNone,
@@ -38,6 +38,10 @@ constexpr std::array<Row, 6> kRows{{
     {gnc::EventId::kSensorRejected, EventId::kSensorRejected, Severity::kWarning,
      Args::kRejectsThrottled, Detail::kRejects,
      "sensor sample rejected: invalid, non-finite or out of range (%.0s%.0s%s so far)"},
+    {gnc::EventId::kModelAdopted, EventId::kModelAdopted, Severity::kInfo, Args::kFromTo,
+     Detail::kNone, "identified model (J_tot, r_SO/BCM, strengths) adopted in %.0s%s%s"},
+    {gnc::EventId::kModelRefused, EventId::kModelRefused, Severity::kWarning, Args::kFromTo,
+     Detail::kNone, "identified model refused: fails table validation (in %.0s%s%s)"},
 }};
 
 const Row* find_row(gnc::EventId id) {

@@ -1,6 +1,7 @@
 #include "ground/campaign/campaign.hpp"
 
 #include <nlohmann/json.hpp>
+#include "ground/campaign/estimation_report.hpp"
 #include "ground/campaign/fsw_flight_side.hpp"
 
 #include <unistd.h>
@@ -121,6 +122,7 @@ void write_results_json(const std::string& path, const CampaignReport& rep) {
                     {"simulated_s", r.sim_s},
                     {"wall_s", r.wall_s},
                     {"plan_wall_s", r.plan_wall_s},
+                    {"estimation", estimation_json(r.estimation)},
                     {"timeseries", r.timeseries_path},
                     {"plot", r.plot_path}});
   }

@@ -16,10 +16,15 @@ struct Strategy {
   std::string name;
   gnc::LawId law{gnc::LawId::kNtcl};
   ReferenceKind reference{ReferenceKind::kDpdRef};
+  // Modifiers beyond the study (name suffixes): ":mekf" flies the MEKF instead of the case's
+  // estimator; ":id" runs the on-line identification with automatic model adoption.
+  bool mekf{false};
+  bool identify{false};
   bool needs_trajectory() const { return reference == ReferenceKind::kFuelOptimal; }
 };
 
-// Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal.
+// Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal;
+// optional suffixes ":mekf" and ":id" in any order ("ntcl+dpd_ref:mekf:id", "dpd:id").
 std::optional<Strategy> parse_strategy(const std::string& name);
 // The six columns of the study's results table, in its order.
 const std::vector<std::string>& study_strategy_names();

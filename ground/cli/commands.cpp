@@ -37,6 +37,9 @@ const std::vector<CommandHelp> kHelp{
     {"discard-gains", "discard-gains", "drop the loads: inactive table := active table"},
     {"dump-params", "dump-params",
      "read the active parameter table back on RS_PARAMS (params get prints it)"},
+    {"load-identified", "load-identified",
+     "load the flight's identified model (J_tot, r_SO/BCM, thruster strengths) into the inactive "
+     "table; refused unless the identification is confident (activate-gains flies it)"},
     {"reset-counters", "reset-counters",
      "reset the command/health counters (cycle counts are kept)"},
     {"load-trajectory", "load-trajectory UPLOAD_ID",
@@ -255,6 +258,9 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
   if (name == "activate-gains") return no_args(Msg::OP_PARAM_ACTIVATE, "PARAM_ACTIVATE");
   if (name == "discard-gains") return no_args(Msg::OP_PARAM_DISCARD, "PARAM_DISCARD");
   if (name == "dump-params") return no_args(Msg::OP_PARAM_DUMP, "PARAM_DUMP");
+  if (name == "load-identified") {
+    return no_args(Msg::OP_PARAM_LOAD_IDENTIFIED, "PARAM_LOAD_IDENTIFIED");
+  }
   if (name == "set-mode") {
     if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
     const auto mode = mode_from_name(args[0]);

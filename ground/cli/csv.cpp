@@ -84,6 +84,12 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_A(integral);
   RS_A(torque_requested); RS_A(torque_achieved); RS_I(saturated); RS_D(alloc_scale);
   RS_I(thrusters_enabled); RS_A(channel_force); RS_D(fuel_kg);
+  RS_I(mekf_active); RS_A(gyro_bias); RS_A(attitude_sigma); RS_A(gyro_bias_sigma);
+  RS_I(star_gated); RS_I(identifying); RS_A(id_j); RS_A(id_j_sigma); RS_A(id_r); RS_A(id_r_sigma);
+  RS_A(id_k); RS_A(id_k_sigma); RS_I(id_inertia_confident); RS_I(id_offset_confident);
+  RS_I(id_thruster_confident); RS_I(id_excited_inertia); RS_I(id_excited_offset);
+  RS_I(id_excited_thrusters); RS_I(id_offset_unobservable); RS_A(id_residual_torque);
+  RS_D(id_residual_chi2); RS_I(id_windows); RS_I(id_candidate); RS_I(model_adoptions);
   RS_I(base_ticks); RS_I(base_missed); RS_I(rate_group_count);
   RS_A(rg_cycles); RS_A(rg_last_exec_ns); RS_A(rg_max_exec_ns); RS_A(rg_slips); RS_A(rg_missed);
   RS_I(cmd_accepted); RS_I(cmd_rejected); RS_I(cmd_last_seq); RS_I(cmd_last_opcode);

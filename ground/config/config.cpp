@@ -42,6 +42,9 @@ RunSetup assemble(const MissionConfig& m, const GncConfig& g, const CaseConfig& 
   } catch (const std::invalid_argument& e) {
     throw ConfigError(c.file + " + " + m.file, "", e.what());
   }
+  if (c.plant_truth.IsDefined() && !c.plant_truth.IsNull()) {
+    apply_plant_truth(c.plant_truth, c.file, t);
+  }
 
   // Estimates (the flight software), Eq. (6): estimate = true - error.
   s.flight = flight_params(m, g, c);

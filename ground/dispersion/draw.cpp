@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ground/campaign/estimation_report.hpp"
 #include "ground/campaign/fsw_flight_side.hpp"
 #include "ground/plant/plant.hpp"
 
@@ -82,6 +83,7 @@ StrategyOutcome outcome_of(const campaign::RunResult& r, double eps_trans) {
   o.saturated_ticks = r.saturated_ticks;
   o.sim_s = r.sim_s;
   o.wall_s = r.wall_s;
+  o.estimation = r.estimation;
   return o;
 }
 
@@ -283,7 +285,8 @@ json to_json(const DrawResult& r, bool with_timing) {
                     {"ticks", o.ticks},
                     {"plant_clipped_ticks", o.clipped_ticks},
                     {"allocator_saturated_ticks", o.saturated_ticks},
-                    {"simulated_s", o.sim_s}});
+                    {"simulated_s", o.sim_s},
+                    {"estimation", campaign::estimation_json(o.estimation)}});
     run_wall[o.strategy] = o.wall_s;
   }
   json out = {{"result",
@@ -368,6 +371,7 @@ DrawResult draw_from_json(const json& top) {
     x.clipped_ticks = o.at("plant_clipped_ticks").get<std::uint64_t>();
     x.saturated_ticks = o.at("allocator_saturated_ticks").get<std::uint64_t>();
     x.sim_s = o.at("simulated_s").get<double>();
+    if (o.contains("estimation")) x.estimation = campaign::estimation_from_json(o.at("estimation"));
     if (timing != nullptr && timing->at("run_wall_s").contains(x.strategy)) {
       x.wall_s = timing->at("run_wall_s").at(x.strategy).get<double>();
     }

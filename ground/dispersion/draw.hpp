@@ -55,6 +55,7 @@ struct StrategyOutcome {
   std::uint64_t saturated_ticks{0};
   double sim_s{0.0};
   double wall_s{0.0};  // timing (not part of the result proper)
+  campaign::EstimationReport estimation;  // estimator and identification against the truth
 };
 
 struct DrawResult {

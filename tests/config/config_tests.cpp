@@ -210,7 +210,7 @@ TEST(ConfigErrors, NegativeNoisePower) {
 
 TEST(ConfigErrors, BadValues) {
   TempFile f("gnc.yaml", replaced(read(kGnc), "estimator: auto", "estimator: kalman"));
-  expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough or filter");
+  expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough, filter or mekf");
   TempFile a("gnc.yaml", replaced(read(kGnc), "allocator: pinv", "allocator: simplex"));
   expect_error([&] { load_gnc(a.path()); }, a.path(), "allocator", "pinv or l1");
   TempFile g("gnc.yaml", replaced(read(kGnc), "{K_d: 1.0e4, k_p: 10.0}", "{K_d: -1.0e4, k_p: 10.0}"));

@@ -120,6 +120,7 @@ std::vector<Case> cases() {
       {"activate-gains", {}, false, M::kHold, O::kParamActivate, {}},
       {"discard-gains", {}, false, M::kHold, O::kParamDiscard, {}},
       {"dump-params", {}, false, M::kTrack, O::kParamDump, {}},
+      {"load-identified", {}, false, M::kDetumble, O::kParamLoadIdentified, {}},
       {"reset-counters", {}, false, M::kSafe, O::kResetCounters, {}},
       {"load-trajectory", {"7"}, false, M::kHold, O::kLoadTrajectory, {7}},
       {"abort-uplink", {"2147483647"}, false, M::kTrack, O::kAbortUplink, {2147483647.0}},
