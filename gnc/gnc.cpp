@@ -42,6 +42,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   last_torque_.setZero();
   last_saturated_ = false;
   last_force_.setZero();
+  id_bias_ = params_.mekf.init_bias;
   candidate_status_ = params_.identification.enabled ? ModelCandidate::kNotConfident
                                                      : ModelCandidate::kDisabled;
   candidate_windows_ = 0;
@@ -208,18 +209,22 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   }
 
   // 1b. Identification (gnc/estimation/README.md §I): this tick's rate and the forces commanded
-  // over the previous tick. The MEKF's rate is the gyro less its bias; the SPEC §6 filter's rate
-  // is model-predicted with J_hat, which is what is being identified, so the gyro goes in.
+  // over the previous tick. The rate is the gyro: the SPEC §6 filter's rate is model-predicted
+  // with J_hat, which is what is being identified. With the MEKF the gyro is corrected by its bias
+  // estimate latched at the start of each window: a bias estimate that moves inside a window
+  // would read as a change of angular momentum, whereas a constant offset cancels in the window
+  // equation's derivative term (the triangular window's w' integrates to zero).
   if (params_.identification.enabled) {
     IdentifierInput in;
     const bool mekf = ep.kind == EstimatorKind::kMekf;
-    in.omega = mekf ? mekf_.omega() : m.omega;
-    in.omega_valid = mekf ? (mekf_.initialised() && m.omega_valid) : m.omega_valid;
+    in.omega = mekf ? Vec3(m.omega - id_bias_) : m.omega;
+    in.omega_valid = m.omega_valid && (!mekf || mekf_.initialised());
     in.force = last_force_;
     ident_.update(in);
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
+      if (mekf) id_bias_ = mekf_.bias();
     }
   }
 

@@ -79,7 +79,8 @@ class Gnc {
   bool have_time_{false};
   Vec3 last_torque_{Vec3::Zero()};  // torque achieved on the previous tick (estimator prediction)
   bool last_saturated_{false};
-  Vec8 last_force_{Vec8::Zero()};  // physical channel forces commanded on the previous tick
+  Vec8 last_force_{Vec8::Zero()};
+  Vec3 id_bias_{Vec3::Zero()};  // MEKF gyro bias latched for the identifier's current window  // physical channel forces commanded on the previous tick
   double last_adoption_t_{0.0};
   bool adopted_once_{false};
   std::uint32_t adoptions_{0};

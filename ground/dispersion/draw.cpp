@@ -126,6 +126,8 @@ config::RunSetup make_setup(const config::MissionConfig& mission, const config::
   c.duration_s = spec.duration_s;
   c.seed = d.noise_seed;
   config::RunSetup s = config::assemble(m, gnc, c);
+  s.truth.thruster_strength = d.thruster_strength;
+  s.truth.sensors.gyro_bias = d.gyro_bias;
   s.case_name = "draw" + std::to_string(d.index);
   // Estimates, Eq. (6): estimate = true - error.
   s.flight.mass_hat.j_ast = mission.mass.j_ast - d.delta_j;
@@ -247,6 +249,10 @@ json to_json(const DrawResult& r, bool with_timing) {
                   {"disturbance_sigma_nm", d.disturbance_sigma_nm},
                   {"noise_seed", d.noise_seed},
                   {"u_max_n", d.u_max_n},
+                  {"thruster_strength",
+                   std::vector<double>(d.thruster_strength.data(),
+                                       d.thruster_strength.data() + gnc::kThrusters)},
+                  {"gyro_bias_rad_s", vec(d.gyro_bias)},
                   {"error", d.error}};
   json flown = nullptr;
   if (r.flown) {
@@ -327,6 +333,13 @@ DrawResult draw_from_json(const json& top) {
   d.disturbance_sigma_nm = s.at("disturbance_sigma_nm").get<double>();
   d.noise_seed = s.at("noise_seed").get<std::uint64_t>();
   d.u_max_n = s.at("u_max_n").get<double>();
+  if (s.contains("thruster_strength")) {
+    const auto& k = s.at("thruster_strength");
+    for (int i = 0; i < gnc::kThrusters; ++i) {
+      d.thruster_strength(i) = k.at(static_cast<std::size_t>(i)).get<double>();
+    }
+  }
+  if (s.contains("gyro_bias_rad_s")) d.gyro_bias = to_vec(s.at("gyro_bias_rad_s"));
   d.error = s.at("error").get<std::string>();
   const json& f = j.at("flown");
   if (!f.is_null()) {

@@ -232,6 +232,15 @@ DrawParams Sampler::draw(int index) const {
     d.mrp0 = mission_.initial_mrp;
   }
   d.noise_seed = spec_.noise_seed_per_draw ? mix_seed(d.seed, kNoiseSeedStream) : spec_.noise_seed;
+  // Truth beyond the study, from its own stream (files without these keys draw nothing).
+  Rng extra(mix_seed(d.seed, kTruthExtrasStream));
+  const double k_sigma = value(spec_.thruster_strength_sigma);
+  for (int i = 0; i < gnc::kThrusters; ++i) {
+    const double e = std::max(-3.0, std::min(3.0, extra.normal()));
+    d.thruster_strength(i) = 1.0 + k_sigma * e;
+  }
+  const double b1 = extra.uniform(), b2 = extra.uniform();
+  d.gyro_bias = value(spec_.gyro_bias_norm_rad_s) * sphere_direction(b1, b2);
   return d;
 }
 

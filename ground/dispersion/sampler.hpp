@@ -68,6 +68,8 @@ struct DrawParams {
   double disturbance_sigma_nm{0.0};
   std::uint64_t noise_seed{1};
   double u_max_n{200.0};
+  gnc::Vec16 thruster_strength{gnc::Vec16::Ones()};  // true strength factors
+  Vec3 gyro_bias{Vec3::Zero()};                      // true constant gyro bias, rad/s
   std::string error;  // non-empty: no valid draw (e.g. no PD estimate within the limit)
 };
 
@@ -93,6 +95,7 @@ enum Stream : std::uint64_t {
   kMatrixStream = 3,
   kNoiseSeedStream = 4,
   kLhsStream = 5,
+  kTruthExtrasStream = 6,  // thruster strengths, gyro bias
 };
 
 }  // namespace rocksteady::dispersion

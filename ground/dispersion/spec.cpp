@@ -212,6 +212,8 @@ std::vector<std::pair<std::string, const Scalar*>> DispersionSpec::dimensions() 
       {"star_noise_psd", &star_psd},
       {"disturbance_sigma_nm", &disturbance_sigma_nm},
       {"u_max_n", &u_max_n},
+      {"thruster_strength_sigma", &thruster_strength_sigma},
+      {"gyro_bias_norm_rad_s", &gyro_bias_norm_rad_s},
   };
   std::vector<std::pair<std::string, const Scalar*>> out;
   for (const auto& d : all) {
@@ -298,6 +300,15 @@ DispersionSpec load_spec(const std::string& path) {
     }
   }
   s.u_max_n = scalar(p, "u_max_n", false);
+  if (p.has("thruster_strength_sigma")) {
+    s.thruster_strength_sigma = scalar(p, "thruster_strength_sigma", false);
+    if (s.thruster_strength_sigma.quantile(1.0) > 0.1) {
+      p.fail("thruster_strength_sigma", "above 0.1: a thruster that far off is a fault, not a strength");
+    }
+  }
+  if (p.has("gyro_bias_norm_rad_s")) {
+    s.gyro_bias_norm_rad_s = scalar(p, "gyro_bias_norm_rad_s", false);
+  }
   if (s.u_max_n.quantile(0.0) <= 0.0 && !(s.u_max_n.kind == Scalar::Kind::kNormal)) {
     p.fail("u_max_n", "must be positive");
   }

@@ -73,6 +73,11 @@ struct DispersionSpec {
   bool noise_seed_per_draw{true};                           // else noise_seed
   std::uint64_t noise_seed{1};
   Scalar u_max_n;
+  // Optional truth beyond the study (absent: none). Per-thruster strength factors k_i = 1 + e_i,
+  // e_i normal with this sigma, truncated to +-3 sigma, drawn independently per thruster; a
+  // constant gyro bias of this norm in a uniformly random direction.
+  Scalar thruster_strength_sigma;
+  Scalar gyro_bias_norm_rad_s;
 
   // The bounded scalars in a fixed order (the hypercube's dimensions), with their key names.
   std::vector<std::pair<std::string, const Scalar*>> dimensions() const;
