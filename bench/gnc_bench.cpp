@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <vector>
 
 #include "gnc/control/laws.hpp"
 #include "gnc/gnc.hpp"
@@ -57,7 +58,7 @@ BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
 // Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (joint, study
 // priors, 20 s windows, automatic adoption), fault-free L1 allocation, NTCL in DETUMBLE. The rate
 // changes every tick so the identifier cycles through its windows. Reports the mean per tick and,
-// as a counter, the worst single tick over the run.
+// as counters, the median, 99.9th percentile and maximum single tick over the run.
 void BM_GncTickAllModules(benchmark::State& state) {
   GncParams p = study_gnc_params(200.0);
   p.law = LawId::kNtcl;
@@ -80,7 +81,8 @@ void BM_GncTickAllModules(benchmark::State& state) {
   double t = 0.0;
   gnc.step(study_sample(t), c, out);
   c = GncCommands{};
-  double worst_ns = 0.0;
+  std::vector<double> tick_ns;
+  tick_ns.reserve(static_cast<std::size_t>(state.max_iterations));
   long k = 0;
   for (auto _ : state) {
     t += p.dt;
@@ -91,10 +93,17 @@ void BM_GncTickAllModules(benchmark::State& state) {
     gnc.step(s, c, out);
     const auto t1 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(out);
-    worst_ns = std::max(worst_ns, static_cast<double>(
-                                      std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count()));
+    tick_ns.push_back(static_cast<double>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count()));
   }
-  state.counters["worst_tick_us"] = worst_ns * 1e-3;
+  // Wall-clock per tick: the 99.9th percentile is the identifier's heaviest phase; the maximum
+  // also holds whatever preemption the machine did, so it is reported but not the figure to quote.
+  std::sort(tick_ns.begin(), tick_ns.end());
+  if (!tick_ns.empty()) {
+    state.counters["p50_tick_us"] = tick_ns[tick_ns.size() / 2] * 1e-3;
+    state.counters["p999_tick_us"] = tick_ns[tick_ns.size() * 999 / 1000] * 1e-3;
+    state.counters["max_tick_us"] = tick_ns.back() * 1e-3;
+  }
   state.counters["id_windows"] = gnc.identifier().counters().windows;
   state.SetLabel(to_string(gnc.mode()));
 }
