@@ -209,6 +209,10 @@ CaseConfig load_case(const std::string& path) {
   c.bias_nm = doc.vec3("disturbance_bias_nm");
   c.duration_s = doc.positive("duration_s");
   c.seed = doc.unsigned_integer("seed");
+  // The plant's truth beyond the study (thruster faults, the valve driver's timeout): read by the
+  // ground's loader (ground/config), never by the flight software.
+  doc.skip("faults");
+  doc.skip("valve_driver_timeout_s");
   doc.finish();
   return c;
 }

@@ -301,7 +301,7 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
   const config::GncConfig gnc_cfg = config::load_gnc(spec.gnc_file);
   std::vector<config::RunSetup> setups;
   for (const std::string& f : spec.case_files) {
-    setups.push_back(config::assemble(mission, gnc_cfg, config::load_case(f)));
+    setups.push_back(config::load_case_run(mission, gnc_cfg, f));
     rep.cases.push_back(setups.back().case_name);
   }
   for (const Strategy& s : spec.strategies) rep.strategies.push_back(s.name);
