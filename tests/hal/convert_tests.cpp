@@ -70,6 +70,28 @@ TEST(Convert, ThrusterCommandRoundTripsThroughTheWire) {
   EXPECT_EQ(bank.channel_forces(back), cmd.force);
 }
 
+TEST(Convert, LatchValvesRoundTripAndAFreshMessageMeansOpen) {
+  for (int mask = 0; mask < 16; ++mask) {
+    ThrusterOutputs o;
+    o.enabled = mask % 3 == 0;
+    for (int p = 0; p < 4; ++p) o.valve_open[static_cast<std::size_t>(p)] = ((mask >> p) & 1) == 0;
+    const auto b = bytes(to_message(o, gnc::Vec8::Zero(), mask, 0.1 * mask));
+    rocksteady::thruster_cmd_t m{};
+    ASSERT_TRUE(safe_decode(b.data(), static_cast<int>(b.size()), m));
+    for (int p = 0; p < 4; ++p) EXPECT_EQ(m.valve_closed[p], (mask >> p) & 1);
+    EXPECT_EQ(to_outputs(m).valve_open, o.valve_open) << "mask " << mask;
+  }
+  // A message whose valve fields were never set (all zero) keeps every valve open.
+  EXPECT_EQ(to_outputs(make<rocksteady::thruster_cmd_t>()).valve_open,
+            (std::array<bool, 4>{true, true, true, true}));
+  // A valve flag other than 0/1 is out of range.
+  auto m = make<rocksteady::thruster_cmd_t>();
+  m.valve_closed[2] = 3;
+  const auto b = bytes(m);
+  rocksteady::thruster_cmd_t back{};
+  EXPECT_EQ(decode(b.data(), static_cast<int>(b.size()), back), DecodeStatus::kOutOfRange);
+}
+
 TEST(Convert, DisabledCommandDecodesToAllOff) {
   auto m = make<rocksteady::thruster_cmd_t>();
   m.enabled = 0;
