@@ -68,6 +68,11 @@ struct DrawParams {
   double disturbance_sigma_nm{0.0};
   std::uint64_t noise_seed{1};
   double u_max_n{200.0};
+  // Fault dispersion: the case file flown (empty: the parameters above) and the thruster fault.
+  std::string case_file;
+  int case_number{0};
+  bool has_fault{false};
+  plant::ThrusterFault fault{};
   std::string error;  // non-empty: no valid draw (e.g. no PD estimate within the limit)
 };
 
@@ -93,6 +98,7 @@ enum Stream : std::uint64_t {
   kMatrixStream = 3,
   kNoiseSeedStream = 4,
   kLhsStream = 5,
+  kFaultStream = 6,
 };
 
 }  // namespace rocksteady::dispersion
