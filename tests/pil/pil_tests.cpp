@@ -561,8 +561,12 @@ TEST(PilPlantFaults, BusInjectionIsAnsweredAndTheValveDriverSwitchesOffWhenTheFl
   bus.publish_raw(channels::kPlantFault, encode(bad));
   ASSERT_TRUE(bus.spin_until([&] { return bus.has_event(kEvFaultRejected); }, 5.0)) << logs();
   for (const auto& e : bus.events) {
-    if (e.id == kEvFaultRejected) EXPECT_NE(e.text.find("[0, 15]"), std::string::npos) << e.text;
-    if (e.id == kEvFaultAccepted) EXPECT_NE(e.text.find("thruster 6 stuck_on"), std::string::npos);
+    if (e.id == kEvFaultRejected) {
+      EXPECT_NE(e.text.find("[0, 15]"), std::string::npos) << e.text;
+    }
+    if (e.id == kEvFaultAccepted) {
+      EXPECT_NE(e.text.find("thruster 6 stuck_on"), std::string::npos) << e.text;
+    }
   }
   auto malformed = inject;
   malformed.onset_s = std::nan("");
