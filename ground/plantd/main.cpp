@@ -595,6 +595,11 @@ int main(int argc, char** argv) {
                 ", rx rejected %" PRIu64 ", thruster/channel mismatches %" PRIu64 "\n",
                 bus.commands, applied, timeouts, resends, holds, stale, bus.rx.rejected(),
                 wiring_mismatch);
+    std::printf("  faults: %s; commands accepted %" PRIu64 ", rejected %" PRIu64
+                ", malformed %" PRIu64 "; valve-driver timeouts %" PRIu64 " (%" PRIu64
+                " periods off)\n",
+                plant::describe(plant.faults()).c_str(), faults_accepted, faults_rejected,
+                bus.fault_rx.rejected(), driver_timeouts, plant.timeout_periods());
     std::printf("summary: case=%d mode=%s periods=%" PRIu64
                 " t_omega=%s fuel_omega=%s t_q=%s "
                 "fuel_q=%s total_fuel=%.17g final_rate=%.17g final_q_error=%.17g flight_mode=%s "
