@@ -167,6 +167,30 @@ void BM_AllocateL1(benchmark::State& state) {
 }
 BENCHMARK(BM_AllocateL1);
 
+// Allocation under failure limits (arg 0: pinv, 1: L1): thruster 2 (channel 1 "+") stuck on with
+// its bias torque, and pod 3's latch valve closed.
+void BM_AllocateUnderLimits(benchmark::State& state) {
+  const GncParams p = study_gnc_params(200.0);
+  const Mat38 b = torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
+  Allocator a;
+  a.configure(b, p.rcs.u_max,
+              state.range(0) == 0 ? AllocatorKind::kPseudoInverse : AllocatorKind::kL1);
+  AllocatorLimits lim = nominal_limits(p.rcs.u_max);
+  lim.hi(1) = 0.0;
+  lim.bias = p.rcs.u_max * b.col(1);
+  lim.lo(6) = lim.hi(6) = lim.lo(7) = lim.hi(7) = 0.0;
+  Vec3 uc(300.0, -150.0, 800.0);
+  Vec8 u;
+  AllocatorStatus st;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(uc);
+    a.allocate(uc, lim, u, st);
+    benchmark::DoNotOptimize(u);
+  }
+  state.counters["simplex_iterations"] = st.l1_iterations;
+}
+BENCHMARK(BM_AllocateUnderLimits)->Arg(0)->Arg(1);
+
 }  // namespace
 
 BENCHMARK_MAIN();

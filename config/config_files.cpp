@@ -261,6 +261,10 @@ CaseConfig load_case(const std::string& path) {
   c.duration_s = doc.positive("duration_s");
   c.seed = doc.unsigned_integer("seed");
   if (doc.has("plant_truth")) c.plant_truth = doc.get("plant_truth");
+  // The plant's truth beyond the study (thruster faults, the valve driver's timeout): read by the
+  // ground's loader (ground/config), never by the flight software.
+  doc.skip("faults");
+  doc.skip("valve_driver_timeout_s");
   doc.finish();
   return c;
 }

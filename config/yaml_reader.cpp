@@ -155,6 +155,12 @@ Eigen::Matrix3d MapReader::matrix3(const std::string& key) {
   return m;
 }
 
+bool MapReader::skip(const std::string& key) {
+  if (!has(key)) return false;
+  read_.insert(key);
+  return true;
+}
+
 void MapReader::finish() const {
   for (const auto& kv : node_) {
     const std::string k = kv.first.as<std::string>();

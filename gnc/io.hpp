@@ -113,6 +113,9 @@ struct GncCommands {
 struct ThrusterCommand {
   Vec8 force{Vec8::Zero()};  // signed channel forces, N, |u_i| <= u_max
   bool enabled{false};       // false: all thrusters inhibited (IDLE, SAFE)
+  // Latch valve of each pod (isolates a failed-on thruster): closed, none of the pod's four
+  // thrusters can fire. Independent of `enabled`; all open by default.
+  std::array<bool, kPods> valve_open{true, true, true, true};
 };
 
 // What the estimators report each tick (zeros for a module that is off).

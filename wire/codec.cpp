@@ -88,7 +88,7 @@ DecodeStatus check(const rocksteady::sensor_frame_t& m) {
 DecodeStatus check(const rocksteady::thruster_cmd_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
   if (m.seq < 0 || !std::isfinite(m.t) || !is_bool(m.enabled) || !all_bool(m.thruster_on) ||
-      !finite(m.channel_force) || !finite(m.thruster_force)) {
+      !finite(m.channel_force) || !finite(m.thruster_force) || !all_bool(m.valve_closed)) {
     return DecodeStatus::kOutOfRange;
   }
   for (const double f : m.thruster_force) {
@@ -129,7 +129,15 @@ DecodeStatus check(const rocksteady::cmd_ack_t& m) {
 
 DecodeStatus check(const rocksteady::plant_truth_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
-  return range(m.seq >= 0 && std::isfinite(m.t));
+  return range(m.seq >= 0 && std::isfinite(m.t) && all_bool(m.valve_open) &&
+               is_bool(m.command_timeout));
+}
+
+// Wire validity only; what the command asks (op, thruster, kind, factor) is the plant's to judge,
+// with a reason in its answer.
+DecodeStatus check(const rocksteady::plant_fault_cmd_t& m) {
+  if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
+  return range(m.seq >= 0 && std::isfinite(m.onset_s) && std::isfinite(m.factor));
 }
 
 DecodeStatus check(const rocksteady::trajectory_chunk_t& m) {

@@ -53,6 +53,9 @@ rocksteady::thruster_cmd_t to_message(const hal::ThrusterOutputs& outputs, const
     m.thruster_on[i] = outputs.on[k] ? 1 : 0;
     m.thruster_force[i] = outputs.on[k] ? outputs.force[k] : 0.0;
   }
+  for (int p = 0; p < gnc::kPods; ++p) {
+    m.valve_closed[p] = outputs.valve_open[static_cast<std::size_t>(p)] ? 0 : 1;
+  }
   return m;
 }
 
@@ -64,6 +67,7 @@ hal::ThrusterOutputs to_outputs(const rocksteady::thruster_cmd_t& m) {
     o.on[k] = o.enabled && m.thruster_on[i] != 0;
     o.force[k] = o.on[k] ? m.thruster_force[i] : 0.0;
   }
+  for (int p = 0; p < gnc::kPods; ++p) o.valve_open[static_cast<std::size_t>(p)] = m.valve_closed[p] == 0;
   return o;
 }
 

@@ -39,6 +39,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   r.case_name = setup.case_name;
   r.case_number = setup.case_number;
   r.strategy = strategy.name;
+  r.faults = plant::describe(setup.truth.faults);
   if (strategy.needs_trajectory() && trajectory == nullptr) {
     r.status = RunStatus::kNoReference;
     r.note = no_reference_note;

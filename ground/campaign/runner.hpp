@@ -72,6 +72,7 @@ struct RunResult {
   std::string strategy;
   RunStatus status{RunStatus::kOk};
   std::string note;
+  std::string faults{"none"};  // the plant's injected thruster faults (plant::describe)
   std::optional<double> t_omega_conv_s;
   std::optional<double> fuel_at_t_omega_kg;
   std::optional<double> t_q_conv_s;

@@ -74,7 +74,7 @@ void visit(const rocksteady::sensor_frame_t& m, Sink& s) {
 
 void visit(const rocksteady::thruster_cmd_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(seq); RS_D(t); RS_I(enabled);
-  RS_A(channel_force); RS_A(thruster_on); RS_A(thruster_force);
+  RS_A(channel_force); RS_A(thruster_on); RS_A(thruster_force); RS_A(valve_closed);
 }
 
 void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
@@ -122,6 +122,8 @@ void visit(const rocksteady::plant_truth_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(seq); RS_D(t);
   RS_A(quat); RS_A(q); RS_A(omega); RS_D(omega_norm); RS_A(channel_force); RS_A(torque_control);
   RS_A(torque_disturbance); RS_D(fuel_used_kg);
+  RS_A(fault_kind); RS_A(fault_factor); RS_A(fault_onset); RS_A(thruster_force); RS_A(valve_open);
+  RS_I(command_timeout);
 }
 
 void visit(const rocksteady::trajectory_chunk_t& m, Sink& s) {

@@ -105,11 +105,39 @@ Readback read_back(const plant::Plant& plant, const gnc::GncParams& flown) {
   b.u_max_true_n = t.rcs.u_max;
   b.u_max_flight_n = flown.rcs.u_max;
   b.allocator = flown.allocator == gnc::AllocatorKind::kL1 ? "l1" : "pinv";
+  b.faults = plant::describe(plant.params().faults);
   return b;
 }
 
+namespace {
+
+// The draw's thruster fault added to the plant's (replacing a case file's fault of that thruster).
+void add_fault(const DrawParams& d, config::RunSetup& s, const std::string& file) {
+  if (!d.has_fault) return;
+  auto& faults = s.truth.faults;
+  for (auto it = faults.begin(); it != faults.end();) {
+    it = it->thruster == d.fault.thruster ? faults.erase(it) : it + 1;
+  }
+  faults.push_back(d.fault);
+  try {
+    plant::validate(s.truth);
+  } catch (const std::invalid_argument& e) {
+    throw config::ConfigError(file, "faults", e.what());
+  }
+}
+
+}  // namespace
+
 config::RunSetup make_setup(const config::MissionConfig& mission, const config::GncConfig& gnc,
                             const DispersionSpec& spec, const DrawParams& d) {
+  if (!d.case_file.empty()) {  // a fault dispersion over study cases: the case as `campaign` flies it
+    config::RunSetup s = config::load_case_run(mission, gnc, d.case_file);
+    s.case_name = "draw" + std::to_string(d.index);
+    s.duration_s = spec.duration_s;
+    if (spec.override_allocator) s.flight.allocator = spec.allocator;
+    add_fault(d, s, spec.file);
+    return s;
+  }
   config::MissionConfig m = mission;
   m.initial_mrp = d.mrp0;
   m.initial_omega = d.omega0;
@@ -136,6 +164,7 @@ config::RunSetup make_setup(const config::MissionConfig& mission, const config::
   if (spec.override_allocator) s.flight.allocator = spec.allocator;
   const gnc::ParamCheck check = gnc::validate(s.flight);
   if (!check.ok) throw config::ConfigError(c.file, check.field, check.reason);
+  add_fault(d, s, spec.file);
   return s;
 }
 
@@ -253,7 +282,16 @@ json to_json(const DrawResult& r, bool with_timing) {
                    std::vector<double>(d.thruster_strength.data(),
                                        d.thruster_strength.data() + gnc::kThrusters)},
                   {"gyro_bias_rad_s", vec(d.gyro_bias)},
+                  {"case_file", d.case_file},
+                  {"case", d.case_number},
+                  {"fault", d.has_fault ? plant::describe(d.fault) : std::string("none")},
                   {"error", d.error}};
+  if (d.has_fault) {
+    sampled["fault_thruster"] = d.fault.thruster;
+    sampled["fault_kind"] = plant::to_string(d.fault.kind);
+    sampled["fault_onset_s"] = d.fault.onset_s;
+    sampled["fault_factor"] = d.fault.factor;
+  }
   json flown = nullptr;
   if (r.flown) {
     const Readback& b = *r.flown;
@@ -269,7 +307,8 @@ json to_json(const DrawResult& r, bool with_timing) {
              {"noise_seed", b.noise_seed},
              {"u_max_true_n", b.u_max_true_n},
              {"u_max_flight_n", b.u_max_flight_n},
-             {"allocator", b.allocator}};
+             {"allocator", b.allocator},
+             {"faults", b.faults}};
   }
   json runs = json::array();
   json run_wall = json::object();
@@ -341,6 +380,15 @@ DrawResult draw_from_json(const json& top) {
   }
   if (s.contains("gyro_bias_rad_s")) d.gyro_bias = to_vec(s.at("gyro_bias_rad_s"));
   d.error = s.at("error").get<std::string>();
+  d.case_file = s.value("case_file", "");
+  d.case_number = s.value("case", 0);
+  if (s.contains("fault_thruster")) {
+    d.has_fault = true;
+    d.fault.thruster = s.at("fault_thruster").get<int>();
+    plant::parse_fault_kind(s.at("fault_kind").get<std::string>(), d.fault.kind);
+    d.fault.onset_s = s.at("fault_onset_s").get<double>();
+    d.fault.factor = s.at("fault_factor").get<double>();
+  }
   const json& f = j.at("flown");
   if (!f.is_null()) {
     Readback b;
@@ -357,6 +405,7 @@ DrawResult draw_from_json(const json& top) {
     b.u_max_true_n = f.at("u_max_true_n").get<double>();
     b.u_max_flight_n = f.at("u_max_flight_n").get<double>();
     b.allocator = f.value("allocator", "");
+    b.faults = f.value("faults", "none");
     r.flown = b;
   }
   r.eps_trans_rad_s = j.at("eps_trans_rad_s").get<double>();

@@ -32,6 +32,7 @@ struct Readback {
   double u_max_true_n{0.0};
   double u_max_flight_n{0.0};
   std::string allocator;  // the flight software's: pinv or l1
+  std::string faults;     // the plant's thruster faults (plant::describe), "none"
 };
 Readback read_back(const plant::Plant& plant, const gnc::GncParams& flown);
 

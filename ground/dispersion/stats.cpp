@@ -297,7 +297,7 @@ void write_results_csv(const std::string& path, const DispersionSpec& spec,
   out << "draw,strategy,status,success,t_omega_conv_s,fuel_at_t_omega_kg,t_q_conv_s,fuel_at_t_q_kg,"
          "total_fuel_kg,max_rate_rad_s,final_mode,delta_j_ast_norm_kg_m2,delta_r_so_bcm_norm_m,"
          "initial_rate_norm_rad_s,gyro_noise_psd_rad2_s2,star_noise_psd,disturbance_sigma_nm,"
-         "u_max_n,noise_seed,pd_redraws,note\n";
+         "u_max_n,noise_seed,pd_redraws,note,case,fault\n";
   for (const DrawResult& d : draws) {
     for (const StrategyOutcome& o : d.runs) {
       std::string note = o.note;
@@ -315,7 +315,11 @@ void write_results_csv(const std::string& path, const DispersionSpec& spec,
       } else {
         out << ",,,,,,,";
       }
-      out << "," << d.sampled.pd_redraws << "," << note << "\n";
+      out << "," << d.sampled.pd_redraws << "," << note << ","
+          << (d.sampled.case_number > 0 ? std::to_string(d.sampled.case_number) : std::string()) << ","
+          << (d.flown ? d.flown->faults
+                      : (d.sampled.has_fault ? plant::describe(d.sampled.fault) : std::string("none")))
+          << "\n";
     }
   }
 }

@@ -145,6 +145,20 @@ TEST(FlightComputer, AGyroWithoutValidReadingsTakesItToSafeWithThrustersOff) {
   EXPECT_GT(rig.computer->gyro_rejects(), 0u);
   EXPECT_EQ(rig.computer->mode(), gnc::Mode::kSafe);
   EXPECT_FALSE(rig.ports->last.enabled);
+  // SAFE keeps commanding every thruster off through the HAL, on every GNC tick: each of the 16 is
+  // written off with zero force (a valve driver that loses these commands times out on its own).
+  for (int i = 0; i < 20; ++i) {
+    const int writes = rig.ports->writes;
+    ASSERT_TRUE(rig.tick().gnc_ran);
+    EXPECT_EQ(rig.ports->writes, writes + 1);
+    EXPECT_EQ(rig.computer->mode(), gnc::Mode::kSafe);
+    EXPECT_FALSE(rig.ports->last.enabled);
+    for (int t = 0; t < hal::kThrusters; ++t) {
+      EXPECT_FALSE(rig.ports->last.on[static_cast<std::size_t>(t)]) << t;
+      EXPECT_EQ(rig.ports->last.force[static_cast<std::size_t>(t)], 0.0) << t;
+    }
+    EXPECT_EQ(rig.ports->last.valve_open, (std::array<bool, 4>{true, true, true, true}));
+  }
 }
 
 // A harness reaches the devices only through the ports: the flight computer exposes no device,
