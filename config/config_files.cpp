@@ -193,6 +193,23 @@ GncConfig load_gnc(const std::string& path) {
     r.finish();
   }
 
+  // Thruster fault detection and isolation (optional; off when absent).
+  if (doc.has("fdi")) {
+    MapReader r = doc.map("fdi");
+    gnc::FaultDetectorParams& fd = p.fdi;
+    fd.enabled = r.boolean("enabled");
+    fd.window_ticks = r.integer("window_ticks");
+    g.fdi_window_noisy_ticks = r.integer("window_noisy_ticks");
+    fd.model_rel_floor = r.non_negative("model_rel_floor");
+    fd.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
+    fd.confirm_llr = r.positive("confirm_llr");
+    fd.margin_llr = r.non_negative("margin_llr");
+    fd.suspect_chi2 = r.positive("suspect_chi2");
+    fd.auto_isolate = r.boolean("auto_isolate");
+    p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
+    r.finish();
+  }
+
   MapReader laws = doc.map("laws");
   tracking(laws.map("ntcl"), p.ntcl);
   tracking(laws.map("el"), p.el);
@@ -315,6 +332,8 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   p.mekf.star_sigma = std::fmax(4.0 * std::sqrt(c.star_psd / m.sensor_period_s), 1e-7);
   p.identification.config.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
   if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
+  p.fdi.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
+  if (noisy) p.fdi.window_ticks = g.fdi_window_noisy_ticks;
   const gnc::ParamCheck check = gnc::validate(p);
   if (!check.ok) {
     const std::string field = check.field;

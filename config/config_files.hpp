@@ -48,6 +48,9 @@ struct GncConfig {
   // Identification window when the case's sensors are noisy (params.identification.config.window_s
   // is the quiet-sensor one): a longer window averages the gyro noise down (estimation README §I.4).
   double id_window_noisy_s{60.0};
+  // Fault-detector residual window when the case's sensors are noisy (params.fdi.window_ticks is
+  // the quiet-sensor one).
+  int fdi_window_noisy_ticks{25};
 };
 
 struct CaseConfig {

@@ -10,7 +10,7 @@
 //   start=hold    start from a slow residual rate and command HOLD instead (instruction counts of
 //                 the HOLD phase without simulating the despin); success = HOLD kept throughout
 //   modules=all   every flight-core module on (the budget of DEVELOPERS.md): the MEKF, on-line
-//                 identification with automatic model adoption, and the L1 allocator
+//                 identification with automatic model adoption, fault detection, the L1 allocator
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -114,6 +114,7 @@ int firmware_main() {
     g_params.allocator = gnc::AllocatorKind::kL1;
     g_params.identification.enabled = true;
     g_params.identification.adopt = gnc::ModelAdoption::kAuto;
+    g_params.fdi.enabled = true;
   }
   const gnc::ParamCheck check = g_gnc.init(g_params);
   if (!check.ok) {
@@ -141,7 +142,7 @@ int firmware_main() {
   line.str("firmware: Cortex-M7 (fpv5-d16), sizeof(Gnc)=").u32(sizeof(gnc::Gnc))
       .str(" B, sizeof(GncParams)=").u32(sizeof(gnc::GncParams))
       .str(" B, dt=").fix(g_params.dt, 2).str(" s, run ").u32(opt.seconds).str(" s")
-      .str(opt.all_modules ? ", modules: MEKF + identification + L1" : ", modules: study");
+      .str(opt.all_modules ? ", modules: MEKF + identification + FDI + L1" : ", modules: study");
   line.flush();
 
   const double dt = g_params.dt;

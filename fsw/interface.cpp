@@ -144,6 +144,16 @@ const char* to_string(EventId id) {
       return "model_refused";
     case EventId::kModelLoaded:
       return "model_loaded";
+    case EventId::kFaultSuspected:
+      return "fault_suspected";
+    case EventId::kFaultConfirmed:
+      return "fault_confirmed";
+    case EventId::kValveClosed:
+      return "valve_closed";
+    case EventId::kFaultOverride:
+      return "fault_override";
+    case EventId::kReducedAuthority:
+      return "reduced_authority";
   }
   return "?";
 }

@@ -144,6 +144,11 @@ enum class EventId : std::int32_t {
   kModelAdopted = 126,  // the identified model became the active table (automatic policy)
   kModelRefused = 127,  // a confident identified model failed table validation
   kModelLoaded = 128,   // PARAM_LOAD_IDENTIFIED: the identified model is in the inactive table
+  kFaultSuspected = 129,   // arg0 = leading thruster (-1 none), arg1 = 1 stuck-on / 2 stuck-off
+  kFaultConfirmed = 130,   // arg0 = thruster, arg1 = gnc::FaultKind; latched until cleared
+  kValveClosed = 131,      // arg0 = pod, arg1 = the stuck-on thruster it isolates
+  kFaultOverride = 132,    // arg0 = thruster / pod / -1, arg1 = kind / 10 open / 11 close / 20, 21 inhibit
+  kReducedAuthority = 133, // arg0 = rank, arg1 = usable channels
 };
 const char* to_string(EventId id);
 

@@ -32,6 +32,13 @@ ParamCheck Gnc::init(const GncParams& params) {
   // The identifier starts from this table's model as its prior; a later table switch keeps its
   // estimate (set_params).
   if (params_.identification.enabled) ident_.configure(build_identifier_config(params_));
+  fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
+  fdi_.clear(-1);
+  valve_open_ = {{true, true, true, true}};
+  last_valve_ = valve_open_;
+  isolation_inhibited_ = false;
+  reduced_reported_ = false;
+  refresh_fault_model();
   modes_.reset(params.mode.initial);
   laws_.reset_state();
   trajectory_valid_ = false;
@@ -75,6 +82,16 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   }
   params_ = params;
   configure_components();
+  {
+    // The detector takes the new table; what it has confirmed stays latched.
+    const std::uint16_t on = fdi_.confirmed_on();
+    const std::uint16_t off = fdi_.confirmed_off();
+    fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
+    for (int i = 0; i < kThrusters; ++i) {
+      if ((on >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOn);
+      if ((off >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOff);
+    }
+  }
   if (estimator_changed) {
     filter_.reset();
     mekf_.reset();
@@ -88,8 +105,121 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
     candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
     ident_.reinflate_all();
   }
+  refresh_fault_model();
   if (!target_changed) refs_.set_target(target);  // keep a ground-commanded target
   return c;
+}
+
+void Gnc::refresh_fault_model() {
+  FaultModel m;
+  if (params_.identification.enabled) {
+    const IdentifierEstimate& e = ident_.estimate();
+    m.j = e.j;
+    m.r = e.r;
+    m.k = e.k;
+    m.j_rel_sigma = e.j_sigma.maxCoeff() / e.j.norm();
+  } else {
+    m.j = total_inertia(params_.mass_hat);
+    m.r = params_.mass_hat.r_so_bcm;
+    m.k = params_.rcs.strength;
+    m.j_rel_sigma = params_.fdi_table_rel_sigma;
+  }
+  fdi_.set_model(m);
+}
+
+void Gnc::apply_fault_overrides(const GncCommands& commands, ModeEvents& events) {
+  const Mode mode = modes_.mode();
+  if (commands.has_fault_declaration) {
+    const int i = commands.fault_thruster;
+    if (commands.fault_kind == FaultKind::kNone) {
+      fdi_.clear(i);
+    } else if (i >= 0 && i < kThrusters) {
+      fdi_.declare(i, commands.fault_kind);
+      if (params_.identification.enabled) ident_.reinflate_thruster(i);
+    }
+    ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
+    e.arg0 = static_cast<std::int16_t>(i);
+    e.arg1 = static_cast<std::int16_t>(commands.fault_kind);
+    events.push(e);
+  }
+  if (commands.has_valve && commands.valve_pod >= 0 && commands.valve_pod < kPods) {
+    valve_open_[static_cast<std::size_t>(commands.valve_pod)] = commands.valve_open;
+    ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
+    e.arg0 = commands.valve_pod;
+    e.arg1 = static_cast<std::int16_t>(commands.valve_open ? 10 : 11);  // valve open / close
+    events.push(e);
+  }
+  if (commands.has_isolation_inhibit) {
+    isolation_inhibited_ = commands.isolation_inhibited;
+    ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
+    e.arg0 = -1;
+    e.arg1 = static_cast<std::int16_t>(commands.isolation_inhibited ? 20 : 21);
+    events.push(e);
+  }
+}
+
+void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events) {
+  if (!params_.fdi.enabled) return;
+  FaultDetectorInput in;
+  in.omega = omega;
+  in.omega_valid = omega_valid;
+  for (int c = 0; c < kChannels; ++c) {
+    const double f = last_force_(c);
+    in.thrust(2 * c) = f > 0.0 ? f : 0.0;
+    in.thrust(2 * c + 1) = f < 0.0 ? -f : 0.0;
+  }
+  in.valve_open = last_valve_;
+  const FaultEvents fe = fdi_.update(in);
+  const Mode mode = modes_.mode();
+  if (fe.suspected && !fe.confirmed) {
+    ModeEvent e{EventId::kFaultSuspected, mode, mode, TransitionCheck::kOk};
+    const int best = fdi_.status().best;
+    e.arg0 = static_cast<std::int16_t>(best < 0 ? -1 : best % kThrusters);
+    e.arg1 = static_cast<std::int16_t>(best < 0 ? 0 : best < kThrusters ? 1 : 2);
+    events.push(e);
+  }
+  if (fe.confirmed) {
+    ModeEvent e{EventId::kFaultConfirmed, mode, mode, TransitionCheck::kOk};
+    e.arg0 = static_cast<std::int16_t>(fe.thruster);
+    e.arg1 = static_cast<std::int16_t>(fe.kind);
+    events.push(e);
+    // The identifier's data of that thruster no longer describe it.
+    if (params_.identification.enabled) ident_.reinflate_thruster(fe.thruster);
+    const int pod = params_.rcs.channel_pod[fe.thruster / 2];
+    const auto p = static_cast<std::size_t>(pod);
+    if (fe.kind == FaultKind::kStuckOn && params_.fdi.auto_isolate && !isolation_inhibited_ &&
+        valve_open_[p]) {
+      valve_open_[p] = false;  // the pod's latch valve: the stuck jet stops, its pod with it
+      ModeEvent v{EventId::kValveClosed, mode, mode, TransitionCheck::kOk};
+      v.arg0 = static_cast<std::int16_t>(pod);
+      v.arg1 = static_cast<std::int16_t>(fe.thruster);
+      events.push(v);
+    }
+  }
+}
+
+AllocatorLimits Gnc::allocation_limits() const {
+  // In produced force (B_hat's units): a thruster of strength k reaches k u_max. A thruster is
+  // usable when its pod's valve is open and no fault is latched on it; a latched stuck-on thruster
+  // behind an open valve is a known bias torque (SPEC §4 column, + or - side).
+  AllocatorLimits l;
+  l.bias.setZero();
+  const double u_max = params_.rcs.u_max;
+  const std::uint16_t on = fdi_.confirmed_on();
+  const std::uint16_t off = fdi_.confirmed_off();
+  const Mat38& b = alloc_.b_hat();
+  for (int c = 0; c < kChannels; ++c) {
+    const bool open = valve_open_[static_cast<std::size_t>(params_.rcs.channel_pod[c])];
+    const int tp = 2 * c;
+    const int tm = 2 * c + 1;
+    const bool plus_ok = open && !(((on | off) >> tp) & 1u);
+    const bool minus_ok = open && !(((on | off) >> tm) & 1u);
+    l.hi(c) = plus_ok ? params_.rcs.strength(tp) * u_max : 0.0;
+    l.lo(c) = minus_ok ? -params_.rcs.strength(tm) * u_max : 0.0;
+    if (open && ((on >> tp) & 1u)) l.bias += b.col(c) * (params_.rcs.strength(tp) * u_max);
+    if (open && ((on >> tm) & 1u)) l.bias -= b.col(c) * (params_.rcs.strength(tm) * u_max);
+  }
+  return l;
 }
 
 TransitionCheck Gnc::check_mode_request(Mode to) const {
@@ -171,8 +301,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     have_time_ = true;
   }
 
-  // 0. Tick boundary: an identified model adopted by the automatic policy takes effect now.
+  // 0. Tick boundary: an identified model adopted by the automatic policy takes effect now, and
+  // the ground's fault overrides.
   adopt_model(t, out.events);
+  apply_fault_overrides(commands, out.events);
 
   // 1. Estimator: accept only finite, in-range samples.
   const EstimatorParams& ep = params_.estimator;
@@ -225,8 +357,14 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
       if (mekf) id_bias_ = mekf_.bias();
+      refresh_fault_model();  // the detector predicts with the latest identified model
     }
   }
+
+  // 1c. Fault detection and isolation (gnc/fdi/README.md): the same rate, the same thrust.
+  detect_faults(ep.kind == EstimatorKind::kMekf ? Vec3(m.omega - id_bias_) : m.omega,
+                m.omega_valid && (ep.kind != EstimatorKind::kMekf || mekf_.initialised()),
+                out.events);
 
   // 2. Mode manager: ground requests at the tick boundary, then autonomous transitions.
   const Mode before = modes_.mode();
@@ -273,7 +411,13 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   AllocatorStatus status;
   const bool enabled = actuating(modes_.mode());
   if (enabled) {
-    alloc_.allocate(u_c, u, status);
+    alloc_.allocate(u_c, allocation_limits(), u, status);
+    if (status.reduced_authority && !reduced_reported_) {
+      out.events.push(ModeEvent{EventId::kReducedAuthority, modes_.mode(), modes_.mode(),
+                                TransitionCheck::kOk, static_cast<std::int16_t>(status.rank),
+                                static_cast<std::int16_t>(status.active_channels)});
+    }
+    reduced_reported_ = status.reduced_authority;
   } else {
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
@@ -290,6 +434,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
 
   out.command.force = force;
   out.command.enabled = enabled;
+  out.command.valve_open = valve_open_;
+  last_valve_ = valve_open_;
   GncTelemetry& tl = out.telemetry;
   tl.t = t;
   tl.tick = tick_++;
@@ -308,6 +454,23 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   tl.a_hat = laws_.a_hat();
   tl.integral = laws_.integral();
   fill_estimation_telemetry(tl);
+  FdiTelemetry& f = tl.fdi;
+  const FaultDetectorStatus& fs = fdi_.status();
+  f.enabled = params_.fdi.enabled;
+  f.residual = fs.residual;
+  f.chi2 = fs.chi2;
+  f.noise_sigma = fs.noise_sigma;
+  f.best = static_cast<std::int8_t>(fs.best);
+  f.best_llr = fs.best_llr;
+  f.runner_up_llr = fs.runner_up_llr;
+  f.suspected_on = fs.suspected_on;
+  f.suspected_off = fs.suspected_off;
+  f.confirmed_on = fs.confirmed_on;
+  f.confirmed_off = fs.confirmed_off;
+  f.valve_open = valve_open_;
+  f.isolation_inhibited = isolation_inhibited_;
+  f.windows = fs.windows;
+  f.suspicions = fs.suspicions;
 }
 
 void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {

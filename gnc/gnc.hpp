@@ -10,6 +10,7 @@
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
+#include "gnc/fdi/fault_detector.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/guidance/trajectory.hpp"
 #include "gnc/io.hpp"  // SensorSample, GncCommands, GncOutput: what step() takes and gives
@@ -52,6 +53,8 @@ class Gnc {
   const StateFilter& estimator() const { return filter_; }
   const Mekf& mekf() const { return mekf_; }
   const Identifier& identifier() const { return ident_; }
+  const FaultDetector& fault_detector() const { return fdi_; }
+  const std::array<bool, kPods>& valve_open() const { return valve_open_; }
   std::uint32_t model_adoptions() const { return adoptions_; }
 
  private:
@@ -61,11 +64,20 @@ class Gnc {
   bool differs(const GncParams& p, const IdentifiedModel& m) const;  // beyond the confidence bounds
   void adopt_model(double t, ModeEvents& events);  // automatic policy, at the tick boundary
   void fill_estimation_telemetry(GncTelemetry& tl) const;
+  void refresh_fault_model();
+  void apply_fault_overrides(const GncCommands& commands, ModeEvents& events);
+  void detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events);
+  AllocatorLimits allocation_limits() const;
 
   GncParams params_{};
   StateFilter filter_{};
   Mekf mekf_{};
   Identifier ident_{};
+  FaultDetector fdi_{};
+  std::array<bool, kPods> valve_open_{{true, true, true, true}};  // commanded this tick
+  std::array<bool, kPods> last_valve_{{true, true, true, true}};  // over the previous tick
+  bool isolation_inhibited_{false};
+  bool reduced_reported_{false};
   ModeManager modes_{};
   References refs_{};
   ControlLaws laws_{};

@@ -60,7 +60,16 @@ enum class EventId : std::uint8_t {
   kSensorRejected,   // a sample failed validity / range checks
   kModelAdopted,     // the identified model became the active table (automatic policy)
   kModelRefused,     // a confident identified model failed table validation (kept the old one)
+  kFaultSuspected,   // a residual window failed the no-fault test (arg0 = leading thruster or -1)
+  kFaultConfirmed,   // a thruster fault confirmed and latched (arg0 = thruster, arg1 = FaultKind)
+  kValveClosed,      // a pod's latch valve closed to isolate a stuck-on thruster (arg0 = pod)
+  kFaultOverride,    // a ground override applied (arg0 = thruster or pod, arg1 = what)
+  kReducedAuthority, // the remaining thrusters cannot produce every torque direction
 };
+
+// Thruster fault kinds the flight software declares (gnc/fdi).
+enum class FaultKind : std::uint8_t { kNone = 0, kStuckOn = 1, kStuckOff = 2 };
+const char* to_string(FaultKind k);
 const char* to_string(EventId e);
 
 // Why an identified model is or is not a parameter-table candidate now (Gnc::model_candidate).
@@ -78,6 +87,8 @@ struct ModeEvent {
   Mode from{Mode::kIdle};
   Mode to{Mode::kIdle};
   TransitionCheck reason{TransitionCheck::kOk};
+  std::int16_t arg0{0};  // event data where the event has any (fault events)
+  std::int16_t arg1{0};
 };
 
 struct ModeEvents {
@@ -108,6 +119,15 @@ struct GncCommands {
   Vec3 target_mrp{Vec3::Zero()};
   bool has_law{false};
   LawId law{LawId::kNtcl};
+  // Ground overrides of fault management.
+  bool has_fault_declaration{false};
+  std::int8_t fault_thruster{-1};        // 0..15; -1 with kNone: clear every declaration
+  FaultKind fault_kind{FaultKind::kNone};  // kNone: clear
+  bool has_valve{false};
+  std::int8_t valve_pod{0};
+  bool valve_open{true};
+  bool has_isolation_inhibit{false};
+  bool isolation_inhibited{false};       // true: a confirmed stuck-on does not close its valve
 };
 
 struct ThrusterCommand {
@@ -146,6 +166,25 @@ struct EstimationTelemetry {
   std::uint32_t adoptions{0};           // identified models adopted into the active table
 };
 
+// Fault detection and isolation (zeros when off).
+struct FdiTelemetry {
+  bool enabled{false};
+  Vec3 residual{Vec3::Zero()};  // rad/s, last window's unexplained rate change
+  double chi2{0.0};             // its no-fault chi-square (3 dof)
+  double noise_sigma{0.0};      // rad/s, the residual's 1 sigma
+  std::int8_t best{-1};         // leading hypothesis: 0..15 stuck-on, 16..31 stuck-off
+  double best_llr{0.0};
+  double runner_up_llr{0.0};
+  std::uint16_t suspected_on{0};
+  std::uint16_t suspected_off{0};
+  std::uint16_t confirmed_on{0};
+  std::uint16_t confirmed_off{0};
+  std::array<bool, kPods> valve_open{{true, true, true, true}};
+  bool isolation_inhibited{false};
+  std::uint32_t windows{0};
+  std::uint32_t suspicions{0};
+};
+
 struct GncTelemetry {
   double t{0.0};
   std::uint32_t tick{0};
@@ -164,6 +203,7 @@ struct GncTelemetry {
   Vec6 a_hat{Vec6::Zero()};     // adaptive law's inertia estimate
   Vec3 integral{Vec3::Zero()};  // integral law's state
   EstimationTelemetry est{};
+  FdiTelemetry fdi{};
 };
 
 struct GncOutput {

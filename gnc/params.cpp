@@ -197,6 +197,14 @@ ParamCheck validate(const GncParams& p) {
     if (!ic.ok) return bad(ic.field, ic.reason);
   }
 
+  if (p.fdi.enabled) {
+    const Check fc = validate(p.fdi);
+    if (!fc.ok) return fc;
+  }
+  if (!finite_non_negative(p.fdi_table_rel_sigma)) {
+    return bad("fdi_table_rel_sigma", "must be >= 0 and finite");
+  }
+
   if (static_cast<int>(p.mode.initial) >= kModeCount) {
     return bad("mode.initial", "unknown mode");
   }

@@ -12,6 +12,7 @@
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
+#include "gnc/fdi/fault_detector.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/io.hpp"
 #include "gnc/mode/mode_manager.hpp"
@@ -39,6 +40,10 @@ struct GncParams {
   // quat_norm_tolerance are the table's dt and estimator fields (build_mekf_config).
   MekfConfig mekf{};
   IdentificationParams identification{};  // on-line identification of J_tot, r_SO/BCM, k_i
+  FaultDetectorParams fdi{};               // thruster fault detection and isolation (gnc/fdi)
+  // Relative 1 sigma of the table's J_tot when the detector runs without identification (the
+  // asteroid known to ~10 %): the detector's model-uncertainty term, so it stays quiet.
+  double fdi_table_rel_sigma{0.1};
   ModeParams mode{};
   // SPEC §4: the study's pseudoinverse, Eq. (53), or the fuel-optimal allocation, Eq. (52).
   AllocatorKind allocator{AllocatorKind::kPseudoInverse};

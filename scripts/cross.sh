@@ -98,7 +98,7 @@ if [[ -z "$only" || "$only" == "baremetal" ]]; then
     echo "cross: FAIL: the firmware image exited with $rc" >&2
     exit 1
   fi
-  stage "bare metal: every module on (MEKF, identification, L1), 3000 s of despin"
+  stage "bare metal: every module on (MEKF, identification, fault detection, L1), 3000 s of despin"
   timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
       -icount shift=0 \
       -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=3000,arg=goal=despin,arg=modules=all \

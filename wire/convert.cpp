@@ -127,6 +127,23 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   m.id_windows = e.windows;
   m.id_candidate = static_cast<std::int8_t>(e.candidate);
   m.model_adoptions = e.adoptions;
+  const gnc::FdiTelemetry& f = g.fdi;
+  m.fdi_enabled = f.enabled ? 1 : 0;
+  put(f.residual, m.fdi_residual);
+  m.fdi_chi2 = f.chi2;
+  m.fdi_noise_sigma = f.noise_sigma;
+  m.fdi_best = f.best;
+  m.fdi_best_llr = f.best_llr;
+  m.fdi_runner_up_llr = f.runner_up_llr;
+  m.fdi_suspected_on = f.suspected_on;
+  m.fdi_suspected_off = f.suspected_off;
+  m.fdi_confirmed_on = f.confirmed_on;
+  m.fdi_confirmed_off = f.confirmed_off;
+  for (int p = 0; p < gnc::kPods; ++p) m.valve_open[p] = f.valve_open[static_cast<std::size_t>(p)] ? 1 : 0;
+  m.isolation_inhibited = f.isolation_inhibited ? 1 : 0;
+  m.fdi_windows = f.windows;
+  m.reduced_authority = g.alloc.reduced_authority ? 1 : 0;
+  m.alloc_rank = static_cast<std::int8_t>(g.alloc.rank);
 }
 
 }  // namespace rocksteady::wire

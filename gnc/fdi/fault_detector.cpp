@@ -6,15 +6,6 @@
 
 namespace rocksteady::gnc {
 
-const char* to_string(FaultKind k) {
-  switch (k) {
-    case FaultKind::kNone: return "none";
-    case FaultKind::kStuckOn: return "stuck-on";
-    case FaultKind::kStuckOff: return "stuck-off";
-  }
-  return "?";
-}
-
 Check validate(const FaultDetectorParams& p) {
   auto bad = [](const char* field, const char* reason) { return Check{false, field, reason}; };
   if (p.window_ticks < 4 || p.window_ticks > 1000) {

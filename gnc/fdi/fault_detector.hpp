@@ -17,13 +17,12 @@
 #include <cstdint>
 
 #include "gnc/check.hpp"
+#include "gnc/io.hpp"  // FaultKind
 #include "gnc/model/rcs.hpp"
 #include "gnc/types.hpp"
 
 namespace rocksteady::gnc {
 
-enum class FaultKind : std::uint8_t { kNone = 0, kStuckOn = 1, kStuckOff = 2 };
-const char* to_string(FaultKind k);
 
 struct FaultDetectorParams {
   bool enabled{false};

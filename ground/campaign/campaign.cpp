@@ -124,6 +124,7 @@ void write_results_json(const std::string& path, const CampaignReport& rep) {
                     {"wall_s", r.wall_s},
                     {"plan_wall_s", r.plan_wall_s},
                     {"estimation", estimation_json(r.estimation)},
+                    {"fdi", fdi_json(r.fdi)},
                     {"timeseries", r.timeseries_path},
                     {"plot", r.plot_path}});
   }

@@ -26,6 +26,44 @@ nlohmann::json estimation_json(const EstimationReport& e) {
           {"identification", marks}};
 }
 
+namespace {
+nlohmann::json opt(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+std::optional<double> to_opt(const nlohmann::json& j) {
+  if (j.is_null()) return std::nullopt;
+  return j.get<double>();
+}
+}  // namespace
+
+nlohmann::json fdi_json(const FdiReport& f) {
+  return {{"enabled", f.enabled},
+          {"first_suspicion_s", opt(f.first_suspicion_s)},
+          {"first_confirmation_s", opt(f.first_confirmation_s)},
+          {"thruster", f.thruster},
+          {"kind", f.kind},
+          {"confirmations", f.confirmations},
+          {"confirmed_on", f.confirmed_on},
+          {"confirmed_off", f.confirmed_off},
+          {"valve_closed_s", opt(f.valve_closed_s)},
+          {"suspicions", f.suspicions}};
+}
+
+FdiReport fdi_from_json(const nlohmann::json& j) {
+  FdiReport f;
+  f.enabled = j.at("enabled").get<bool>();
+  f.first_suspicion_s = to_opt(j.at("first_suspicion_s"));
+  f.first_confirmation_s = to_opt(j.at("first_confirmation_s"));
+  f.thruster = j.at("thruster").get<int>();
+  f.kind = j.at("kind").get<std::string>();
+  f.confirmations = j.at("confirmations").get<int>();
+  f.confirmed_on = j.at("confirmed_on").get<std::uint16_t>();
+  f.confirmed_off = j.at("confirmed_off").get<std::uint16_t>();
+  f.valve_closed_s = to_opt(j.at("valve_closed_s"));
+  f.suspicions = j.at("suspicions").get<std::uint32_t>();
+  return f;
+}
+
 EstimationReport estimation_from_json(const nlohmann::json& j) {
   EstimationReport e;
   e.estimator = j.at("estimator").get<std::string>();

@@ -29,6 +29,7 @@ gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& stra
     p.identification.enabled = true;
     p.identification.adopt = gnc::ModelAdoption::kAuto;
   }
+  if (strategy.fdi) p.fdi.enabled = true;
   return p;
 }
 
@@ -145,6 +146,32 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     flight.step();
     const gnc::GncOutput& out = flight.output();
     score_estimate(out);
+    if (fs.params.fdi.enabled) {
+      const gnc::FdiTelemetry& f = out.telemetry.fdi;
+      FdiReport& d = r.fdi;
+      d.enabled = true;
+      const double t = plant.t();
+      if (!d.first_suspicion_s && f.suspicions > 0) d.first_suspicion_s = t;
+      const std::uint16_t now = static_cast<std::uint16_t>(f.confirmed_on | f.confirmed_off);
+      if (!d.first_confirmation_s && now != 0) {
+        d.first_confirmation_s = t;
+        for (int i = 0; i < 16; ++i) {
+          if ((now >> i) & 1u) {
+            d.thruster = i;
+            d.kind = ((f.confirmed_on >> i) & 1u) ? "stuck-on" : "stuck-off";
+            break;
+          }
+        }
+      }
+      if (!d.valve_closed_s) {
+        for (bool v : f.valve_open) {
+          if (!v) d.valve_closed_s = t;
+        }
+      }
+      d.confirmed_on = f.confirmed_on;
+      d.confirmed_off = f.confirmed_off;
+      d.suspicions = f.suspicions;
+    }
     if (log_every != 0 && k % log_every == 0) {
       // The row at time t_k: the state, the estimate and the command computed from it.
       record(out);
@@ -188,6 +215,9 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     est.rate_rms_rad_s = std::sqrt(sq_rate / static_cast<double>(n_est));
   }
   est.model_adoptions = out.telemetry.est.adoptions;
+  for (int i = 0; i < 16; ++i) {
+    r.fdi.confirmations += (((r.fdi.confirmed_on | r.fdi.confirmed_off) >> i) & 1u) ? 1 : 0;
+  }
   r.ticks = plant.ticks();
   r.clipped_ticks = plant.clipped_periods();
   r.sim_s = plant.t();

@@ -63,6 +63,20 @@ struct EstimationReport {
   std::uint32_t model_adoptions{0};
 };
 
+// Fault detection against the injected truth.
+struct FdiReport {
+  bool enabled{false};
+  std::optional<double> first_suspicion_s;  // first window above the no-fault bound
+  std::optional<double> first_confirmation_s;
+  int thruster{-1};           // first confirmed thruster (flight index 2c "+", 2c+1 "-")
+  std::string kind;           // stuck-on | stuck-off
+  int confirmations{0};       // thrusters confirmed over the run
+  std::uint16_t confirmed_on{0};
+  std::uint16_t confirmed_off{0};
+  std::optional<double> valve_closed_s;
+  std::uint32_t suspicions{0};
+};
+
 enum class RunStatus { kOk, kNoReference, kError };
 const char* to_string(RunStatus s);
 
@@ -90,6 +104,7 @@ struct RunResult {
   double wall_s{0.0};
   double plan_wall_s{0.0};
   EstimationReport estimation;
+  FdiReport fdi;
   std::vector<TimeRow> series;  // decimated
   std::string timeseries_path;
   std::string plot_path;

@@ -40,8 +40,8 @@ std::optional<Strategy> parse_strategy(const std::string& name) {
   while (at != std::string::npos) {
     const std::size_t next = name.find(':', at + 1);
     const std::string mod = name.substr(at + 1, next == std::string::npos ? next : next - at - 1);
-    bool& flag = mod == "mekf" ? s->mekf : s->identify;
-    if ((mod != "mekf" && mod != "id") || flag) return std::nullopt;  // unknown or repeated
+    bool& flag = mod == "mekf" ? s->mekf : mod == "id" ? s->identify : s->fdi;
+    if ((mod != "mekf" && mod != "id" && mod != "fdi") || flag) return std::nullopt;
     flag = true;
     at = next;
   }

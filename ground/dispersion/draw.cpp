@@ -84,6 +84,7 @@ StrategyOutcome outcome_of(const campaign::RunResult& r, double eps_trans) {
   o.sim_s = r.sim_s;
   o.wall_s = r.wall_s;
   o.estimation = r.estimation;
+  o.fdi = r.fdi;
   return o;
 }
 
@@ -331,7 +332,8 @@ json to_json(const DrawResult& r, bool with_timing) {
                     {"plant_clipped_ticks", o.clipped_ticks},
                     {"allocator_saturated_ticks", o.saturated_ticks},
                     {"simulated_s", o.sim_s},
-                    {"estimation", campaign::estimation_json(o.estimation)}});
+                    {"estimation", campaign::estimation_json(o.estimation)},
+                    {"fdi", campaign::fdi_json(o.fdi)}});
     run_wall[o.strategy] = o.wall_s;
   }
   json out = {{"result",
@@ -434,6 +436,7 @@ DrawResult draw_from_json(const json& top) {
     x.saturated_ticks = o.at("allocator_saturated_ticks").get<std::uint64_t>();
     x.sim_s = o.at("simulated_s").get<double>();
     if (o.contains("estimation")) x.estimation = campaign::estimation_from_json(o.at("estimation"));
+    if (o.contains("fdi")) x.fdi = campaign::fdi_from_json(o.at("fdi"));
     if (timing != nullptr && timing->at("run_wall_s").contains(x.strategy)) {
       x.wall_s = timing->at("run_wall_s").at(x.strategy).get<double>();
     }

@@ -57,6 +57,7 @@ struct StrategyOutcome {
   double sim_s{0.0};
   double wall_s{0.0};  // timing (not part of the result proper)
   campaign::EstimationReport estimation;  // estimator and identification against the truth
+  campaign::FdiReport fdi;                // fault detection
 };
 
 struct DrawResult {

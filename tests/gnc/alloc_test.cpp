@@ -78,9 +78,10 @@ TEST(ZeroAllocation, NoHeapInAnyTickOfAnyLawAndMode) {
   }
 }
 
-// Every module on (MEKF, identification with automatic adoption, L1): the tick, the identifier's
-// whole window cycle and a model adoption at a boundary allocate nothing.
-TEST(ZeroAllocation, NoHeapWithMekfIdentificationAdoptionAndL1) {
+// Every module on (MEKF, identification with automatic adoption, fault detection, L1): the tick,
+// the identifier's whole window cycle, a model adoption, a declared fault with its bias torque
+// and a closed valve allocate nothing.
+TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
   GncParams truth = test::small_vehicle_params();
   auto* loop = new test::SmallLoop(truth);
   GncParams p = truth;
@@ -104,6 +105,7 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationAdoptionAndL1) {
   id.config.min_torque_impulse = 0.05;
   id.config.min_force_impulse = 0.02;
   id.config.min_thruster_impulse = 0.005;
+  p.fdi.enabled = true;  // and fault detection, with a ground declaration and a valve closure
   ASSERT_TRUE(loop->gnc.init(p).ok);
   long counted = -1;
   {
@@ -112,7 +114,16 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationAdoptionAndL1) {
     c.has_mode_request = true;
     c.mode_request = Mode::kDetumble;
     loop->tick(c);
-    for (int i = 0; i < 2400; ++i) loop->tick();
+    for (int i = 0; i < 1200; ++i) loop->tick();
+    GncCommands o;
+    o.has_fault_declaration = true;
+    o.fault_thruster = 2;
+    o.fault_kind = FaultKind::kStuckOn;
+    o.has_valve = true;
+    o.valve_pod = 3;
+    o.valve_open = false;
+    loop->tick(o);
+    for (int i = 0; i < 1200; ++i) loop->tick();
     counted = rocksteady::test::heap_allocations();
   }
   EXPECT_EQ(counted, 0);
