@@ -118,11 +118,16 @@ void Gnc::refresh_fault_model() {
     m.r = e.r;
     m.k = e.k;
     m.j_rel_sigma = e.j_sigma.maxCoeff() / e.j.norm();
+    // Directions of r the firings have not shown are at their prior: they count as uncertain.
+    m.r_sigma = e.r_sigma.maxCoeff();
+    m.k_sigma = e.k_sigma.maxCoeff();
   } else {
     m.j = total_inertia(params_.mass_hat);
     m.r = params_.mass_hat.r_so_bcm;
     m.k = params_.rcs.strength;
     m.j_rel_sigma = params_.fdi_table_rel_sigma;
+    m.r_sigma = params_.identification.config.r_prior_sigma;
+    m.k_sigma = params_.identification.config.k_prior_sigma;
   }
   fdi_.set_model(m);
 }
@@ -183,8 +188,13 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
     e.arg0 = static_cast<std::int16_t>(fe.thruster);
     e.arg1 = static_cast<std::int16_t>(fe.kind);
     events.push(e);
-    // The identifier's data of that thruster no longer describe it.
-    if (params_.identification.enabled) ident_.reinflate_thruster(fe.thruster);
+    // Until the confirmation the fault was unmodelled: every group the identifier fitted since
+    // onset absorbed it. Its covariance goes back to the prior (estimates kept), which also makes
+    // the detector insensitive until the model is re-identified (no cascade of confirmations).
+    if (params_.identification.enabled) {
+      ident_.reinflate_all();
+      refresh_fault_model();
+    }
     const int pod = params_.rcs.channel_pod[fe.thruster / 2];
     const auto p = static_cast<std::size_t>(pod);
     if (fe.kind == FaultKind::kStuckOn && params_.fdi.auto_isolate && !isolation_inhibited_ &&

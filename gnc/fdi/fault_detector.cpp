@@ -115,6 +115,8 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   }
   predicted_ += (thrust_rate - gyro) * dt_;
   motion_ += (thrust_rate.norm() + gyro.norm()) * dt_;
+  thrust_motion_ += thrust_rate.norm() * dt_;
+  force_impulse_ += in.thrust.sum() * dt_;
   ++n_;
   const double t = static_cast<double>(n_);
   const Vec3 r = in.omega - omega_start_ - predicted_;  // (F3) residual of sample j
@@ -154,6 +156,8 @@ void FaultDetector::start_window(const Vec3& omega) {
   omega_prev_ = omega;
   predicted_.setZero();
   motion_ = 0.0;
+  force_impulse_ = 0.0;
+  thrust_motion_ = 0.0;
   sum_r_.setZero();
   sum_rr_ = 0.0;
   sum_t_ = sum_tt_ = 0.0;
@@ -173,8 +177,12 @@ void FaultDetector::close_window() {
   const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
   const double dist = p_.disturbance_sigma * j_inv_.norm() * n * dt_;
   const double model = rel * motion_;
-  const double var =
-      2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model + 1e-30;
+  // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
+  // r_sigma times the jets' force, and k_sigma times their torque.
+  const double offset = m_.r_sigma * j_inv_.norm() * force_impulse_;
+  const double strength = m_.k_sigma * thrust_motion_;
+  const double var = 2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model +
+                     offset * offset + strength * strength + 1e-30;
   st_.noise_sigma = std::sqrt(var);
   // The unknown offset (the start sample's own noise) is removed: mean-centred sums.
   const Vec3 r_mean = sum_r_ / n;

@@ -65,6 +65,8 @@ struct FaultModel {
   Vec3 r{Vec3::Zero()};
   Vec16 k{Vec16::Ones()};
   double j_rel_sigma{1.0};  // largest 1 sigma of J relative to ||J|| (the identifier's)
+  double r_sigma{1.0};      // m, largest 1 sigma of r: a torque error of r_sigma x the net force
+  double k_sigma{0.05};     // largest 1 sigma of the strengths: k_sigma x each jet's torque
 };
 
 struct FaultDetectorStatus {
@@ -131,6 +133,8 @@ class FaultDetector {
   Vec3 omega_prev_{Vec3::Zero()};
   Vec3 predicted_{Vec3::Zero()};    // cumulative predicted rate change since the start
   double motion_{0.0};              // cumulative |predicted terms| * dt (model-uncertainty scale)
+  double force_impulse_{0.0};       // cumulative sum of thrust * dt over the jets, N s
+  double thrust_motion_{0.0};       // cumulative |thrust rate change| * dt
   Vec3 sum_r_{Vec3::Zero()};        // sum of residuals r_j
   double sum_rr_{0.0};
   double sum_t_{0.0};               // sum of j (sample index), for the slope test

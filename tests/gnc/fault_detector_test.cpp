@@ -78,6 +78,8 @@ FaultDetector make_detector(const Truth& t, double gyro_sigma) {
   m.j = t.body.j;
   m.r = t.r;
   m.j_rel_sigma = 1e-3;  // an identified model
+  m.r_sigma = 1e-3;
+  m.k_sigma = 1e-3;
   d.set_model(m);
   return d;
 }
@@ -224,6 +226,8 @@ TEST(FaultDetector, ScoresAreTheLikelihoodRatioOfTheSignatures) {
   m.j = t.body.j;
   m.r = t.r;
   m.j_rel_sigma = 0.0;
+  m.r_sigma = 0.0;
+  m.k_sigma = 0.0;
   d.set_model(m);
   fly(t, d, 11, 0, 9, -1);  // one window, thruster 9 stuck on from the start
   EXPECT_EQ(d.status().best, 9);
