@@ -34,6 +34,8 @@ InitResult FlightApp::init(const FlightConfig& config, const Clock& clock) {
   }
   const gnc::ParamCheck p = gnc_.init(config.gnc);
   if (!p.ok) return InitResult{false, p.field, p.reason};
+  const auth::CommandSecurity::InitCheck sc = security_.init(config.security);
+  if (!sc.ok) return InitResult{false, sc.field, sc.reason};
   config_ = config;
   clock_ = &clock;
 
@@ -48,6 +50,12 @@ InitResult FlightApp::init(const FlightConfig& config, const Clock& clock) {
   translator_.configure(interval);
   missed_throttle_.configure(to_ns(config_.executive.slip_event_interval_s));
   missed_throttle_.reset();
+  auth_throttle_.configure(interval);
+  auth_throttle_.reset();
+  if (security_.lab_mode()) {
+    events_.emit(Severity::kWarning, EventId::kLabMode, 0, 0,
+                 "LAB MODE: ground commands are NOT authenticated");
+  }
   latest_frame_ = gnc::SensorSample{};
   fresh_frame_ = false;
   consecutive_slips_ = 0;
@@ -208,6 +216,10 @@ HealthTelemetry FlightApp::health() const {
   h.uplink_chunks_rejected = uplink_.chunks_rejected();
   h.trajectories_loaded = uplink_.loaded();
   h.trajectory_loaded = trajectory_loaded_;
+  h.lab_mode = security_.lab_mode();
+  h.auth_key_id = security_.active_key_id();
+  h.auth_rejected = security_.auth_rejected();
+  h.replays_rejected = security_.replays_rejected();
   return h;
 }
 
@@ -217,15 +229,48 @@ HealthTelemetry FlightApp::health() const {
 
 DispatchContext FlightApp::dispatch_context() {
   return DispatchContext{clock_ != nullptr, gnc_,    trajectory_loaded_, time_base_.onboard_time(),
-                         params_,           uplink_, events_};
+                         params_,           uplink_, events_,           security_};
+}
+
+void FlightApp::report_auth_failure(auth::AuthResult r, int what, std::int64_t seq) {
+  std::uint32_t suppressed = 0;
+  if (clock_ == nullptr || !auth_throttle_.allow(clock_->now_ns(), suppressed)) return;
+  events_.emit(Severity::kWarning, EventId::kAuthRejected, static_cast<std::int32_t>(r), what,
+               "%s seq %" PRId64 " refused: %s (%" PRIu32 " report(s) suppressed)",
+               what == 0 ? "command" : "uplink chunk", seq, auth::to_string(r), suppressed);
 }
 
 CommandAck FlightApp::submit(const GroundCommand& cmd) {
+  if (clock_ != nullptr) {
+    const auth::AuthResult a = security_.verify(cmd);
+    if (a != auth::AuthResult::kOk && a != auth::AuthResult::kLabMode) {
+      report_auth_failure(a, 0, cmd.seq);
+      const bool replay = a == auth::AuthResult::kReplay || a == auth::AuthResult::kBadCounter;
+      return commands_.refuse(cmd,
+                              replay ? RejectReason::kStaleSequence
+                                     : RejectReason::kNotAuthenticated,
+                              auth::to_string(a));
+    }
+  }
   return commands_.submit(cmd, dispatch_context());
 }
 
 ChunkStatus FlightApp::receive_chunk(const TrajectoryChunk& chunk) {
+  if (clock_ == nullptr) return ChunkStatus::kBusy;
+  const auth::AuthResult a = security_.verify(chunk);
+  if (a != auth::AuthResult::kOk && a != auth::AuthResult::kLabMode) {
+    report_auth_failure(a, 1, chunk.seq);
+    return ChunkStatus::kNotAuthenticated;
+  }
   return uplink_.receive(chunk, events_);
+}
+
+void FlightApp::rotate_key(std::int32_t key_id) {
+  const std::int32_t from = security_.active_key_id();
+  if (security_.rotate(key_id)) {
+    events_.emit(Severity::kInfo, EventId::kKeyRotated, from, key_id,
+                 "command key %" PRId32 " -> %" PRId32, from, key_id);
+  }
 }
 
 void FlightApp::load_trajectory(std::int32_t upload_id) {

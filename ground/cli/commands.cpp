@@ -42,6 +42,9 @@ const std::vector<CommandHelp> kHelp{
     {"load-trajectory", "load-trajectory UPLOAD_ID",
      "hand a completely uplinked trajectory to the flight core (not in TRACK)"},
     {"abort-uplink", "abort-uplink UPLOAD_ID", "discard a trajectory uplink in progress"},
+    {"key-rotate", "key-rotate KEY_ID",
+     "make command key KEY_ID (higher than the active one) active at the next tick; then send "
+     "with --key-id KEY_ID"},
     {"upload-trajectory", "upload-trajectory FILE",
      "uplink a planner trajectory file in chunks, wait for the flight to complete it, then load "
      "it"},
@@ -277,6 +280,14 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
     const std::int32_t op = load ? static_cast<std::int32_t>(Msg::OP_LOAD_TRAJECTORY)
                                  : static_cast<std::int32_t>(Msg::OP_ABORT_UPLINK);
     return make(op, {id}, std::string(load ? "LOAD_TRAJECTORY " : "ABORT_UPLINK ") + args[0]);
+  }
+  if (name == "key-rotate") {
+    if (args.size() != 1) return wrong_count(name, "1 argument (the new key id)", args.size());
+    double id = 0.0;
+    if (!parse_number(args[0], id) || id < 1.0 || id > 2147483647.0 || std::trunc(id) != id) {
+      return fail(name + ": the key id must be a positive integer, got '" + args[0] + "'");
+    }
+    return make(Msg::OP_KEY_ROTATE, {id}, "KEY_ROTATE " + args[0]);
   }
   if (name == "upload-trajectory") {
     return fail("upload-trajectory is a procedure of many messages, not one command");
