@@ -109,7 +109,8 @@ std::int32_t auth_key_id() {
   return g_state.lab ? 0 : g_state.key_id;
 }
 
-std::int64_t next_counter(const std::string& state_dir, std::int32_t sender_id) {
+std::int64_t next_counter(const std::string& state_dir, std::int32_t sender_id,
+                          std::int64_t at_least) {
   std::int32_t key = 0;
   {
     std::lock_guard<std::mutex> lock(g_mutex);
@@ -119,9 +120,10 @@ std::int64_t next_counter(const std::string& state_dir, std::int32_t sender_id) 
   if (state_dir.empty()) {
     throw std::runtime_error("no state directory for counters ($XDG_STATE_HOME or $HOME)");
   }
-  if (key == 0) return SequenceStore(sequence_file(state_dir, sender_id)).next();
+  if (key == 0) return SequenceStore(sequence_file(state_dir, sender_id)).next(at_least);
+  const std::int64_t now = wall_us();
   return SequenceStore(state_dir + "/ground-key-" + std::to_string(key) + "-counter")
-      .next(wall_us());
+      .next(at_least > now ? at_least : now);
 }
 
 void authenticate(rocksteady::ground_cmd_t& cmd) {

@@ -42,7 +42,10 @@ std::int32_t auth_key_id();  // 0 in lab mode
 
 // The next message counter: the key's (keys) or the sender's sequence number (lab mode), from
 // `state_dir`. Throws std::runtime_error when not configured or the state file is unusable.
-std::int64_t next_counter(const std::string& state_dir, std::int32_t sender_id);
+// `at_least`: the counter returned is not below it (a counter given by the operator, --seq, moves
+// the key's counter file forward with it).
+std::int64_t next_counter(const std::string& state_dir, std::int32_t sender_id,
+                          std::int64_t at_least = 1);
 
 // Stamps key_id and mac (the counter must already be in seq). No-op in lab mode (key 0, zero MAC).
 // Throws std::runtime_error when not configured.

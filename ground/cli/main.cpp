@@ -85,7 +85,11 @@ class SeqSource {
       const std::int64_t s = fixed_++;
       if (!path_.empty() && !dry_run_) {
         try {
-          cli::SequenceStore(path_).next(s);
+          if (cli::auth_lab_mode()) {
+            cli::SequenceStore(path_).next(s);
+          } else {
+            cli::next_counter(dir_, sender_, s);  // the key's counter follows it
+          }
         } catch (const std::exception&) {
           // --seq works without a usable state file
         }
