@@ -13,6 +13,11 @@ std::int64_t to_ns(double s) {
   return static_cast<std::int64_t>(std::llround(s * static_cast<double>(gnc::kNsPerS)));
 }
 
+// Event arguments are int32: counts saturate instead of wrapping negative.
+std::int32_t sat_i32(std::uint64_t v) {
+  return v > 2147483647u ? 2147483647 : static_cast<std::int32_t>(v);
+}
+
 }  // namespace
 
 // ----------------------------------------------------------------------------------------------
@@ -46,7 +51,8 @@ InitResult FlightApp::init(const FlightConfig& config, const Clock& clock) {
   events_.reset();
   const std::int64_t interval = to_ns(config_.sensor_event_interval_s);
   time_base_.configure(TimeBaseConfig{exec_.gnc_period_s(), config_.max_frame_time_jump_s,
-                                      config_.frame_resync_count, interval});
+                                      config_.frame_resync_count, config_.frame_resync_run,
+                                      interval});
   translator_.configure(interval);
   missed_throttle_.configure(to_ns(config_.executive.slip_event_interval_s));
   missed_throttle_.reset();
@@ -62,6 +68,7 @@ InitResult FlightApp::init(const FlightConfig& config, const Clock& clock) {
   overrun_request_ = false;
   next_index_ = 0;
   sensor_rejects_base_ = 0;
+  device_rejects_ = 0;
   trajectory_loaded_ = false;
   return InitResult{};
 }
@@ -99,9 +106,8 @@ void FlightApp::run_tick(const Tick& tick, const gnc::SensorSample* frame,
   if (plan.base_missed > 0) {
     std::uint32_t suppressed = 0;
     if (missed_throttle_.allow(clock_->now_ns(), suppressed)) {
-      events_.emit(Severity::kWarning, EventId::kMissedTicks,
-                   static_cast<std::int32_t>(plan.base_missed),
-                   static_cast<std::int32_t>(suppressed),
+      events_.emit(Severity::kWarning, EventId::kMissedTicks, sat_i32(plan.base_missed),
+                   sat_i32(suppressed),
                    "%" PRIu32 " base tick(s) missed (%" PRIu32 " report(s) suppressed)",
                    plan.base_missed, suppressed);
     }
@@ -206,7 +212,7 @@ HealthTelemetry FlightApp::health() const {
   h.frames_accepted = time_base_.frames_accepted();
   h.frames_rejected = time_base_.frames_rejected();
   h.frameless_ticks = time_base_.frameless_ticks();
-  h.sensor_rejects = gout_.telemetry.sensor_rejects - sensor_rejects_base_;
+  h.sensor_rejects = gout_.telemetry.sensor_rejects - sensor_rejects_base_ + device_rejects_;
   h.table_loads = params_.loads();
   h.table_activations = params_.activations();
   h.table_loaded = params_.table().loaded();
@@ -281,6 +287,7 @@ void FlightApp::reset_counters() {
   commands_.reset_counters();
   time_base_.reset_counters();
   sensor_rejects_base_ = gout_.telemetry.sensor_rejects;
+  device_rejects_ = 0;
   uplink_.reset_counters();
   exec_.reset_counters();
   events_.reset_dropped();

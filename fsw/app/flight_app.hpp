@@ -40,6 +40,8 @@ struct FlightConfig {
   // After this many consecutive rejected frames, the next frame with a finite time re-anchors the
   // time base (e.g. the sensor front end restarted its clock).
   std::uint32_t frame_resync_count{50};
+  // ... and then only a run of this many frames with consistent times re-anchors it (never one).
+  std::uint32_t frame_resync_run{3};
   // This many consecutive GNC cycles that slipped -> SAFE (thrusters off) with an event; 0: never.
   std::uint32_t overrun_safe_slips{10};
   // Command keys and persisted replay state, or lab mode (explicit; see fsw/auth/auth.hpp). The
@@ -102,6 +104,10 @@ class FlightApp final : private BoundaryActions {
   // One base tick without a frame; the GNC cycle (if due) runs at time t with an invalid sample.
   void gnc_tick_without_frame(double t, Outputs& out);
 
+  // Readings the devices rejected before the flight core saw them (non-finite values): counted in
+  // HealthTelemetry::sensor_rejects.
+  void note_sensor_rejects(std::uint32_t n) { device_rejects_ += n; }
+
   // --- Outputs besides Outputs ------------------------------------------------------------------
   bool pop_event(Event& e) { return events_.pop(e); }
   // The parameter table read back by an accepted PARAM_DUMP, once.
@@ -159,6 +165,7 @@ class FlightApp final : private BoundaryActions {
   bool overrun_request_{false};  // this tick's SAFE request is the overrun protection's
   std::uint64_t next_index_{0};  // for the lockstep conveniences
   std::uint32_t sensor_rejects_base_{0};
+  std::uint32_t device_rejects_{0};
   bool trajectory_loaded_{false};
   Throttle missed_throttle_{};
 };

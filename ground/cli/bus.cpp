@@ -81,13 +81,14 @@ class UplinkWatcher {
         last_rejection_ = Clock::now();
         if (log_ != nullptr) {
           std::fprintf(log_, "chunk rejected: %s\n",
-                       e.text.empty() ? chunk_status_name(e.arg1).c_str() : e.text.c_str());
+                       e.text.empty() ? chunk_status_name(e.arg1).c_str()
+                                      : sanitize_text(e.text).c_str());
         }
         break;
       case kEventUplinkAbandoned:
         abandoned_ = true;
         if (log_ != nullptr)
-          std::fprintf(log_, "uplink abandoned by the flight: %s\n", e.text.c_str());
+          std::fprintf(log_, "uplink abandoned by the flight: %s\n", sanitize_text(e.text).c_str());
         break;
       default:
         break;

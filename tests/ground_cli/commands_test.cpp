@@ -123,6 +123,7 @@ std::vector<Case> cases() {
       {"reset-counters", {}, false, M::kSafe, O::kResetCounters, {}},
       {"load-trajectory", {"7"}, false, M::kHold, O::kLoadTrajectory, {7}},
       {"abort-uplink", {"2147483647"}, false, M::kTrack, O::kAbortUplink, {2147483647.0}},
+      {"key-rotate", {"2"}, false, M::kTrack, O::kKeyRotate, {2}},
   };
 }
 
