@@ -172,7 +172,7 @@ const char* to_string(AuthResult r) {
     case AuthResult::kReplay:
       return "replayed or too old counter";
     case AuthResult::kBadCounter:
-      return "counter not positive";
+      return "counter not positive or too far ahead";
   }
   return "?";
 }
@@ -223,8 +223,9 @@ int CommandSecurity::slot_of(std::int32_t key_id) const {
 }
 
 AuthResult CommandSecurity::check_counter(int slot, std::int64_t counter) {
-  if (counter <= 0) return AuthResult::kBadCounter;
-  if (!windows_[static_cast<std::size_t>(slot)].fresh(counter)) return AuthResult::kReplay;
+  const ReplayWindow& w = windows_[static_cast<std::size_t>(slot)];
+  if (counter <= 0 || counter - w.highest() > kMaxCounterStep) return AuthResult::kBadCounter;
+  if (!w.fresh(counter)) return AuthResult::kReplay;
   return AuthResult::kOk;
 }
 

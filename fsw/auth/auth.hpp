@@ -46,6 +46,9 @@ inline constexpr int kKeyBytes = 32;
 inline constexpr int kMacBytes = 32;
 inline constexpr int kMaxKeys = 4;
 inline constexpr int kReplayWindow = 64;
+// A counter more than this above the key's highest is refused (kBadCounter): 2^53 us is 285 years,
+// so no run of authentic commands can spend a key's counter space (a lock-out by its own holder).
+inline constexpr std::int64_t kMaxCounterStep = std::int64_t{1} << 53;
 
 using Key = std::array<std::uint8_t, kKeyBytes>;
 using MacBytes = std::array<std::uint8_t, kMacBytes>;
@@ -130,7 +133,7 @@ enum class AuthResult : std::uint8_t {
   kUnknownKey,     // key id not in the key set, or not the active key
   kBadMac,         // authenticator does not match (forged, altered, truncated, zero)
   kReplay,         // counter already used, or at/below the window's floor
-  kBadCounter,     // counter <= 0
+  kBadCounter,     // counter <= 0, or more than kMaxCounterStep above the highest
 };
 const char* to_string(AuthResult r);
 

@@ -377,6 +377,19 @@ TEST(CommandSecurity, ForgedSendersCannotExhaustAnyStateOrLockTheGroundOut) {
   EXPECT_TRUE(f.app->submit(signed_cmd(++f.counter, Opcode::kSetMode, {4.0})).accepted);
 }
 
+// Even the key's holder cannot spend the counter space: a counter too far ahead is refused.
+TEST(CommandSecurity, ACounterTooFarAheadIsRefusedSoNoKeyCanBeLockedOut) {
+  KeyedFixture f;
+  const Snapshot before = snapshot(*f.app);
+  EXPECT_EQ(f.app->submit(signed_cmd(INT64_MAX, Opcode::kNoop)).reason,
+            RejectReason::kStaleSequence);
+  EXPECT_EQ(f.app->submit(signed_cmd(auth::kMaxCounterStep + 1, Opcode::kNoop)).reason,
+            RejectReason::kStaleSequence);
+  EXPECT_EQ(snapshot(*f.app), before);
+  EXPECT_TRUE(f.app->submit(signed_cmd(auth::kMaxCounterStep, Opcode::kNoop)).accepted);
+  EXPECT_TRUE(f.app->submit(signed_cmd(2 * auth::kMaxCounterStep, Opcode::kNoop)).accepted);
+}
+
 TEST(CommandSecurity, LabModeSendersCannotLockEachOtherOut) {
   test::AppFixture f;  // lab mode: no authentication, per-source sequence numbers
   for (int s = 0; s < 16; ++s) {
