@@ -70,6 +70,9 @@ constexpr ParamBound kBounds[] = {
      "a gyro reading above this is rejected: at most a gyro's range (~1000 deg/s)"},
     {"estimator.quat_norm_tolerance", BoundKind::kScalar, 1e-9, 0.5, "",
      "star-tracker |q| deviation accepted; 0.5 would accept garbage"},
+    // Configuration-only values (the YAML loader, config/): not in GncParams.
+    {"case.duration_s", BoundKind::kScalar, 1e-3, 1e7, "s",
+     "simulated run length: up to ~4 months (the study's runs are 1e5 s); 1e300 never ends"},
     {"mode.sensor_timeout", BoundKind::kScalar, 1e-3, 60.0, "s",
      "no valid sample this long -> SAFE: thrusters firing open loop for more than a minute is "
      "unsafe (1e30 s kept them firing 8 s with no sensor at all and never stopped)"},
