@@ -226,7 +226,7 @@ CommandCheck CommandDispatcher::execute_load_trajectory(const GroundCommand& cmd
   if (u.active() && u.upload_id() == id && !u.pending() && u.complete() && !queue_.has_room(1)) {
     return reject(RejectReason::kBusy, 0, "command queue full");
   }
-  const CommandCheck c = ctx.uplink.request_load(id, ctx.core.params().guidance.eps_trans, ctx.log);
+  const CommandCheck c = ctx.uplink.request_load(id, ctx.core.params(), ctx.log);
   if (!c.ok()) return c;
   Action a;
   a.kind = ActionKind::kLoadTrajectory;
