@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "gnc/math/rotation.hpp"
+#include "gnc/param_bounds.hpp"
 #include "ground/cli/dictionary.hpp"
 #include "ground/dictionary/dictionary.hpp"
 
@@ -217,6 +218,13 @@ Encoded set_gain(const std::vector<std::string>& args) {
     if (std::abs(values[i]) > kValueMax) {
       return fail(name + ": value " + std::to_string(i + 1) + " is out of range (|v| <= 1e30)");
     }
+  }
+  // The flight's own physical ranges (gnc/param_bounds.cpp), checked before anything is sent.
+  if (p->kind == ParamKind::kScalar && !gnc::within_bound(p->name, values[0])) {
+    const gnc::ParamBound* b = gnc::find_param_bound(p->name);
+    return fail(name + ": " + p->name + " = " + number_text(values[0]) +
+                " is outside its physical range [" + number_text(b->lo) + ", " +
+                number_text(b->hi) + "] " + b->units + ": " + b->why);
   }
   std::vector<double> a{static_cast<double>(p->id)};
   a.insert(a.end(), values.begin(), values.end());

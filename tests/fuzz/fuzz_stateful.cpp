@@ -175,8 +175,6 @@ struct Harness {
     }
     sign(m);
     const std::size_t n = encode_cmd(m);
-    last_signed.assign(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
-    last_was_chunk = false;
     const std::uint8_t flip = in.u8();
     const bool tamper = flip >= 128;
     if (tamper) {
@@ -193,6 +191,9 @@ struct Harness {
     } else {
       require(ack.reason != fsw::RejectReason::kNotAuthenticated &&
               ack.reason != fsw::RejectReason::kStaleSequence);
+      // Only what the flight has really received can be replayed.
+      last_signed.assign(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+      last_was_chunk = false;
     }
   }
 
@@ -209,8 +210,6 @@ struct Harness {
     std::memcpy(chunk_msg.mac, mac.data(), mac.size());
     const int n = wire::encode(chunk_msg, buf.data(), static_cast<int>(buf.size()));
     require(n > 0);
-    last_signed.assign(buf.begin(), buf.begin() + n);
-    last_was_chunk = true;
     const std::uint8_t flip = in.u8();
     const bool tamper = flip >= 128;
     if (tamper) {
@@ -220,7 +219,11 @@ struct Harness {
     fsw::ChunkStatus st;
     if (!chunk_bytes(buf.data(), static_cast<std::size_t>(n), st)) return;
     if (tamper) require(st == fsw::ChunkStatus::kNotAuthenticated);
-    if (!tamper) require(st != fsw::ChunkStatus::kNotAuthenticated);
+    if (!tamper) {
+      require(st != fsw::ChunkStatus::kNotAuthenticated);
+      last_signed.assign(buf.begin(), buf.begin() + n);
+      last_was_chunk = true;
+    }
   }
 
   void replay() {

@@ -307,5 +307,14 @@ TEST(GroundDictionary, OpcodeNumbersAreTheFlightOpcodes) {
   EXPECT_EQ(G::OP_ABORT_UPLINK, static_cast<int>(fsw::Opcode::kAbortUplink));
 }
 
+// The ground refuses what the flight would refuse, with the same table and reason.
+TEST(GroundCommands, SetGainChecksThePhysicalRangesBeforeSending) {
+  const Encoded e = encode_command("set-gain", {"mode.sensor_timeout", "1e30"});
+  EXPECT_FALSE(e.ok);
+  EXPECT_NE(e.error.find("outside its physical range"), std::string::npos) << e.error;
+  EXPECT_NE(e.error.find("mode.sensor_timeout"), std::string::npos) << e.error;
+  EXPECT_TRUE(encode_command("set-gain", {"mode.sensor_timeout", "2"}).ok);
+}
+
 }  // namespace
 }  // namespace rocksteady::ground::cli
