@@ -90,6 +90,9 @@ class FlightApp final : private BoundaryActions {
   bool sign_ack(auth::AckFields& ack, auth::MacBytes& mac) const {
     return security_.sign_ack(ack, mac);
   }
+  bool sign_event(auth::EventFields& event, auth::MacBytes& mac) const {
+    return security_.sign_event(event, mac);
+  }
   // What must survive a reboot (the bus layer persists it when its generation changes).
   const auth::SecurityState& security_state() const { return security_.state(); }
   const auth::CommandSecurity& security() const { return security_; }

@@ -13,6 +13,7 @@ constexpr char kDomain[] = "rocksteady-auth-v1";
 constexpr char kChannelCommand[] = "RS_GROUND_CMD";
 constexpr char kChannelChunk[] = "RS_TRAJ_UPLINK";
 constexpr char kChannelAck[] = "RS_CMD_ACK";
+constexpr char kChannelEvents[] = "RS_EVENTS";
 constexpr std::int16_t kVersion = 1;  // the messages' VERSION
 
 // The canonical encoder: fields go straight into the HMAC state (nothing buffered, no heap).
@@ -108,6 +109,20 @@ void mac_ack(const AckFields& ack, const Key& key, MacBytes& out) {
   c.i32(ack.detail);
   c.u32(static_cast<std::uint32_t>(ack.text_len));
   c.bytes(ack.text, ack.text_len);
+  c.finish(out);
+}
+
+void mac_event(const EventFields& e, const Key& key, MacBytes& out) {
+  Canonical c(key, kChannelEvents, MessageKind::kEvent);
+  c.i32(e.key_id);
+  c.f64(e.t);
+  c.i64(e.seq);
+  c.i32(e.severity);
+  c.i32(e.id);
+  c.i32(e.arg0);
+  c.i32(e.arg1);
+  c.u32(static_cast<std::uint32_t>(e.text_len));
+  c.bytes(e.text, e.text_len);
   c.finish(out);
 }
 
@@ -320,6 +335,17 @@ bool CommandSecurity::sign_ack(AckFields& ack, MacBytes& out) const {
     slot = slot_of(active_);
   }
   mac_ack(ack, keys_.keys[static_cast<std::size_t>(slot)].key, out);
+  return true;
+}
+
+bool CommandSecurity::sign_event(EventFields& event, MacBytes& out) const {
+  if (lab_mode_) {
+    event.key_id = 0;
+    out.fill(0);
+    return false;
+  }
+  event.key_id = active_;
+  mac_event(event, keys_.keys[static_cast<std::size_t>(slot_of(active_))].key, out);
   return true;
 }
 

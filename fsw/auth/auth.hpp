@@ -54,7 +54,7 @@ using Key = std::array<std::uint8_t, kKeyBytes>;
 using MacBytes = std::array<std::uint8_t, kMacBytes>;
 
 // What a MAC covers (domain separation; the numbers are the lcmtypes KIND of each message).
-enum class MessageKind : std::int16_t { kCommand = 5, kAck = 6, kChunk = 8 };
+enum class MessageKind : std::int16_t { kEvent = 4, kCommand = 5, kAck = 6, kChunk = 8 };
 
 struct KeyEntry {
   std::int32_t id{0};  // > 0
@@ -81,10 +81,24 @@ struct AckFields {
   std::size_t text_len{0};
 };
 
+// An event's fields as they go on the bus (event_t without kind/version/mac).
+struct EventFields {
+  double t{0.0};
+  std::int64_t seq{0};
+  std::int32_t severity{0};
+  std::int32_t id{0};
+  std::int32_t arg0{0};
+  std::int32_t arg1{0};
+  std::int32_t key_id{0};
+  const char* text{""};
+  std::size_t text_len{0};
+};
+
 // The MACs (the command's and chunk's key_id/seq are inside the structs).
 void mac_command(const GroundCommand& cmd, const Key& key, MacBytes& out);
 void mac_chunk(const TrajectoryChunk& chunk, const Key& key, MacBytes& out);
 void mac_ack(const AckFields& ack, const Key& key, MacBytes& out);
+void mac_event(const EventFields& event, const Key& key, MacBytes& out);
 // Constant-time comparison of two MACs.
 bool mac_equal(const MacBytes& a, const MacBytes& b);
 
@@ -164,6 +178,8 @@ class CommandSecurity {
   // Downlink authenticator for an acknowledgement: with key `key_id` when it is a known key that is
   // not retired (the command's key), else the active key. Sets ack.key_id. False in lab mode.
   bool sign_ack(AckFields& ack, MacBytes& out) const;
+  // Downlink authenticator of an event, with the active key (sets event.key_id). False in lab mode.
+  bool sign_event(EventFields& event, MacBytes& out) const;
 
   const SecurityState& state() const { return state_; }
   std::uint64_t auth_rejected() const { return auth_rejected_; }

@@ -139,6 +139,29 @@ bool sign(const FlightApp& app, rocksteady::cmd_ack_t& m) {
   return signed_;
 }
 
+auth::EventFields event_fields(const rocksteady::event_t& m) {
+  auth::EventFields f;
+  f.t = m.t;
+  f.seq = m.seq;
+  f.severity = m.severity;
+  f.id = m.id;
+  f.arg0 = m.arg0;
+  f.arg1 = m.arg1;
+  f.key_id = m.key_id;
+  f.text = m.text.c_str();
+  f.text_len = m.text.size();
+  return f;
+}
+
+bool sign(const FlightApp& app, rocksteady::event_t& m) {
+  auth::EventFields f = event_fields(m);
+  auth::MacBytes mac{};
+  const bool signed_ = app.sign_event(f, mac);
+  m.key_id = f.key_id;
+  for (int i = 0; i < kMacSize; ++i) m.mac[i] = static_cast<std::int8_t>(mac[static_cast<std::size_t>(i)]);
+  return signed_;
+}
+
 auth::AckFields ack_fields(const rocksteady::cmd_ack_t& m) {
   auth::AckFields f;
   f.t = m.t;
@@ -164,6 +187,8 @@ void to_message(const Event& e, rocksteady::event_t& m) {
   m.arg0 = e.arg0;
   m.arg1 = e.arg1;
   set_text(m.text, e.text.data(), rocksteady::event_t::MAX_TEXT);
+  m.key_id = 0;
+  std::memset(m.mac, 0, sizeof m.mac);
 }
 
 void to_message(const ParamDump& d, rocksteady::param_table_t& m) {

@@ -224,6 +224,7 @@ void FlightNode::drain_events() {
   Event e;
   while (computer_.pop_event(e)) {
     to_message(e, event_msg_);
+    sign(computer_.app(), event_msg_);
     publish(channels::kEvents, event_msg_);
   }
 }
@@ -239,6 +240,7 @@ void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::
   e.arg1 = arg1;
   std::snprintf(e.text.data(), e.text.size(), "%s", text);
   to_message(e, event_msg_);
+  sign(computer_.app(), event_msg_);
   publish(channels::kEvents, event_msg_);
 }
 

@@ -72,6 +72,8 @@ class UplinkWatcher {
     rocksteady::event_t e;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), e)) return;
     if (e.arg0 != id_) return;
+    // Only the flight's authentic events count (a forged uplink_complete must not end the upload).
+    if (verify_event(e) == AckAuth::kForged) return;
     switch (e.id) {
       case kEventUplinkComplete:
         complete_ = true;
@@ -142,13 +144,16 @@ class Monitor {
     rocksteady::event_t e;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), e, &counts_.rx)) return;
     ++counts_.events;
-    show("EVENT " + format_event(e));
+    // With a key: the flight's events are signed; anything else is shown as such.
+    const bool forged = auth_configured() && verify_event(e) == AckAuth::kForged;
+    show(std::string(forged ? "EVENT (unauthenticated) " : "EVENT ") + format_event(e));
   }
   void on_ack(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     rocksteady::cmd_ack_t a;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), a, &counts_.rx)) return;
     ++counts_.acks;
-    show("ACK " + format_ack(a));
+    const bool forged = auth_configured() && verify_ack(a) == AckAuth::kForged;
+    show(std::string(forged ? "ACK (FORGED) " : "ACK ") + format_ack(a));
   }
   const MonitorCounts& counts() const { return counts_; }
 

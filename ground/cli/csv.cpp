@@ -99,6 +99,7 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
 
 void visit(const rocksteady::event_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_D(t); RS_I(seq); RS_I(severity); RS_I(id); RS_I(arg0); RS_I(arg1);
+  RS_I(key_id); RS_A(mac);
   s.text("text", m.text);
 }
 

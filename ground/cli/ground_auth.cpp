@@ -209,4 +209,27 @@ AckAuth verify_ack(const rocksteady::cmd_ack_t& ack) {
   return auth::mac_equal(expect, got) ? AckAuth::kAuthentic : AckAuth::kForged;
 }
 
+AckAuth verify_event(const rocksteady::event_t& e) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (g_state.configured && g_state.lab) return AckAuth::kLabMode;
+  if (!g_state.configured) return AckAuth::kForged;
+  const auth::KeyEntry* k = g_state.keys.find(e.key_id);
+  if (k == nullptr) return AckAuth::kForged;
+  auth::EventFields f;
+  f.t = e.t;
+  f.seq = e.seq;
+  f.severity = e.severity;
+  f.id = e.id;
+  f.arg0 = e.arg0;
+  f.arg1 = e.arg1;
+  f.key_id = e.key_id;
+  f.text = e.text.c_str();
+  f.text_len = e.text.size();
+  auth::MacBytes expect;
+  auth::mac_event(f, k->key, expect);
+  auth::MacBytes got;
+  std::memcpy(got.data(), e.mac, got.size());
+  return auth::mac_equal(expect, got) ? AckAuth::kAuthentic : AckAuth::kForged;
+}
+
 }  // namespace rocksteady::ground::cli

@@ -21,6 +21,7 @@
 
 #include "fsw/auth/auth.hpp"
 #include "rocksteady/cmd_ack_t.hpp"
+#include "rocksteady/event_t.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
@@ -55,5 +56,7 @@ void authenticate(rocksteady::trajectory_chunk_t& chunk);
 enum class AckAuth { kAuthentic, kForged, kLabMode };
 // Checks an acknowledgement's downlink authenticator (kLabMode when the ground is in lab mode).
 AckAuth verify_ack(const rocksteady::cmd_ack_t& ack);
+// The same for an event (the flight signs its events; the plant's and the watchdog's are not).
+AckAuth verify_event(const rocksteady::event_t& event);
 
 }  // namespace rocksteady::ground::cli

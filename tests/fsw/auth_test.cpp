@@ -532,6 +532,38 @@ TEST(CommandSecurity, AcknowledgementsCarryAVerifiableAuthenticator) {
   EXPECT_EQ(a.key_id, 0);
 }
 
+TEST(CommandSecurity, EventsCarryAVerifiableAuthenticatorDistinctFromAcks) {
+  KeyedFixture f;
+  auth::EventFields e;
+  e.t = 3.0;
+  e.seq = 12;
+  e.id = 120;
+  e.arg0 = 4;
+  e.text = "uplink complete";
+  e.text_len = 15;
+  MacBytes m;
+  ASSERT_TRUE(f.app->sign_event(e, m));
+  EXPECT_EQ(e.key_id, 1);
+  MacBytes expect;
+  auth::mac_event(e, kKey1, expect);
+  EXPECT_TRUE(auth::mac_equal(m, expect));
+  auth::EventFields forged = e;
+  forged.arg0 = 5;  // another upload id
+  auth::mac_event(forged, kKey1, expect);
+  EXPECT_FALSE(auth::mac_equal(m, expect));
+  // The same numbers as an acknowledgement never give the event's authenticator.
+  auth::AckFields a;
+  a.t = e.t;
+  a.seq = e.seq;
+  a.key_id = 1;
+  a.text = e.text;
+  a.text_len = e.text_len;
+  auth::mac_ack(a, kKey1, expect);
+  EXPECT_FALSE(auth::mac_equal(m, expect));
+  test::AppFixture lab;
+  EXPECT_FALSE(lab.app->sign_event(e, m));
+}
+
 // ----------------------------------------------------------------------------------------------
 // Key file
 // ----------------------------------------------------------------------------------------------
