@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "config/yaml_reader.hpp"
+#include "gnc/param_bounds.hpp"
 
 namespace rocksteady::config {
 
@@ -274,8 +275,16 @@ CaseConfig load_case(const std::string& path) {
   c.gyro_psd = doc.non_negative("gyro_noise_psd_rad2_s2");
   c.star_psd = doc.non_negative("star_noise_psd");
   c.u_max = doc.positive("u_max_n");
+  if (!gnc::within_bound("rcs.u_max", c.u_max)) {
+    doc.fail("u_max_n", std::string("outside its physical range: ") +
+                            gnc::find_param_bound("rcs.u_max")->why);
+  }
   c.bias_nm = doc.vec3("disturbance_bias_nm");
   c.duration_s = doc.positive("duration_s");
+  if (!gnc::within_bound("case.duration_s", c.duration_s)) {
+    doc.fail("duration_s", std::string("outside its physical range: ") +
+                               gnc::find_param_bound("case.duration_s")->why);
+  }
   c.seed = doc.unsigned_integer("seed");
   if (doc.has("plant_truth")) c.plant_truth = doc.get("plant_truth");
   // The plant's truth beyond the study (thruster faults, the valve driver's timeout): read by the

@@ -26,6 +26,8 @@ const char* to_string(Opcode op) {
       return "PARAM_DISCARD";
     case Opcode::kParamDump:
       return "PARAM_DUMP";
+    case Opcode::kKeyRotate:
+      return "KEY_ROTATE";
     case Opcode::kParamLoadIdentified:
       return "PARAM_LOAD_IDENTIFIED";
   }
@@ -80,6 +82,8 @@ const char* to_string(ChunkStatus s) {
       return "header differs from the uplink in progress";
     case ChunkStatus::kBusy:
       return "a completed table awaits the tick boundary";
+    case ChunkStatus::kNotAuthenticated:
+      return "not authenticated (bad authenticator, unknown key or replayed counter)";
   }
   return "?";
 }
@@ -138,6 +142,12 @@ const char* to_string(EventId id) {
       return "overrun_safe";
     case EventId::kParamsDumped:
       return "params_dumped";
+    case EventId::kLabMode:
+      return "lab_mode";
+    case EventId::kAuthRejected:
+      return "auth_rejected";
+    case EventId::kKeyRotated:
+      return "key_rotated";
     case EventId::kModelAdopted:
       return "model_adopted";
     case EventId::kModelRefused:

@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 
 #include "gnc/allocation/allocator.hpp"
+#include "gnc/param_bounds.hpp"
 
 namespace rocksteady::gnc {
 
@@ -214,7 +215,7 @@ ParamCheck validate(const GncParams& p) {
   }
   if (!finite_positive(p.isp_s)) return bad("isp", "must be positive");
   if (!finite_positive(p.g0)) return bad("g0", "must be positive");
-  return r;
+  return check_bounds(p);  // the physical ranges (gnc/param_bounds.cpp)
 }
 
 }  // namespace rocksteady::gnc

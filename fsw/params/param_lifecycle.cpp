@@ -78,6 +78,12 @@ CommandCheck ParamLifecycle::check_stage() const {
 }
 
 CommandCheck ParamLifecycle::discard(const gnc::GncParams& active, EventLog& log) {
+  // An activation already accepted for the next tick boundary goes through: the discard is refused
+  // (never acknowledged while the table it claims to drop is still activated).
+  if (table_.staged()) {
+    return CommandCheck{RejectReason::kBusy, 0,
+                        "an activation is pending at the next tick: nothing to discard"};
+  }
   if (!table_.loaded())
     return CommandCheck{RejectReason::kNothingToActivate, 0, "no parameter load"};
   table_.discard(active);

@@ -104,21 +104,23 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_I(table_loads); RS_I(table_activations); RS_I(table_loaded);
   RS_I(uplink_id); RS_I(uplink_chunks_received); RS_I(uplink_total_chunks);
   RS_I(uplink_chunks_rejected); RS_I(trajectories_loaded);
+  RS_I(lab_mode); RS_I(auth_key_id); RS_I(auth_rejected); RS_I(replays_rejected);
 }
 
 void visit(const rocksteady::event_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_D(t); RS_I(seq); RS_I(severity); RS_I(id); RS_I(arg0); RS_I(arg1);
+  RS_I(key_id); RS_A(mac);
   s.text("text", m.text);
 }
 
 void visit(const rocksteady::ground_cmd_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(seq); RS_I(sender_id); RS_I(opcode); RS_I(nargs); RS_A(args);
-  RS_A(mac);
+  RS_I(key_id); RS_A(mac);
 }
 
 void visit(const rocksteady::cmd_ack_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_D(t); RS_I(seq); RS_I(sender_id); RS_I(opcode); RS_I(accepted);
-  RS_I(reason); RS_I(detail);
+  RS_I(reason); RS_I(detail); RS_I(key_id); RS_A(mac);
   s.text("text", m.text);
 }
 
@@ -134,6 +136,7 @@ void visit(const rocksteady::trajectory_chunk_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(upload_id); RS_I(chunk_index); RS_I(total_chunks);
   RS_I(total_samples); RS_I(first_sample); RS_I(count); RS_I(table_crc);
   RS_A(t); RS_A(omega_d); RS_A(omega_d_dot);
+  RS_I(seq); RS_I(key_id); RS_A(mac);
 }
 
 #undef RS_I

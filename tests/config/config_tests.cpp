@@ -172,6 +172,34 @@ TEST(ConfigErrors, UnknownKey) {
   expect_error([&] { load_case(g.path()); }, g.path(), "u_maxx", "unknown key");
 }
 
+// The findings: a duplicate key was silently ignored (the first one won), and u_max_n: 1e300 or
+// duration_s: 1e300 were accepted. Both are errors naming file, key and reason now.
+TEST(ConfigErrors, DuplicateKeyIsAnError) {
+  TempFile f("case.yaml", read(case_file(1)) + "u_max_n: 5\n");
+  expect_error([&] { load_case(f.path()); }, f.path(), "u_max_n", "duplicate key");
+  TempFile g("gnc.yaml", replaced(read(kGnc), "  auto_hold: true", "  auto_hold: true\n  auto_hold: false"));
+  expect_error([&] { load_gnc(g.path()); }, g.path(), "modes.auto_hold", "duplicate key");
+}
+
+TEST(ConfigErrors, ValuesOutsideTheirPhysicalRangesAreErrors) {
+  TempFile f("case.yaml", replaced(read(case_file(2)), "u_max_n: 200", "u_max_n: 1e300"));
+  expect_error([&] { load_case(f.path()); }, f.path(), "u_max_n", "physical range");
+  TempFile g("case.yaml", read(case_file(1)));
+  const std::string text = read(case_file(1));
+  const std::size_t at = text.find("duration_s:");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t end = text.find('\n', at);
+  TempFile h("case.yaml", text.substr(0, at) + "duration_s: 1e300" + text.substr(end));
+  expect_error([&] { load_case(h.path()); }, h.path(), "duration_s", "physical range");
+  TempFile k("gnc.yaml", replaced(read(kGnc), "sensor_timeout_s: 1.0", "sensor_timeout_s: 1e30"));
+  try {
+    load_flight_params(kMission, k.path(), case_file(1));
+    ADD_FAILURE() << "sensor_timeout_s: 1e30 accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("mode.sensor_timeout"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ConfigErrors, WrongShape) {
   TempFile f("mission.yaml",
              replaced(read(kMission), "r_so_bcm_m: [-0.0495, -0.0004, 3.5456]", "r_so_bcm_m: [1, 2]"));

@@ -73,8 +73,10 @@ std::vector<std::string> plant_args(const std::string& url, const std::string& m
 std::vector<std::string> fsw_args(const std::string& url, const std::string& mission,
                                   const std::string& gnc, const std::string& case_file,
                                   std::vector<std::string> extra) {
-  std::vector<std::string> a = {fsw_exe(), "--lcm-url", url,    "--mission", mission,
-                                "--gnc",   gnc,         "--case", case_file, "-v"};
+  // Lab mode: these tests command through the harness's unsigned messages (authentication over the
+  // bus is tested in auth_pil_test below and in tests/ground_cli/fsw_net_test.cpp).
+  std::vector<std::string> a = {fsw_exe(), "--lcm-url", url,       "--mission", mission, "--gnc",
+                                gnc,       "--case",    case_file, "-v",        "--lab-mode"};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
 }
