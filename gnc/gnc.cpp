@@ -117,10 +117,11 @@ void Gnc::refresh_fault_model() {
     m.j = e.j;
     m.r = e.r;
     m.k = e.k;
-    m.j_rel_sigma = e.j_sigma.maxCoeff() / e.j.norm();
-    // Directions of r the firings have not shown are at their prior: they count as uncertain.
-    m.r_sigma = e.r_sigma.maxCoeff();
-    m.k_sigma = e.k_sigma.maxCoeff();
+    // The 1 sigma from the identifier's covariances as they are now (a re-inflation shows at
+    // once); directions of r the firings have not shown stay at their prior: uncertain.
+    m.j_rel_sigma = std::sqrt(ident_.inertia_covariance().diagonal().maxCoeff()) / e.j.norm();
+    m.r_sigma = std::sqrt(ident_.offset_covariance().diagonal().maxCoeff());
+    m.k_sigma = std::sqrt(ident_.strength_covariance().diagonal().maxCoeff());
   } else {
     m.j = total_inertia(params_.mass_hat);
     m.r = params_.mass_hat.r_so_bcm;
