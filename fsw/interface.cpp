@@ -30,6 +30,14 @@ const char* to_string(Opcode op) {
       return "KEY_ROTATE";
     case Opcode::kParamLoadIdentified:
       return "PARAM_LOAD_IDENTIFIED";
+    case Opcode::kFaultDeclare:
+      return "FAULT_DECLARE";
+    case Opcode::kFaultClear:
+      return "FAULT_CLEAR";
+    case Opcode::kValve:
+      return "VALVE";
+    case Opcode::kIsolationInhibit:
+      return "ISOLATION_INHIBIT";
   }
   return "?";
 }

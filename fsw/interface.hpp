@@ -32,8 +32,12 @@ enum class Opcode : std::int32_t {
   kParamDump = 10,      // no arguments                the active table -> telemetry (ParamDump)
   kKeyRotate = 11,      // [key_id]                    active command key at the next tick
   kParamLoadIdentified = 12,  // no arguments        the identified model -> the inactive table
+  kFaultDeclare = 13,      // [thruster, kind]            declare a thruster failed: 1 stuck-on, 2 stuck-off
+  kFaultClear = 14,        // [thruster]                  clear a declaration or confirmation (-1: all)
+  kValve = 15,             // [pod, open]                 command a pod's latch valve (1 open, 0 closed)
+  kIsolationInhibit = 16,  // [flag]                      1: a confirmed stuck-on no longer closes its valve
 };
-inline constexpr int kOpcodeCount = 13;
+inline constexpr int kOpcodeCount = 17;
 const char* to_string(Opcode op);
 
 // The reference of "select law and reference" (second argument of kSetLaw).

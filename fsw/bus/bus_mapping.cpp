@@ -23,6 +23,11 @@ static_assert(static_cast<std::int32_t>(Opcode::kParamDiscard) == GroundCmd::OP_
 static_assert(static_cast<std::int32_t>(Opcode::kParamDump) == GroundCmd::OP_PARAM_DUMP);
 static_assert(static_cast<std::int32_t>(Opcode::kParamLoadIdentified) ==
               GroundCmd::OP_PARAM_LOAD_IDENTIFIED);
+static_assert(static_cast<std::int32_t>(Opcode::kFaultDeclare) == GroundCmd::OP_FAULT_DECLARE);
+static_assert(static_cast<std::int32_t>(Opcode::kFaultClear) == GroundCmd::OP_FAULT_CLEAR);
+static_assert(static_cast<std::int32_t>(Opcode::kValve) == GroundCmd::OP_VALVE);
+static_assert(static_cast<std::int32_t>(Opcode::kIsolationInhibit) ==
+              GroundCmd::OP_ISOLATION_INHIBIT);
 static_assert(kOpcodeCount == GroundCmd::OP_COUNT);
 static_assert(kMaxDumpParams == rocksteady::param_table_t::MAX_PARAMS);
 static_assert(kMaxParamValues == rocksteady::param_table_t::MAX_VALUES);

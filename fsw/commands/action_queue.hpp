@@ -18,6 +18,9 @@ enum class ActionKind : std::uint8_t {
   kLoadTrajectory,
   kResetCounters,
   kRotateKey,  // key_id becomes the active command key (fsw/auth)
+  kFaultDeclare,    // thruster, fault (kNone: clear; thruster -1: every thruster)
+  kValve,           // pod, open
+  kIsolation,       // inhibit automatic isolation (flag)
 };
 
 struct Action {
@@ -27,6 +30,9 @@ struct Action {
   gnc::Vec3 target{gnc::Vec3::Zero()};
   std::int32_t upload_id{0};
   std::int32_t key_id{0};
+  std::int8_t thruster{-1};  // kFaultDeclare; kValve: the pod
+  gnc::FaultKind fault{gnc::FaultKind::kNone};
+  bool flag{false};          // kValve: open; kIsolation: inhibited
 };
 
 class ActionQueue {

@@ -157,6 +157,25 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
     }
     case Opcode::kParamLoadIdentified:
       return ctx.params.load_identified(ctx.core, ctx.log);
+    case Opcode::kFaultDeclare:
+      a.kind = ActionKind::kFaultDeclare;
+      a.thruster = static_cast<std::int8_t>(cmd.args[0]);
+      a.fault = static_cast<gnc::FaultKind>(static_cast<int>(cmd.args[1]));
+      return enqueue_one(a);
+    case Opcode::kFaultClear:
+      a.kind = ActionKind::kFaultDeclare;
+      a.thruster = static_cast<std::int8_t>(cmd.args[0]);
+      a.fault = gnc::FaultKind::kNone;
+      return enqueue_one(a);
+    case Opcode::kValve:
+      a.kind = ActionKind::kValve;
+      a.thruster = static_cast<std::int8_t>(cmd.args[0]);
+      a.flag = cmd.args[1] != 0.0;
+      return enqueue_one(a);
+    case Opcode::kIsolationInhibit:
+      a.kind = ActionKind::kIsolation;
+      a.flag = cmd.args[0] != 0.0;
+      return enqueue_one(a);
   }
   return reject(RejectReason::kUnknownOpcode, cmd.opcode, "unknown opcode");
 }
@@ -275,6 +294,32 @@ void CommandDispatcher::apply_pending(gnc::GncCommands& cmds, BoundaryActions& a
         } else {
           cmds.has_mode_request = true;
           cmds.mode_request = a.mode;
+        }
+        break;
+      case ActionKind::kFaultDeclare:
+        if (cmds.has_fault_declaration) {
+          stop = true;
+        } else {
+          cmds.has_fault_declaration = true;
+          cmds.fault_thruster = a.thruster;
+          cmds.fault_kind = a.fault;
+        }
+        break;
+      case ActionKind::kValve:
+        if (cmds.has_valve) {
+          stop = true;
+        } else {
+          cmds.has_valve = true;
+          cmds.valve_pod = a.thruster;
+          cmds.valve_open = a.flag;
+        }
+        break;
+      case ActionKind::kIsolation:
+        if (cmds.has_isolation_inhibit) {
+          stop = true;
+        } else {
+          cmds.has_isolation_inhibit = true;
+          cmds.isolation_inhibited = a.flag;
         }
         break;
       case ActionKind::kTarget:

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <string>
 
 #include "gnc/math/rotation.hpp"
 #include "gnc/param_bounds.hpp"
@@ -41,6 +43,13 @@ const std::vector<CommandHelp> kHelp{
     {"load-identified", "load-identified",
      "load the flight's identified model (J_tot, r_SO/BCM, thruster strengths) into the inactive "
      "table; refused unless the identification is confident (activate-gains flies it)"},
+    {"declare-fault", "declare-fault THRUSTER stuck-on|stuck-off",
+     "declare a thruster (0-15, 4 x pod + position) failed; latched like a confirmed fault"},
+    {"clear-fault", "clear-fault THRUSTER|all",
+     "clear a thruster's declared or confirmed fault (valves are commanded separately)"},
+    {"valve", "valve POD open|close", "command a pod's latch valve (0-3)"},
+    {"isolation", "isolation inhibit|allow",
+     "inhibit or allow the automatic closing of a valve on a confirmed stuck-on thruster"},
     {"reset-counters", "reset-counters",
      "reset the command/health counters (cycle counts are kept)"},
     {"load-trajectory", "load-trajectory UPLOAD_ID",
@@ -271,6 +280,54 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
   if (name == "dump-params") return no_args(Msg::OP_PARAM_DUMP, "PARAM_DUMP");
   if (name == "load-identified") {
     return no_args(Msg::OP_PARAM_LOAD_IDENTIFIED, "PARAM_LOAD_IDENTIFIED");
+  }
+  auto index = [](const std::string& s, int lo, int hi, int& out) {
+    try {
+      std::size_t used = 0;
+      const int v = std::stoi(s, &used);
+      if (used != s.size() || v < lo || v > hi) return false;
+      out = v;
+      return true;
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  if (name == "declare-fault") {
+    if (args.size() != 2) return wrong_count(name, "2 arguments", args.size());
+    int t = 0;
+    if (!index(args[0], 0, 15, t)) return fail(name + ": thruster must be 0..15, got '" + args[0] + "'");
+    if (args[1] != "stuck-on" && args[1] != "stuck-off") {
+      return fail(name + ": kind must be stuck-on or stuck-off, got '" + args[1] + "'");
+    }
+    const double kind = args[1] == "stuck-on" ? 1.0 : 2.0;
+    return make(Msg::OP_FAULT_DECLARE, {static_cast<double>(t), kind},
+                "FAULT_DECLARE thruster " + args[0] + " " + args[1]);
+  }
+  if (name == "clear-fault") {
+    if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
+    int t = -1;
+    if (args[0] != "all" && !index(args[0], 0, 15, t)) {
+      return fail(name + ": thruster must be 0..15 or all, got '" + args[0] + "'");
+    }
+    return make(Msg::OP_FAULT_CLEAR, {static_cast<double>(t)}, "FAULT_CLEAR " + args[0]);
+  }
+  if (name == "valve") {
+    if (args.size() != 2) return wrong_count(name, "2 arguments", args.size());
+    int pod = 0;
+    if (!index(args[0], 0, 3, pod)) return fail(name + ": pod must be 0..3, got '" + args[0] + "'");
+    if (args[1] != "open" && args[1] != "close") {
+      return fail(name + ": expected open or close, got '" + args[1] + "'");
+    }
+    return make(Msg::OP_VALVE, {static_cast<double>(pod), args[1] == "open" ? 1.0 : 0.0},
+                "VALVE pod " + args[0] + " " + args[1]);
+  }
+  if (name == "isolation") {
+    if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
+    if (args[0] != "inhibit" && args[0] != "allow") {
+      return fail(name + ": expected inhibit or allow, got '" + args[0] + "'");
+    }
+    return make(Msg::OP_ISOLATION_INHIBIT, {args[0] == "inhibit" ? 1.0 : 0.0},
+                "ISOLATION_INHIBIT " + args[0]);
   }
   if (name == "set-mode") {
     if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
