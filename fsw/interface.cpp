@@ -136,6 +136,10 @@ const char* to_string(EventId id) {
       return "overrun_safe";
     case EventId::kParamsDumped:
       return "params_dumped";
+    case EventId::kTrajectorySwitched:
+      return "trajectory_switched";
+    case EventId::kTrajectoryStale:
+      return "trajectory_stale";
   }
   return "?";
 }

@@ -140,6 +140,8 @@ enum class EventId : std::int32_t {
   kCountersReset = 123,
   kOverrunSafe = 124,  // -> SAFE: arg0 = consecutive GNC slips
   kParamsDumped = 125, // the active table read back; arg0 = dump number
+  kTrajectorySwitched = 126,  // the staged trajectory became active at the tick boundary
+  kTrajectoryStale = 127,     // the staged trajectory was stale: refused, the active one kept
 };
 const char* to_string(EventId id);
 

@@ -29,7 +29,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   filter_.reset();
   modes_.reset(params.mode.initial);
   laws_.reset_state();
-  trajectory_valid_ = false;
+  trajectories_.clear();
   fuel_kg_ = 0.0;
   tick_ = 0;
   sensor_rejects_ = 0;
@@ -51,17 +51,12 @@ ParamCheck Gnc::set_params(const GncParams& params) {
 }
 
 TransitionCheck Gnc::check_mode_request(Mode to) const {
-  const TransitionContext ctx{filter_.initialised(), trajectory_valid_, params_.law};
+  const TransitionContext ctx{filter_.initialised(), trajectories_.valid(), params_.law};
   return check_transition(modes_.mode(), to, ctx);
 }
 
 TrajectoryError Gnc::load_trajectory(const TrajectoryTable& table) {
-  const TrajectoryError e = validate_trajectory(table, params_.guidance.eps_trans);
-  if (e != TrajectoryError::kOk) return e;
-  if (modes_.mode() == Mode::kTrack) return TrajectoryError::kBusyTracking;
-  trajectory_ = table;
-  trajectory_valid_ = true;
-  return e;
+  return trajectories_.load(table, params_.guidance.eps_trans, modes_.mode() == Mode::kTrack);
 }
 
 void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutput& out) {
@@ -104,7 +99,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   if (commands.has_target && commands.target_mrp.allFinite()) {
     refs_.set_target(commands.target_mrp);
   }
-  const TransitionContext ctx{filter_.initialised(), trajectory_valid_, params_.law};
+  const TransitionContext ctx{filter_.initialised(), trajectories_.valid(), params_.law};
   const bool finite = omega_hat.allFinite() && q_hat.allFinite();
   modes_.update(ModeInputs{commands.has_mode_request, commands.mode_request, ctx, omega_hat.norm(),
                            t - last_good_t_, finite},
@@ -112,9 +107,19 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   const Mode mode = modes_.mode();
   if (actuating(mode) && !actuating(before)) laws_.reset_state();
 
-  // 3. Reference.
+  // 3. Reference. A staged trajectory becomes active here, at the tick boundary, and TRACK
+  // re-synchronises to the estimate on it.
+  const SwitchOutcome sw = trajectories_.switch_at_boundary(omega_hat, stale_tolerance(omega_hat));
+  if (sw != SwitchOutcome::kNone) {
+    const bool switched = sw == SwitchOutcome::kSwitched;
+    out.events.push(ModeEvent{switched ? EventId::kTrajectorySwitched : EventId::kTrajectoryStale,
+                              mode, mode, TransitionCheck::kOk});
+    if (switched && mode == Mode::kTrack && !modes_.entered()) {
+      refs_.reset_track(t, q_hat, omega_hat, trajectories_.active());
+    }
+  }
   const ReferenceSample ref =
-      refs_.update(mode, modes_.entered(), t, q_hat, omega_hat, trajectory_);
+      refs_.update(mode, modes_.entered(), t, q_hat, omega_hat, trajectories_.active());
 
   // 4. Control law.
   RateReference rr;
@@ -160,7 +165,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   tl.alloc = status;
   tl.fuel_kg = fuel_kg_;
   tl.sensor_rejects = sensor_rejects_;
-  tl.trajectory_loaded = trajectory_valid_;
+  tl.trajectory_loaded = trajectories_.valid();
   tl.a_hat = laws_.a_hat();
   tl.integral = laws_.integral();
 }

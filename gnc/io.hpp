@@ -58,6 +58,8 @@ enum class EventId : std::uint8_t {
   kNonFiniteState,   // -> SAFE: the estimate or command went non-finite
   kRequestRejected,  // a mode request that failed the check at the tick boundary
   kSensorRejected,   // a sample failed validity / range checks
+  kTrajectorySwitched,  // a staged trajectory became active at this tick boundary (TRACK re-synced)
+  kTrajectoryStale,     // a staged trajectory was refused at the boundary; the active one kept
 };
 const char* to_string(EventId e);
 

@@ -24,7 +24,7 @@ struct Row {
   const char* text;  // printf with %s: from, to, detail (in that order; each may be unused)
 };
 
-constexpr std::array<Row, 6> kRows{{
+constexpr std::array<Row, 8> kRows{{
     {gnc::EventId::kModeChanged, EventId::kModeChanged, Severity::kInfo, Args::kFromTo,
      Detail::kCause, "mode %s -> %s (%s)"},
     {gnc::EventId::kAutoHold, EventId::kAutoHold, Severity::kInfo, Args::kFromTo, Detail::kNone,
@@ -38,6 +38,12 @@ constexpr std::array<Row, 6> kRows{{
     {gnc::EventId::kSensorRejected, EventId::kSensorRejected, Severity::kWarning,
      Args::kRejectsThrottled, Detail::kRejects,
      "sensor sample rejected: invalid, non-finite or out of range (%.0s%.0s%s so far)"},
+    {gnc::EventId::kTrajectorySwitched, EventId::kTrajectorySwitched, Severity::kInfo,
+     Args::kFromTo, Detail::kNone,
+     "trajectory switched at the tick boundary (mode %s%.0s): reference re-synchronised%s"},
+    {gnc::EventId::kTrajectoryStale, EventId::kTrajectoryStale, Severity::kWarning,
+     Args::kFromTo, Detail::kNone,
+     "staged trajectory refused at the tick boundary (mode %s%.0s): stale, active one kept%s"},
 }};
 
 const Row* find_row(gnc::EventId id) {
