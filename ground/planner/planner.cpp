@@ -631,6 +631,18 @@ PlanResult plan(const PlanProblem& problem) {
         [&](double t) { return w0 * std::max(1.0 - t / t_f, kTumbleFloor); }, t_f,
         settings.intervals_per_turn, settings.nodes, max_nodes());
   } else {
+    if (settings.nodes <= 0 && std::ceil(r.t_final_max / kUniformStep) + 1.0 > max_nodes()) {
+      // Refused before solving: at the grid's resolution the plan would not fit the on-board
+      // table, and a coarser grid fails the open-loop check (after minutes of solving).
+      std::ostringstream msg;
+      msg << "invalid problem: a " << r.t_final_max << " s horizon needs "
+          << std::ceil(r.t_final_max / kUniformStep) + 1.0 << " nodes at one per " << kUniformStep
+          << " s; the on-board table holds " << max_nodes()
+          << " (at most " << kUniformStep * (max_nodes() - 1)
+          << " s on the uniform grid; try the tumble-following grid)";
+      r.error = msg.str();
+      return r;
+    }
     spec.grid = uniform_grid(settings.nodes > 0 ? settings.nodes
                                                 : automatic_uniform_nodes(r.t_final_max));
   }

@@ -188,3 +188,20 @@ TEST(Replan, FromAMidDespinStateVerifiesCostsNoMoreThanTheRestAndIsAcceptedOnBoa
 
 }  // namespace
 }  // namespace rocksteady::ground::planner
+
+namespace rocksteady::ground::planner {
+namespace {
+
+TEST(PlannerHorizon, HorizonBeyondTheTableOnTheUniformGridIsRefusedWithTheReason) {
+  PlanProblem p;
+  p.model = study_case_model(200.0, 0.0, 0.0);
+  p.settings.t_final_max = kStudyHorizon;
+  const PlanResult r = plan(p);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("needs 1761 nodes"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("holds 512"), std::string::npos) << r.error;
+  EXPECT_EQ(r.iterations, 0);  // refused before solving
+}
+
+}  // namespace
+}  // namespace rocksteady::ground::planner
