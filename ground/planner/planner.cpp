@@ -269,6 +269,8 @@ SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
     // iterations.
     app->Options()->SetStringValue("mu_strategy", "monotone");
     app->Options()->SetNumericValue("mu_init", spec.warm_mu);
+    // A warm start that has not converged by then is not near its answer: solve() starts over cold.
+    app->Options()->SetIntegerValue("max_iter", std::min(settings.max_iterations, kWarmMaxIterations));
     app->Options()->SetNumericValue("bound_push", 1e-6);
     app->Options()->SetNumericValue("bound_frac", 1e-6);
     app->Options()->SetStringValue("bound_mult_init_method", "mu-based");
@@ -672,6 +674,25 @@ PlanResult plan(const PlanProblem& problem) {
     spec = again;
     spec.warm = nullptr;
     safety *= 0.25;
+  }
+  // Automatic uniform grid: when the open-loop check fails (faster dynamics than case 1's, e.g. a
+  // larger u_max), 1.5x the nodes, warm-started, while the table holds them.
+  for (int round = 0; main.ok && !settings.tumble_grid && settings.nodes <= 0 &&
+                      spec.nodes < max_nodes() && round < kMaxRegrids;
+       ++round) {
+    if (verify_samples(model, main.samples, settings.propagation_limit).passed) break;
+    const std::vector<PlanSample> previous = main.samples;
+    SolveSpec again = spec;
+    again.grid = uniform_grid(std::min(max_nodes(), (3 * spec.nodes) / 2));
+    again.nodes = static_cast<int>(again.grid.size());
+    again.warm = &previous;
+    again.warm_mu = kWarmMu;
+    SolveOutcome next = solve(model, settings, again);
+    r.iterations += next.iterations;
+    r.solve_seconds += next.seconds;
+    main = std::move(next);
+    spec = again;
+    spec.warm = nullptr;
   }
   r.nodes = spec.nodes;
   if (!main.ok) {
