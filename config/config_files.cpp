@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "config/yaml_reader.hpp"
+#include "gnc/param_bounds.hpp"
 
 namespace rocksteady::config {
 
@@ -119,8 +120,10 @@ GncConfig load_gnc(const std::string& path) {
     g.estimator = EstimatorChoice::kPassThrough;
   } else if (est == "filter") {
     g.estimator = EstimatorChoice::kFilter;
+  } else if (est == "mekf") {
+    g.estimator = EstimatorChoice::kMekf;
   } else {
-    doc.fail("estimator", "expected auto, passthrough or filter, got '" + est + "'");
+    doc.fail("estimator", "expected auto, passthrough, filter or mekf, got '" + est + "'");
   }
 
   // SPEC §4: optional; the study's pseudoinverse, Eq. (53), unless the fuel-optimal Eq. (52).
@@ -141,6 +144,72 @@ GncConfig load_gnc(const std::string& path) {
   p.estimator.gyro_max_rate = f.positive("gyro_max_rate_rad_s");
   p.estimator.quat_norm_tolerance = f.positive("quat_norm_tolerance");
   f.finish();
+
+  // The MEKF's tuning (optional; the sensor noise itself comes from the case, flight_params).
+  if (doc.has("mekf")) {
+    MapReader r = doc.map("mekf");
+    p.mekf.gyro_bias_rw = r.positive("gyro_bias_rw_rad_s32");
+    p.mekf.model_sigma = r.non_negative("model_sigma_rad_sqrt_s");
+    p.mekf.init_attitude_sigma = r.positive("init_attitude_sigma_rad");
+    p.mekf.init_bias_sigma = r.positive("init_bias_sigma_rad_s");
+    p.mekf.gate_chi2 = r.positive("gate_chi2");
+    p.mekf.max_consecutive_rejects = r.integer("max_consecutive_rejects");
+    r.finish();
+  }
+
+  // On-line identification (optional; off when absent). The priors are the case's estimates.
+  if (doc.has("identification")) {
+    MapReader r = doc.map("identification");
+    gnc::IdentificationParams& id = p.identification;
+    id.enabled = r.boolean("enabled");
+    const std::string adopt = r.text("adopt");
+    if (adopt == "off") {
+      id.adopt = gnc::ModelAdoption::kOff;
+    } else if (adopt == "auto") {
+      id.adopt = gnc::ModelAdoption::kAuto;
+    } else {
+      r.fail("adopt", "expected off or auto, got '" + adopt + "'");
+    }
+    id.adopt_interval_s = r.positive("adopt_interval_s");
+    gnc::IdentifierConfig& ic = id.config;
+    const std::string mode = r.text("mode");
+    if (mode == "joint") {
+      ic.mode = gnc::IdentifierMode::kJoint;
+    } else if (mode == "concurrent") {
+      ic.mode = gnc::IdentifierMode::kConcurrent;
+    } else {
+      r.fail("mode", "expected joint or concurrent, got '" + mode + "'");
+    }
+    ic.window_s = r.positive("window_s");
+    g.id_window_noisy_s = r.positive("window_noisy_s");
+    ic.j_prior_sigma = r.positive("inertia_prior_sigma_kg_m2");
+    ic.r_prior_sigma = r.positive("offset_prior_sigma_m");
+    ic.k_prior_sigma = r.positive("strength_prior_sigma");
+    ic.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
+    ic.j_forget_s = r.non_negative("inertia_forget_s");
+    ic.r_forget_s = r.non_negative("offset_forget_s");
+    ic.j_confident_rel = r.positive("inertia_confident_rel");
+    ic.r_confident = r.positive("offset_confident_m");
+    ic.k_confident = r.positive("strength_confident");
+    r.finish();
+  }
+
+  // Thruster fault detection and isolation (optional; off when absent).
+  if (doc.has("fdi")) {
+    MapReader r = doc.map("fdi");
+    gnc::FaultDetectorParams& fd = p.fdi;
+    fd.enabled = r.boolean("enabled");
+    fd.window_ticks = r.integer("window_ticks");
+    g.fdi_window_noisy_ticks = r.integer("window_noisy_ticks");
+    fd.model_rel_floor = r.non_negative("model_rel_floor");
+    fd.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
+    fd.confirm_llr = r.positive("confirm_llr");
+    fd.margin_llr = r.non_negative("margin_llr");
+    fd.suspect_chi2 = r.positive("suspect_chi2");
+    fd.auto_isolate = r.boolean("auto_isolate");
+    p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
+    r.finish();
+  }
 
   MapReader laws = doc.map("laws");
   tracking(laws.map("ntcl"), p.ntcl);
@@ -206,9 +275,22 @@ CaseConfig load_case(const std::string& path) {
   c.gyro_psd = doc.non_negative("gyro_noise_psd_rad2_s2");
   c.star_psd = doc.non_negative("star_noise_psd");
   c.u_max = doc.positive("u_max_n");
+  if (!gnc::within_bound("rcs.u_max", c.u_max)) {
+    doc.fail("u_max_n", std::string("outside its physical range: ") +
+                            gnc::find_param_bound("rcs.u_max")->why);
+  }
   c.bias_nm = doc.vec3("disturbance_bias_nm");
   c.duration_s = doc.positive("duration_s");
+  if (!gnc::within_bound("case.duration_s", c.duration_s)) {
+    doc.fail("duration_s", std::string("outside its physical range: ") +
+                               gnc::find_param_bound("case.duration_s")->why);
+  }
   c.seed = doc.unsigned_integer("seed");
+  if (doc.has("plant_truth")) c.plant_truth = doc.get("plant_truth");
+  // The plant's truth beyond the study (thruster faults, the valve driver's timeout): read by the
+  // ground's loader (ground/config), never by the flight software.
+  doc.skip("faults");
+  doc.skip("valve_driver_timeout_s");
   doc.finish();
   return c;
 }
@@ -249,7 +331,18 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
       break;
     case EstimatorChoice::kPassThrough: p.estimator.kind = gnc::EstimatorKind::kPassThrough; break;
     case EstimatorChoice::kFilter: p.estimator.kind = gnc::EstimatorKind::kFilter; break;
+    case EstimatorChoice::kMekf: p.estimator.kind = gnc::EstimatorKind::kMekf; break;
   }
+  // The MEKF's and the identifier's sensor noise: the case's (the sensors' data sheet), with a
+  // floor for the noise-free cases so the filter stays well posed. SPEC §5: per-sample sigma =
+  // sqrt(P / T_s); the MEKF's angle random walk is sqrt(P(dw)); its star-tracker attitude sigma
+  // is 4 sigma_q (dtheta = 4 dq for small angles).
+  p.mekf.gyro_arw = std::fmax(std::sqrt(c.gyro_psd), 1e-9);
+  p.mekf.star_sigma = std::fmax(4.0 * std::sqrt(c.star_psd / m.sensor_period_s), 1e-7);
+  p.identification.config.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
+  if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
+  p.fdi.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
+  if (noisy) p.fdi.window_ticks = g.fdi_window_noisy_ticks;
   const gnc::ParamCheck check = gnc::validate(p);
   if (!check.ok) {
     const std::string field = check.field;

@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <string>
 
+#include <yaml-cpp/yaml.h>
+
 #include "gnc/params.hpp"
 #include "config/config_error.hpp"
 
@@ -37,12 +39,18 @@ struct MissionConfig {
   int rk4_substeps{1};
 };
 
-enum class EstimatorChoice { kAuto, kPassThrough, kFilter };
+enum class EstimatorChoice { kAuto, kPassThrough, kFilter, kMekf };
 
 struct GncConfig {
   std::string file;
   gnc::GncParams params{};  // mass_hat, rcs and law are filled in by assemble()
   EstimatorChoice estimator{EstimatorChoice::kAuto};
+  // Identification window when the case's sensors are noisy (params.identification.config.window_s
+  // is the quiet-sensor one): a longer window averages the gyro noise down (estimation README §I.4).
+  double id_window_noisy_s{60.0};
+  // Fault-detector residual window when the case's sensors are noisy (params.fdi.window_ticks is
+  // the quiet-sensor one).
+  int fdi_window_noisy_ticks{25};
 };
 
 struct CaseConfig {
@@ -57,6 +65,9 @@ struct CaseConfig {
   Vec3 bias_nm{Vec3::Zero()};
   double duration_s{1e5};
   std::uint64_t seed{1};
+  // Optional `plant_truth:` mapping (gyro bias, thruster strengths beyond the study's truth),
+  // applied by the ground's assemble() (ground/config); null when absent.
+  YAML::Node plant_truth{};
 };
 
 MissionConfig load_mission(const std::string& path);

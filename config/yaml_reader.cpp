@@ -25,6 +25,12 @@ MapReader::MapReader(YAML::Node node, std::string file, std::string path)
     throw ConfigError(file_, path_.empty() ? "(document)" : path_,
                       "expected a mapping of keys" + line_of(node_));
   }
+  // yaml-cpp keeps both entries of a repeated key and lookups see only the first: an error here.
+  std::set<std::string> seen;
+  for (const auto& kv : node_) {
+    const std::string k = kv.first.as<std::string>();
+    if (!seen.insert(k).second) fail(k, "duplicate key" + line_of(kv.first));
+  }
 }
 
 std::string MapReader::key_path(const std::string& key) const {
@@ -153,6 +159,12 @@ Eigen::Matrix3d MapReader::matrix3(const std::string& key) {
   }
   if ((m - m.transpose()).norm() > 1e-9 * (1.0 + m.norm())) fail(key, "matrix is not symmetric");
   return m;
+}
+
+bool MapReader::skip(const std::string& key) {
+  if (!has(key)) return false;
+  read_.insert(key);
+  return true;
 }
 
 void MapReader::finish() const {

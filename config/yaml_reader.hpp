@@ -35,6 +35,8 @@ class MapReader {
   Eigen::VectorXd list(const std::string& key, int size);
   // A number (times I), a list of 3 (diagonal) or a 3x3 matrix; must be symmetric.
   Eigen::Matrix3d matrix3(const std::string& key);
+  // Marks a key as read without interpreting it (a key another loader owns). False when absent.
+  bool skip(const std::string& key);
   // Every key present must have been read.
   void finish() const;
 

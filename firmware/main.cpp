@@ -9,6 +9,8 @@
 //   goal=despin   only require |w| to fall (default goal=hold: DETUMBLE must also hand over to HOLD)
 //   start=hold    start from a slow residual rate and command HOLD instead (instruction counts of
 //                 the HOLD phase without simulating the despin); success = HOLD kept throughout
+//   modules=all   every flight-core module on (the budget of DEVELOPERS.md): the MEKF, on-line
+//                 identification with automatic model adoption, fault detection, the L1 allocator
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -43,6 +45,7 @@ struct Options {
   std::uint32_t print_every_s{1000};
   bool require_hold{true};
   bool start_hold{false};
+  bool all_modules{false};
 };
 
 // Parses "key=value" tokens of the semihosting command line (unknown tokens are ignored).
@@ -68,6 +71,7 @@ Options parse_options() {
     if (const char* v = value_of("print=")) o.print_every_s = to_u32(v) > 0 ? to_u32(v) : 1U;
     if (const char* v = value_of("goal=")) o.require_hold = std::strncmp(v, "despin", 6) != 0;
     if (const char* v = value_of("start=")) o.start_hold = std::strncmp(v, "hold", 4) == 0;
+    if (const char* v = value_of("modules=")) o.all_modules = std::strncmp(v, "all", 3) == 0;
   }
   return o;
 }
@@ -103,6 +107,15 @@ int firmware_main() {
   const Options opt = parse_options();
 
   g_params = gnc::study_gnc_params(200.0);
+  if (opt.all_modules) {
+    g_params.estimator.kind = gnc::EstimatorKind::kMekf;
+    g_params.mekf.gyro_arw = 1e-6;
+    g_params.mekf.star_sigma = 4e-4;
+    g_params.allocator = gnc::AllocatorKind::kL1;
+    g_params.identification.enabled = true;
+    g_params.identification.adopt = gnc::ModelAdoption::kAuto;
+    g_params.fdi.enabled = true;
+  }
   const gnc::ParamCheck check = g_gnc.init(g_params);
   if (!check.ok) {
     line.str("firmware: parameter table rejected: ").str(check.field).str(": ").str(check.reason);
@@ -128,7 +141,8 @@ int firmware_main() {
 
   line.str("firmware: Cortex-M7 (fpv5-d16), sizeof(Gnc)=").u32(sizeof(gnc::Gnc))
       .str(" B, sizeof(GncParams)=").u32(sizeof(gnc::GncParams))
-      .str(" B, dt=").fix(g_params.dt, 2).str(" s, run ").u32(opt.seconds).str(" s");
+      .str(" B, dt=").fix(g_params.dt, 2).str(" s, run ").u32(opt.seconds).str(" s")
+      .str(opt.all_modules ? ", modules: MEKF + identification + FDI + L1" : ", modules: study");
   line.flush();
 
   const double dt = g_params.dt;

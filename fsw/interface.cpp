@@ -26,6 +26,10 @@ const char* to_string(Opcode op) {
       return "PARAM_DISCARD";
     case Opcode::kParamDump:
       return "PARAM_DUMP";
+    case Opcode::kKeyRotate:
+      return "KEY_ROTATE";
+    case Opcode::kParamLoadIdentified:
+      return "PARAM_LOAD_IDENTIFIED";
   }
   return "?";
 }
@@ -78,6 +82,8 @@ const char* to_string(ChunkStatus s) {
       return "header differs from the uplink in progress";
     case ChunkStatus::kBusy:
       return "a completed table awaits the tick boundary";
+    case ChunkStatus::kNotAuthenticated:
+      return "not authenticated (bad authenticator, unknown key or replayed counter)";
   }
   return "?";
 }
@@ -136,6 +142,28 @@ const char* to_string(EventId id) {
       return "overrun_safe";
     case EventId::kParamsDumped:
       return "params_dumped";
+    case EventId::kLabMode:
+      return "lab_mode";
+    case EventId::kAuthRejected:
+      return "auth_rejected";
+    case EventId::kKeyRotated:
+      return "key_rotated";
+    case EventId::kModelAdopted:
+      return "model_adopted";
+    case EventId::kModelRefused:
+      return "model_refused";
+    case EventId::kModelLoaded:
+      return "model_loaded";
+    case EventId::kFaultSuspected:
+      return "fault_suspected";
+    case EventId::kFaultConfirmed:
+      return "fault_confirmed";
+    case EventId::kValveClosed:
+      return "valve_closed";
+    case EventId::kFaultOverride:
+      return "fault_override";
+    case EventId::kReducedAuthority:
+      return "reduced_authority";
     case EventId::kTrajectorySwitched:
       return "trajectory_switched";
     case EventId::kTrajectoryStale:

@@ -30,8 +30,10 @@ enum class Opcode : std::int32_t {
   kParamActivate = 8,   // no arguments                inactive -> active at the next tick
   kParamDiscard = 9,    // no arguments                inactive := active
   kParamDump = 10,      // no arguments                the active table -> telemetry (ParamDump)
+  kKeyRotate = 11,      // [key_id]                    active command key at the next tick
+  kParamLoadIdentified = 12,  // no arguments        the identified model -> the inactive table
 };
-inline constexpr int kOpcodeCount = 11;
+inline constexpr int kOpcodeCount = 13;
 const char* to_string(Opcode op);
 
 // The reference of "select law and reference" (second argument of kSetLaw).
@@ -41,12 +43,16 @@ enum class ReferenceId : std::int32_t {
   kFuelOptimal = 2,  // fuel-optimal reference, Eqs. (45)-(48): TRACK
 };
 
+inline constexpr int kMacSize = 32;  // HMAC-SHA256 (fsw/auth/auth.hpp)
+
 struct GroundCommand {
-  std::int64_t seq{0};     // per-source sequence number, > 0, strictly increasing
+  std::int64_t seq{0};     // the key's message counter (fsw/auth), > 0
   std::int32_t source{0};  // who sent it (operator console, campaign script, ...)
   std::int32_t opcode{0};  // Opcode
   std::int32_t arg_count{0};
   std::array<double, kMaxCommandArgs> args{};
+  std::int32_t key_id{0};                      // 0: unauthenticated (lab mode)
+  std::array<std::uint8_t, kMacSize> mac{};    // authenticator (fsw/auth)
 };
 
 // Numbers 0..10 are those of lcmtypes' cmd_ack_t REASON_*; 11..13 are the fsw's additions.
@@ -93,6 +99,9 @@ struct TrajectoryChunk {
   std::uint32_t crc32{0};         // gnc::trajectory_checksum of the whole table
   std::int32_t n{0};              // samples in this chunk: 32, the last one the remainder
   std::array<gnc::TrajectorySample, kChunkSamples> samples{};
+  std::int64_t seq{0};                        // the key's message counter (fsw/auth)
+  std::int32_t key_id{0};                     // 0: unauthenticated (lab mode)
+  std::array<std::uint8_t, kMacSize> mac{};   // authenticator (fsw/auth)
 };
 
 enum class ChunkStatus : std::uint8_t {
@@ -102,6 +111,7 @@ enum class ChunkStatus : std::uint8_t {
   kBadCount,        // n is not the number of samples this chunk must carry
   kHeaderMismatch,  // same upload id, different total / chunk count / CRC
   kBusy,            // a completed table is waiting for the tick boundary
+  kNotAuthenticated,  // bad authenticator, unknown key or replayed counter (fsw/auth)
 };
 const char* to_string(ChunkStatus s);
 
@@ -140,8 +150,20 @@ enum class EventId : std::int32_t {
   kCountersReset = 123,
   kOverrunSafe = 124,  // -> SAFE: arg0 = consecutive GNC slips
   kParamsDumped = 125, // the active table read back; arg0 = dump number
-  kTrajectorySwitched = 126,  // the staged trajectory became active at the tick boundary
-  kTrajectoryStale = 127,     // the staged trajectory was stale: refused, the active one kept
+  kLabMode = 126,      // warning at init: commands are NOT authenticated (explicit lab mode)
+  kAuthRejected = 127, // throttled; a command/chunk failed authentication; arg0 = AuthResult,
+                       // arg1 = 0 command / 1 chunk
+  kKeyRotated = 128,   // arg0 = old key id, arg1 = new key id (at the tick boundary)
+  kModelAdopted = 129,  // the identified model became the active table (automatic policy)
+  kModelRefused = 130,  // a confident identified model failed table validation
+  kModelLoaded = 131,   // PARAM_LOAD_IDENTIFIED: the identified model is in the inactive table
+  kFaultSuspected = 132,   // arg0 = leading thruster (-1 none), arg1 = 1 stuck-on / 2 stuck-off
+  kFaultConfirmed = 133,   // arg0 = thruster, arg1 = gnc::FaultKind; latched until cleared
+  kValveClosed = 134,      // arg0 = pod, arg1 = the stuck-on thruster it isolates
+  kFaultOverride = 135,    // arg0 = thruster / pod / -1, arg1 = kind / 10 open / 11 close / 20, 21 inhibit
+  kReducedAuthority = 136, // arg0 = rank, arg1 = usable channels
+  kTrajectorySwitched = 137,  // the staged trajectory became active at the tick boundary
+  kTrajectoryStale = 138,     // the staged trajectory was stale: refused, the active one kept
 };
 const char* to_string(EventId id);
 
@@ -218,6 +240,11 @@ struct HealthTelemetry {
   std::uint32_t uplink_chunks_rejected{0};
   std::uint32_t trajectories_loaded{0};
   bool trajectory_loaded{false};
+
+  bool lab_mode{false};                 // commands are not authenticated
+  std::int32_t auth_key_id{0};          // active command key (0: lab mode)
+  std::uint64_t auth_rejected{0};       // failed authentication
+  std::uint64_t replays_rejected{0};    // authentic but replayed / too old
 };
 
 }  // namespace rocksteady::fsw

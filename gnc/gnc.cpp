@@ -13,6 +13,7 @@ bool actuating(Mode m) { return m == Mode::kDetumble || m == Mode::kHold || m ==
 void Gnc::configure_components() {
   const Mat3 j_hat = total_inertia(params_.mass_hat);  // Eq. (1) with the estimates
   filter_.configure(params_.estimator, j_hat, params_.dt);
+  if (params_.estimator.kind == EstimatorKind::kMekf) mekf_.configure(build_mekf_config(params_));
   modes_.configure(params_.mode, params_.guidance.omega_switch);
   refs_.configure(params_.guidance, params_.dt);
   laws_.configure(law_gains(params_), j_hat, params_.dt);
@@ -27,6 +28,17 @@ ParamCheck Gnc::init(const GncParams& params) {
   params_ = params;
   configure_components();
   filter_.reset();
+  mekf_.reset();
+  // The identifier starts from this table's model as its prior; a later table switch keeps its
+  // estimate (set_params).
+  if (params_.identification.enabled) ident_.configure(build_identifier_config(params_));
+  fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
+  fdi_.clear(-1);
+  valve_open_ = {{true, true, true, true}};
+  last_valve_ = valve_open_;
+  isolation_inhibited_ = false;
+  reduced_reported_ = false;
+  refresh_fault_model();
   modes_.reset(params.mode.initial);
   laws_.reset_state();
   trajectories_.clear();
@@ -36,23 +48,250 @@ ParamCheck Gnc::init(const GncParams& params) {
   have_time_ = false;
   last_torque_.setZero();
   last_saturated_ = false;
+  last_force_.setZero();
+  id_bias_ = params_.mekf.init_bias;
+  candidate_status_ = params_.identification.enabled ? ModelCandidate::kNotConfident
+                                                     : ModelCandidate::kDisabled;
+  candidate_windows_ = 0;
+  last_adoption_t_ = 0.0;
+  adopted_once_ = false;
+  adoptions_ = 0;
   return c;
 }
 
-ParamCheck Gnc::set_params(const GncParams& params) {
+ParamCheck Gnc::set_params(const GncParams& params) { return apply_params(params, true); }
+
+ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   const ParamCheck c = validate(params);
   if (!c.ok) return c;
   const Vec3 target = refs_.target();
   const bool target_changed = !(params.guidance.q_final == params_.guidance.q_final);
+  const bool estimator_changed = params.estimator.kind != params_.estimator.kind;
+  const bool identification_started = params.identification.enabled && !params_.identification.enabled;
+  // A table whose model differs from what the identifier believes is a declared change: the
+  // identifier keeps its estimate and goes back to its prior covariance. A table holding the
+  // identified model (adopted automatically or loaded by the ground) changes nothing.
+  bool model_changed = false;
+  if (params_.identification.enabled) {
+    const IdentifierEstimate& e = ident_.estimate();
+    IdentifiedModel m{e.j, e.r, params.rcs.strength};
+    for (int i = 0; i < kThrusters; ++i) {
+      if (e.thruster_confident[static_cast<std::size_t>(i)]) m.k(i) = e.k(i);
+    }
+    model_changed = differs(params, m);
+  }
   params_ = params;
   configure_components();
+  {
+    // The detector takes the new table; what it has confirmed stays latched.
+    const std::uint16_t on = fdi_.confirmed_on();
+    const std::uint16_t off = fdi_.confirmed_off();
+    fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
+    for (int i = 0; i < kThrusters; ++i) {
+      if ((on >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOn);
+      if ((off >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOff);
+    }
+  }
+  if (estimator_changed) {
+    filter_.reset();
+    mekf_.reset();
+  }
+  if (!params_.identification.enabled) candidate_status_ = ModelCandidate::kDisabled;
+  if (identification_started) {
+    ident_.configure(build_identifier_config(params_));
+    candidate_status_ = ModelCandidate::kNotConfident;
+    candidate_windows_ = 0;
+  } else if (model_changed && declared_change) {
+    candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
+    ident_.reinflate_all();
+  }
+  refresh_fault_model();
   if (!target_changed) refs_.set_target(target);  // keep a ground-commanded target
   return c;
 }
 
+void Gnc::refresh_fault_model() {
+  FaultModel m;
+  if (params_.identification.enabled) {
+    const IdentifierEstimate& e = ident_.estimate();
+    m.j = e.j;
+    m.r = e.r;
+    m.k = e.k;
+    m.j_rel_sigma = e.j_sigma.maxCoeff() / e.j.norm();
+    // Directions of r the firings have not shown are at their prior: they count as uncertain.
+    m.r_sigma = e.r_sigma.maxCoeff();
+    m.k_sigma = e.k_sigma.maxCoeff();
+  } else {
+    m.j = total_inertia(params_.mass_hat);
+    m.r = params_.mass_hat.r_so_bcm;
+    m.k = params_.rcs.strength;
+    m.j_rel_sigma = params_.fdi_table_rel_sigma;
+    m.r_sigma = params_.identification.config.r_prior_sigma;
+    m.k_sigma = params_.identification.config.k_prior_sigma;
+  }
+  fdi_.set_model(m);
+}
+
+void Gnc::apply_fault_overrides(const GncCommands& commands, ModeEvents& events) {
+  const Mode mode = modes_.mode();
+  if (commands.has_fault_declaration) {
+    const int i = commands.fault_thruster;
+    if (commands.fault_kind == FaultKind::kNone) {
+      fdi_.clear(i);
+    } else if (i >= 0 && i < kThrusters) {
+      fdi_.declare(i, commands.fault_kind);
+      if (params_.identification.enabled) ident_.reinflate_thruster(i);
+    }
+    ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
+    e.arg0 = static_cast<std::int16_t>(i);
+    e.arg1 = static_cast<std::int16_t>(commands.fault_kind);
+    events.push(e);
+  }
+  if (commands.has_valve && commands.valve_pod >= 0 && commands.valve_pod < kPods) {
+    valve_open_[static_cast<std::size_t>(commands.valve_pod)] = commands.valve_open;
+    ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
+    e.arg0 = commands.valve_pod;
+    e.arg1 = static_cast<std::int16_t>(commands.valve_open ? 10 : 11);  // valve open / close
+    events.push(e);
+  }
+  if (commands.has_isolation_inhibit) {
+    isolation_inhibited_ = commands.isolation_inhibited;
+    ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
+    e.arg0 = -1;
+    e.arg1 = static_cast<std::int16_t>(commands.isolation_inhibited ? 20 : 21);
+    events.push(e);
+  }
+}
+
+void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events) {
+  if (!params_.fdi.enabled) return;
+  FaultDetectorInput in;
+  in.omega = omega;
+  in.omega_valid = omega_valid;
+  for (int c = 0; c < kChannels; ++c) {
+    const double f = last_force_(c);
+    in.thrust(2 * c) = f > 0.0 ? f : 0.0;
+    in.thrust(2 * c + 1) = f < 0.0 ? -f : 0.0;
+  }
+  in.valve_open = last_valve_;
+  const FaultEvents fe = fdi_.update(in);
+  const Mode mode = modes_.mode();
+  if (fe.suspected && !fe.confirmed) {
+    ModeEvent e{EventId::kFaultSuspected, mode, mode, TransitionCheck::kOk};
+    const int best = fdi_.status().best;
+    e.arg0 = static_cast<std::int16_t>(best < 0 ? -1 : best % kThrusters);
+    e.arg1 = static_cast<std::int16_t>(best < 0 ? 0 : best < kThrusters ? 1 : 2);
+    events.push(e);
+  }
+  if (fe.confirmed) {
+    ModeEvent e{EventId::kFaultConfirmed, mode, mode, TransitionCheck::kOk};
+    e.arg0 = static_cast<std::int16_t>(fe.thruster);
+    e.arg1 = static_cast<std::int16_t>(fe.kind);
+    events.push(e);
+    // Until the confirmation the fault was unmodelled: every group the identifier fitted since
+    // onset absorbed it. Its covariance goes back to the prior (estimates kept), which also makes
+    // the detector insensitive until the model is re-identified (no cascade of confirmations).
+    if (params_.identification.enabled) {
+      ident_.reinflate_all();
+      refresh_fault_model();
+    }
+    const int pod = params_.rcs.channel_pod[fe.thruster / 2];
+    const auto p = static_cast<std::size_t>(pod);
+    if (fe.kind == FaultKind::kStuckOn && params_.fdi.auto_isolate && !isolation_inhibited_ &&
+        valve_open_[p]) {
+      valve_open_[p] = false;  // the pod's latch valve: the stuck jet stops, its pod with it
+      ModeEvent v{EventId::kValveClosed, mode, mode, TransitionCheck::kOk};
+      v.arg0 = static_cast<std::int16_t>(pod);
+      v.arg1 = static_cast<std::int16_t>(fe.thruster);
+      events.push(v);
+    }
+  }
+}
+
+AllocatorLimits Gnc::allocation_limits() const {
+  // In produced force (B_hat's units): a thruster of strength k reaches k u_max. A thruster is
+  // usable when its pod's valve is open and no fault is latched on it; a latched stuck-on thruster
+  // behind an open valve is a known bias torque (SPEC §4 column, + or - side).
+  AllocatorLimits l;
+  l.bias.setZero();
+  const double u_max = params_.rcs.u_max;
+  const std::uint16_t on = fdi_.confirmed_on();
+  const std::uint16_t off = fdi_.confirmed_off();
+  const Mat38& b = alloc_.b_hat();
+  for (int c = 0; c < kChannels; ++c) {
+    const bool open = valve_open_[static_cast<std::size_t>(params_.rcs.channel_pod[c])];
+    const int tp = 2 * c;
+    const int tm = 2 * c + 1;
+    const bool plus_ok = open && !(((on | off) >> tp) & 1u);
+    const bool minus_ok = open && !(((on | off) >> tm) & 1u);
+    l.hi(c) = plus_ok ? params_.rcs.strength(tp) * u_max : 0.0;
+    l.lo(c) = minus_ok ? -params_.rcs.strength(tm) * u_max : 0.0;
+    if (open && ((on >> tp) & 1u)) l.bias += b.col(c) * (params_.rcs.strength(tp) * u_max);
+    if (open && ((on >> tm) & 1u)) l.bias -= b.col(c) * (params_.rcs.strength(tm) * u_max);
+  }
+  return l;
+}
+
 TransitionCheck Gnc::check_mode_request(Mode to) const {
-  const TransitionContext ctx{filter_.initialised(), trajectories_.valid(), params_.law};
+  const TransitionContext ctx{estimate_ready(), trajectories_.valid(), params_.law};
   return check_transition(modes_.mode(), to, ctx);
+}
+
+bool Gnc::estimate_ready() const {
+  return params_.estimator.kind == EstimatorKind::kMekf ? mekf_.initialised() : filter_.initialised();
+}
+
+ModelCandidate Gnc::identified_model(IdentifiedModel& out) const {
+  if (!params_.identification.enabled) return ModelCandidate::kDisabled;
+  const IdentifierEstimate& e = ident_.estimate();
+  if (!e.inertia_confident || !e.offset_confident) return ModelCandidate::kNotConfident;
+  out.j = e.j;
+  out.r = e.r;
+  // Only the strengths the data have pinned replace the table's; the others keep theirs.
+  out.k = params_.rcs.strength;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (e.thruster_confident[static_cast<std::size_t>(i)]) out.k(i) = e.k(i);
+  }
+  return differs(params_, out) ? ModelCandidate::kOk : ModelCandidate::kUnchanged;
+}
+
+bool Gnc::differs(const GncParams& p, const IdentifiedModel& m) const {
+  const IdentifierConfig& c = params_.identification.config;
+  const Mat3 j = total_inertia(p.mass_hat);
+  return (m.j - j).norm() > c.j_confident_rel * j.norm() ||
+         (m.r - p.mass_hat.r_so_bcm).norm() > c.r_confident ||
+         (m.k - p.rcs.strength).cwiseAbs().maxCoeff() > c.k_confident;
+}
+
+ModelCandidate Gnc::model_candidate(GncParams& out) const {
+  IdentifiedModel m;
+  const ModelCandidate c = identified_model(m);
+  if (c != ModelCandidate::kOk) return c;
+  out = with_model(params_, m.j, m.r, m.k);
+  return validate(out).ok ? ModelCandidate::kOk : ModelCandidate::kInvalid;
+}
+
+void Gnc::adopt_model(double t, ModeEvents& events) {
+  const IdentificationParams& ip = params_.identification;
+  if (!ip.enabled || ip.adopt != ModelAdoption::kAuto) return;
+  if (adopted_once_ && t - last_adoption_t_ < ip.adopt_interval_s) return;
+  const ModelCandidate c = candidate_status_;  // evaluated when the last window closed
+  if (c != ModelCandidate::kOk && c != ModelCandidate::kInvalid) return;
+  adopted_once_ = true;
+  last_adoption_t_ = t;  // a refused model is not retried before the interval either
+  if (c == ModelCandidate::kInvalid) {
+    events.push(ModeEvent{EventId::kModelRefused, modes_.mode(), modes_.mode(),
+                          TransitionCheck::kOk});
+    return;
+  }
+  const LawId law = params_.law;  // the law stays the commanded one
+  candidate_.law = law;
+  candidate_status_ = ModelCandidate::kUnchanged;
+  if (apply_params(candidate_, false).ok) {
+    ++adoptions_;
+    events.push(ModeEvent{EventId::kModelAdopted, modes_.mode(), modes_.mode(),
+                          TransitionCheck::kOk});
+  }
 }
 
 TrajectoryError Gnc::load_trajectory(const TrajectoryTable& table) {
@@ -66,6 +305,11 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     last_good_t_ = t;  // first call: the sensor age starts counting now
     have_time_ = true;
   }
+
+  // 0. Tick boundary: an identified model adopted by the automatic policy takes effect now, and
+  // the ground's fault overrides.
+  adopt_model(t, out.events);
+  apply_fault_overrides(commands, out.events);
 
   // 1. Estimator: accept only finite, in-range samples.
   const EstimatorParams& ep = params_.estimator;
@@ -83,9 +327,49 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   if (m.omega_valid) m.omega = sample.gyro_rate;
   if (m.q_valid) m.q = mrp::from_quaternion(sample.star_quat / qn);
   if (m.omega_valid && m.q_valid) last_good_t_ = t;
-  filter_.update(m, last_torque_);
-  const Vec3 omega_hat = filter_.omega();
-  const Vec3 q_hat = filter_.q();
+  Vec3 omega_hat;
+  Vec3 q_hat;
+  if (ep.kind == EstimatorKind::kMekf) {
+    MekfInput mi;
+    mi.t = t;
+    mi.gyro_rate = m.omega;
+    mi.gyro_valid = m.omega_valid;
+    if (m.q_valid) mi.star_quat = sample.star_quat / qn;
+    mi.star_valid = m.q_valid;
+    mekf_.update(mi);
+    omega_hat = mekf_.omega();
+    q_hat = mekf_.q();
+  } else {
+    filter_.update(m, last_torque_);
+    omega_hat = filter_.omega();
+    q_hat = filter_.q();
+  }
+
+  // 1b. Identification (gnc/estimation/README.md §I): this tick's rate and the forces commanded
+  // over the previous tick. The rate is the gyro: the SPEC §6 filter's rate is model-predicted
+  // with J_hat, which is what is being identified. With the MEKF the gyro is corrected by its bias
+  // estimate latched at the start of each window: a bias estimate that moves inside a window
+  // would read as a change of angular momentum, whereas a constant offset cancels in the window
+  // equation's derivative term (the triangular window's w' integrates to zero).
+  if (params_.identification.enabled) {
+    IdentifierInput in;
+    const bool mekf = ep.kind == EstimatorKind::kMekf;
+    in.omega = mekf ? Vec3(m.omega - id_bias_) : m.omega;
+    in.omega_valid = m.omega_valid && (!mekf || mekf_.initialised());
+    in.force = last_force_;
+    ident_.update(in);
+    if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
+      candidate_windows_ = ident_.counters().windows;
+      candidate_status_ = model_candidate(candidate_);
+      if (mekf) id_bias_ = mekf_.bias();
+      refresh_fault_model();  // the detector predicts with the latest identified model
+    }
+  }
+
+  // 1c. Fault detection and isolation (gnc/fdi/README.md): the same rate, the same thrust.
+  detect_faults(ep.kind == EstimatorKind::kMekf ? Vec3(m.omega - id_bias_) : m.omega,
+                m.omega_valid && (ep.kind != EstimatorKind::kMekf || mekf_.initialised()),
+                out.events);
 
   // 2. Mode manager: ground requests at the tick boundary, then autonomous transitions.
   const Mode before = modes_.mode();
@@ -99,7 +383,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   if (commands.has_target && commands.target_mrp.allFinite()) {
     refs_.set_target(commands.target_mrp);
   }
-  const TransitionContext ctx{filter_.initialised(), trajectories_.valid(), params_.law};
+  const TransitionContext ctx{estimate_ready(), trajectories_.valid(), params_.law};
   const bool finite = omega_hat.allFinite() && q_hat.allFinite();
   modes_.update(ModeInputs{commands.has_mode_request, commands.mode_request, ctx, omega_hat.norm(),
                            t - last_good_t_, finite},
@@ -136,21 +420,37 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   }
 
   // 5. Allocator, Eq. (53) or Eq. (52) (params_.allocator); fuel estimate, Eq. (54).
+  // The allocator works in produced force (B_hat's columns are per newton produced); a thruster
+  // of strength k_i is commanded u / k_i, within u_max.
   Vec8 u = Vec8::Zero();
   AllocatorStatus status;
   const bool enabled = actuating(modes_.mode());
   if (enabled) {
-    alloc_.allocate(u_c, u, status);
+    alloc_.allocate(u_c, allocation_limits(), u, status);
+    if (status.reduced_authority && !reduced_reported_) {
+      out.events.push(ModeEvent{EventId::kReducedAuthority, modes_.mode(), modes_.mode(),
+                                TransitionCheck::kOk, static_cast<std::int16_t>(status.rank),
+                                static_cast<std::int16_t>(status.active_channels)});
+    }
+    reduced_reported_ = status.reduced_authority;
   } else {
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
   }
-  fuel_kg_ += fuel_rate(u, params_.isp_s, params_.g0) * params_.dt;
+  Vec8 force = Vec8::Zero();
+  for (int c = 0; c < kChannels; ++c) {
+    const double k = u(c) >= 0.0 ? params_.rcs.strength(2 * c) : params_.rcs.strength(2 * c + 1);
+    force(c) = std::fmax(-params_.rcs.u_max, std::fmin(params_.rcs.u_max, u(c) / k));
+  }
+  fuel_kg_ += fuel_rate(force, params_.isp_s, params_.g0) * params_.dt;
   last_torque_ = status.torque_achieved;
   last_saturated_ = status.saturated;
+  last_force_ = force;
 
-  out.command.force = u;
+  out.command.force = force;
   out.command.enabled = enabled;
+  out.command.valve_open = valve_open_;
+  last_valve_ = valve_open_;
   GncTelemetry& tl = out.telemetry;
   tl.t = t;
   tl.tick = tick_++;
@@ -168,6 +468,61 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   tl.trajectory_loaded = trajectories_.valid();
   tl.a_hat = laws_.a_hat();
   tl.integral = laws_.integral();
+  fill_estimation_telemetry(tl);
+  FdiTelemetry& f = tl.fdi;
+  const FaultDetectorStatus& fs = fdi_.status();
+  f.enabled = params_.fdi.enabled;
+  f.residual = fs.residual;
+  f.chi2 = fs.chi2;
+  f.noise_sigma = fs.noise_sigma;
+  f.best = static_cast<std::int8_t>(fs.best);
+  f.best_llr = fs.best_llr;
+  f.runner_up_llr = fs.runner_up_llr;
+  f.suspected_on = fs.suspected_on;
+  f.suspected_off = fs.suspected_off;
+  f.confirmed_on = fs.confirmed_on;
+  f.confirmed_off = fs.confirmed_off;
+  f.valve_open = valve_open_;
+  f.isolation_inhibited = isolation_inhibited_;
+  f.windows = fs.windows;
+  f.suspicions = fs.suspicions;
+}
+
+void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
+  EstimationTelemetry& e = tl.est;
+  e = EstimationTelemetry{};
+  if (params_.estimator.kind == EstimatorKind::kMekf) {
+    e.mekf = true;
+    e.gyro_bias = mekf_.bias();
+    e.attitude_sigma = mekf_.attitude_sigma();
+    e.bias_sigma = mekf_.bias_sigma();
+    e.star_gated = mekf_.counters().gated;
+  }
+  e.adoptions = adoptions_;
+  if (!params_.identification.enabled) return;
+  const IdentifierEstimate& est = ident_.estimate();
+  const IdentifierExcitation& exc = ident_.excitation();
+  e.identifying = true;
+  e.j = inertia_params(est.j);
+  e.j_sigma = est.j_sigma;
+  e.r = est.r;
+  e.r_sigma = est.r_sigma;
+  e.k = est.k;
+  e.k_sigma = est.k_sigma;
+  e.inertia_confident = est.inertia_confident;
+  e.offset_confident = est.offset_confident;
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto b = static_cast<std::uint16_t>(1u << i);
+    if (est.thruster_confident[static_cast<std::size_t>(i)]) e.thruster_confident |= b;
+    if (exc.thruster[static_cast<std::size_t>(i)]) e.excited_thrusters |= b;
+  }
+  e.excited_inertia = exc.inertia_scale;
+  e.excited_offset = exc.offset;
+  e.offset_unobservable = static_cast<std::uint8_t>(ident_.observability().offset_unobservable);
+  e.residual_torque = est.residual_torque;
+  e.residual_chi2 = est.residual_chi2;
+  e.windows = ident_.counters().windows;
+  e.candidate = candidate_status_;
 }
 
 }  // namespace rocksteady::gnc

@@ -1,4 +1,5 @@
-// The GNC component: one call per tick, estimator -> mode manager -> reference -> law -> allocator.
+// The GNC component: one call per tick, estimator -> identifier -> mode manager -> reference ->
+// law -> allocator (DESIGN.md "One tick as data").
 // Static allocation, no exceptions, no I/O: inputs and outputs are plain structs.
 #pragma once
 
@@ -6,7 +7,10 @@
 
 #include "gnc/allocation/allocator.hpp"
 #include "gnc/control/laws.hpp"
+#include "gnc/estimation/identifier.hpp"
+#include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
+#include "gnc/fdi/fault_detector.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/guidance/trajectory.hpp"
 #include "gnc/guidance/trajectory_buffers.hpp"
@@ -16,6 +20,12 @@
 #include "gnc/types.hpp"
 
 namespace rocksteady::gnc {
+
+struct IdentifiedModel {
+  Mat3 j{Mat3::Identity()};  // J_tot, kg m^2
+  Vec3 r{Vec3::Zero()};      // r_SO/BCM, m
+  Vec16 k{Vec16::Ones()};    // thruster strengths
+};
 
 class Gnc {
  public:
@@ -36,14 +46,43 @@ class Gnc {
 
   void step(const SensorSample& sample, const GncCommands& commands, GncOutput& out);
 
+  // The identified model, if confident: J_tot, r_SO/BCM, and the strengths of the thrusters the
+  // data have pinned (the table's for the others). kOk: it differs from the active table.
+  ModelCandidate identified_model(IdentifiedModel& out) const;
+  // The table that would fly the identified model now (the active table with J_tot, r_SO/BCM and
+  // the confident thruster strengths replaced, validated). kOk writes `out`; otherwise why not.
+  ModelCandidate model_candidate(GncParams& out) const;
+
+  bool estimate_ready() const;  // the active estimator has a state
   Mode mode() const { return modes_.mode(); }
   const StateFilter& estimator() const { return filter_; }
+  const Mekf& mekf() const { return mekf_; }
+  const Identifier& identifier() const { return ident_; }
+  const FaultDetector& fault_detector() const { return fdi_; }
+  const std::array<bool, kPods>& valve_open() const { return valve_open_; }
+  std::uint32_t model_adoptions() const { return adoptions_; }
 
  private:
   void configure_components();
+  // Validate and install; declared_change: a table from outside (the identifier re-inflates).
+  ParamCheck apply_params(const GncParams& params, bool declared_change);
+  bool differs(const GncParams& p, const IdentifiedModel& m) const;  // beyond the confidence bounds
+  void adopt_model(double t, ModeEvents& events);  // automatic policy, at the tick boundary
+  void fill_estimation_telemetry(GncTelemetry& tl) const;
+  void refresh_fault_model();
+  void apply_fault_overrides(const GncCommands& commands, ModeEvents& events);
+  void detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events);
+  AllocatorLimits allocation_limits() const;
 
   GncParams params_{};
   StateFilter filter_{};
+  Mekf mekf_{};
+  Identifier ident_{};
+  FaultDetector fdi_{};
+  std::array<bool, kPods> valve_open_{{true, true, true, true}};  // commanded this tick
+  std::array<bool, kPods> last_valve_{{true, true, true, true}};  // over the previous tick
+  bool isolation_inhibited_{false};
+  bool reduced_reported_{false};
   ModeManager modes_{};
   References refs_{};
   ControlLaws laws_{};
@@ -56,6 +95,14 @@ class Gnc {
   bool have_time_{false};
   Vec3 last_torque_{Vec3::Zero()};  // torque achieved on the previous tick (estimator prediction)
   bool last_saturated_{false};
+  Vec8 last_force_{Vec8::Zero()};
+  Vec3 id_bias_{Vec3::Zero()};  // MEKF gyro bias latched for the identifier's current window  // physical channel forces commanded on the previous tick
+  double last_adoption_t_{0.0};
+  bool adopted_once_{false};
+  std::uint32_t adoptions_{0};
+  ModelCandidate candidate_status_{ModelCandidate::kDisabled};
+  std::uint32_t candidate_windows_{0};
+  GncParams candidate_{};  // scratch for the automatic adoption (too large for a tick's stack)
 };
 
 }  // namespace rocksteady::gnc

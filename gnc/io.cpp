@@ -60,6 +60,33 @@ const char* to_string(EventId e) {
     case EventId::kSensorRejected: return "sensor_rejected";
     case EventId::kTrajectorySwitched: return "trajectory_switched";
     case EventId::kTrajectoryStale: return "trajectory_stale";
+    case EventId::kModelAdopted: return "model_adopted";
+    case EventId::kModelRefused: return "model_refused";
+    case EventId::kFaultSuspected: return "fault_suspected";
+    case EventId::kFaultConfirmed: return "fault_confirmed";
+    case EventId::kValveClosed: return "valve_closed";
+    case EventId::kFaultOverride: return "fault_override";
+    case EventId::kReducedAuthority: return "reduced_authority";
+  }
+  return "?";
+}
+
+const char* to_string(FaultKind k) {
+  switch (k) {
+    case FaultKind::kNone: return "none";
+    case FaultKind::kStuckOn: return "stuck-on";
+    case FaultKind::kStuckOff: return "stuck-off";
+  }
+  return "?";
+}
+
+const char* to_string(ModelCandidate c) {
+  switch (c) {
+    case ModelCandidate::kOk: return "ok";
+    case ModelCandidate::kDisabled: return "identification off";
+    case ModelCandidate::kNotConfident: return "identification not confident";
+    case ModelCandidate::kUnchanged: return "the active table already holds the identified model";
+    case ModelCandidate::kInvalid: return "the identified model fails table validation";
   }
   return "?";
 }

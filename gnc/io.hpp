@@ -60,14 +60,37 @@ enum class EventId : std::uint8_t {
   kSensorRejected,   // a sample failed validity / range checks
   kTrajectorySwitched,  // a staged trajectory became active at this tick boundary (TRACK re-synced)
   kTrajectoryStale,     // a staged trajectory was refused at the boundary; the active one kept
+  kModelAdopted,     // the identified model became the active table (automatic policy)
+  kModelRefused,     // a confident identified model failed table validation (kept the old one)
+  kFaultSuspected,   // a residual window failed the no-fault test (arg0 = leading thruster or -1)
+  kFaultConfirmed,   // a thruster fault confirmed and latched (arg0 = thruster, arg1 = FaultKind)
+  kValveClosed,      // a pod's latch valve closed to isolate a stuck-on thruster (arg0 = pod)
+  kFaultOverride,    // a ground override applied (arg0 = thruster or pod, arg1 = what)
+  kReducedAuthority, // the remaining thrusters cannot produce every torque direction
 };
+
+// Thruster fault kinds the flight software declares (gnc/fdi).
+enum class FaultKind : std::uint8_t { kNone = 0, kStuckOn = 1, kStuckOff = 2 };
+const char* to_string(FaultKind k);
 const char* to_string(EventId e);
+
+// Why an identified model is or is not a parameter-table candidate now (Gnc::model_candidate).
+enum class ModelCandidate : std::uint8_t {
+  kOk = 0,
+  kDisabled,       // identification is off
+  kNotConfident,   // inertia or centre-of-mass 1 sigma above the confidence bounds
+  kUnchanged,      // the active table already holds this model (within the confidence bounds)
+  kInvalid,        // the model fails table validation (e.g. J_ast not positive definite)
+};
+const char* to_string(ModelCandidate c);
 
 struct ModeEvent {
   EventId id{EventId::kModeChanged};
   Mode from{Mode::kIdle};
   Mode to{Mode::kIdle};
   TransitionCheck reason{TransitionCheck::kOk};
+  std::int16_t arg0{0};  // event data where the event has any (fault events)
+  std::int16_t arg1{0};
 };
 
 struct ModeEvents {
@@ -98,11 +121,70 @@ struct GncCommands {
   Vec3 target_mrp{Vec3::Zero()};
   bool has_law{false};
   LawId law{LawId::kNtcl};
+  // Ground overrides of fault management.
+  bool has_fault_declaration{false};
+  std::int8_t fault_thruster{-1};        // 0..15; -1 with kNone: clear every declaration
+  FaultKind fault_kind{FaultKind::kNone};  // kNone: clear
+  bool has_valve{false};
+  std::int8_t valve_pod{0};
+  bool valve_open{true};
+  bool has_isolation_inhibit{false};
+  bool isolation_inhibited{false};       // true: a confirmed stuck-on does not close its valve
 };
 
 struct ThrusterCommand {
   Vec8 force{Vec8::Zero()};  // signed channel forces, N, |u_i| <= u_max
   bool enabled{false};       // false: all thrusters inhibited (IDLE, SAFE)
+  // Latch valve of each pod (isolates a failed-on thruster): closed, none of the pod's four
+  // thrusters can fire. Independent of `enabled`; all open by default.
+  std::array<bool, kPods> valve_open{true, true, true, true};
+};
+
+// What the estimators report each tick (zeros for a module that is off).
+struct EstimationTelemetry {
+  bool mekf{false};                  // the MEKF is the active estimator
+  Vec3 gyro_bias{Vec3::Zero()};      // MEKF gyro bias estimate, rad/s
+  Vec3 attitude_sigma{Vec3::Zero()}; // MEKF attitude 1 sigma per axis, rad
+  Vec3 bias_sigma{Vec3::Zero()};     // MEKF bias 1 sigma per axis, rad/s
+  std::uint32_t star_gated{0};       // MEKF star-tracker samples rejected by the gate
+  bool identifying{false};           // the identifier runs
+  Vec6 j{Vec6::Zero()};              // identified J_tot [Jxx Jyy Jzz Jxy Jxz Jyz], kg m^2
+  Vec6 j_sigma{Vec6::Zero()};
+  Vec3 r{Vec3::Zero()};              // identified r_SO/BCM, m
+  Vec3 r_sigma{Vec3::Zero()};
+  Vec16 k{Vec16::Zero()};            // identified thruster strengths
+  Vec16 k_sigma{Vec16::Zero()};
+  bool inertia_confident{false};
+  bool offset_confident{false};
+  std::uint16_t thruster_confident{0};  // bit i: thruster i within its confidence bound
+  bool excited_inertia{false};          // last window: commanded torque excited the inertia scale
+  bool excited_offset{false};           // last window: net force excited r
+  std::uint16_t excited_thrusters{0};   // bit i: thruster i fired enough in the last window
+  std::uint8_t offset_unobservable{0};  // directions of r not (yet) observable
+  Vec3 residual_torque{Vec3::Zero()};   // N m, last window's mean residual with the estimates
+  double residual_chi2{0.0};            // its squared norm normalised by the window noise
+  std::uint32_t windows{0};
+  ModelCandidate candidate{ModelCandidate::kDisabled};
+  std::uint32_t adoptions{0};           // identified models adopted into the active table
+};
+
+// Fault detection and isolation (zeros when off).
+struct FdiTelemetry {
+  bool enabled{false};
+  Vec3 residual{Vec3::Zero()};  // rad/s, last window's unexplained rate change
+  double chi2{0.0};             // its no-fault chi-square (3 dof)
+  double noise_sigma{0.0};      // rad/s, the residual's 1 sigma
+  std::int8_t best{-1};         // leading hypothesis: 0..15 stuck-on, 16..31 stuck-off
+  double best_llr{0.0};
+  double runner_up_llr{0.0};
+  std::uint16_t suspected_on{0};
+  std::uint16_t suspected_off{0};
+  std::uint16_t confirmed_on{0};
+  std::uint16_t confirmed_off{0};
+  std::array<bool, kPods> valve_open{{true, true, true, true}};
+  bool isolation_inhibited{false};
+  std::uint32_t windows{0};
+  std::uint32_t suspicions{0};
 };
 
 struct GncTelemetry {
@@ -122,6 +204,8 @@ struct GncTelemetry {
   bool trajectory_loaded{false};
   Vec6 a_hat{Vec6::Zero()};     // adaptive law's inertia estimate
   Vec3 integral{Vec3::Zero()};  // integral law's state
+  EstimationTelemetry est{};
+  FdiTelemetry fdi{};
 };
 
 struct GncOutput {

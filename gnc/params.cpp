@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 
 #include "gnc/allocation/allocator.hpp"
+#include "gnc/param_bounds.hpp"
 
 namespace rocksteady::gnc {
 
@@ -17,6 +18,35 @@ GncParams study_gnc_params(double u_max) {
 
 LawGains law_gains(const GncParams& p) {
   return LawGains{p.ntcl, p.el, p.feedforward, p.integral, p.adaptive, p.so3, p.dpd};
+}
+
+MekfConfig build_mekf_config(const GncParams& p) {
+  MekfConfig c = p.mekf;
+  c.dt = p.dt;
+  c.gyro_max_rate = p.estimator.gyro_max_rate;
+  c.quat_norm_tolerance = p.estimator.quat_norm_tolerance;
+  return c;
+}
+
+IdentifierConfig build_identifier_config(const GncParams& p) {
+  IdentifierConfig c = p.identification.config;
+  c.dt = p.dt;
+  c.rcs = p.rcs;
+  c.j0 = total_inertia(p.mass_hat);
+  c.r0 = p.mass_hat.r_so_bcm;
+  c.k0 = p.rcs.strength;
+  return c;
+}
+
+GncParams with_model(const GncParams& p, const Mat3& j_tot, const Vec3& r, const Vec16& k) {
+  GncParams out = p;
+  out.mass_hat.r_so_bcm = r;
+  MassProperties sc_only = out.mass_hat;
+  sc_only.j_ast.setZero();
+  out.mass_hat.j_ast = j_tot - total_inertia(sc_only);  // Eq. (1) solved for J_ast
+  out.mass_hat.j_ast = 0.5 * (out.mass_hat.j_ast + out.mass_hat.j_ast.transpose());
+  out.rcs.strength = k;
+  return out;
 }
 
 bool all_finite(const Mat3& m) { return m.allFinite(); }
@@ -74,6 +104,13 @@ ParamCheck validate(const GncParams& p) {
       return bad("rcs.channel_pod", "pod index out of range");
     }
   }
+  for (int i = 0; i < kThrusters; ++i) {
+    // A thruster producing less than 10 % of its calibrated force is a failed thruster (a fault
+    // declaration), not a strength; more than 150 % is not a plausible calibration error.
+    if (!std::isfinite(p.rcs.strength(i)) || p.rcs.strength(i) < 0.1 || p.rcs.strength(i) > 1.5) {
+      return bad("rcs.strength", "thruster strength must be in [0.1, 1.5]");
+    }
+  }
   if (torque_matrix_rcond(torque_matrix(p.rcs, m.r_so_bcm)) < 1e-9) {
     return bad("rcs", "B_hat is rank-deficient (cannot produce torque about every axis)");
   }
@@ -129,7 +166,7 @@ ParamCheck validate(const GncParams& p) {
   }
 
   const EstimatorParams& e = p.estimator;
-  if (e.kind != EstimatorKind::kPassThrough && e.kind != EstimatorKind::kFilter) {
+  if (static_cast<int>(e.kind) >= kEstimatorKindCount) {
     return bad("estimator.kind", "unknown estimator");
   }
   if (!finite_positive(e.omega_c)) return bad("estimator.omega_c", "must be positive");
@@ -145,6 +182,30 @@ ParamCheck validate(const GncParams& p) {
     return bad("estimator.quat_norm_tolerance", "must be in (0, 1)");
   }
 
+  if (e.kind == EstimatorKind::kMekf) {
+    const MekfConfigCheck mc = validate(build_mekf_config(p));
+    if (!mc.ok) return bad(mc.field, mc.reason);
+  }
+  const IdentificationParams& id = p.identification;
+  if (static_cast<int>(id.adopt) >= kModelAdoptionCount) {
+    return bad("identification.adopt", "unknown adoption policy");
+  }
+  if (!finite_positive(id.adopt_interval_s)) {
+    return bad("identification.adopt_interval", "must be positive and finite");
+  }
+  if (id.enabled) {
+    const IdentifierConfigCheck ic = validate(build_identifier_config(p));
+    if (!ic.ok) return bad(ic.field, ic.reason);
+  }
+
+  if (p.fdi.enabled) {
+    const Check fc = validate(p.fdi);
+    if (!fc.ok) return fc;
+  }
+  if (!finite_non_negative(p.fdi_table_rel_sigma)) {
+    return bad("fdi_table_rel_sigma", "must be >= 0 and finite");
+  }
+
   if (static_cast<int>(p.mode.initial) >= kModeCount) {
     return bad("mode.initial", "unknown mode");
   }
@@ -154,7 +215,7 @@ ParamCheck validate(const GncParams& p) {
   }
   if (!finite_positive(p.isp_s)) return bad("isp", "must be positive");
   if (!finite_positive(p.g0)) return bad("g0", "must be positive");
-  return r;
+  return check_bounds(p);  // the physical ranges (gnc/param_bounds.cpp)
 }
 
 }  // namespace rocksteady::gnc

@@ -9,7 +9,10 @@
 #include "gnc/allocation/allocator.hpp"
 #include "gnc/check.hpp"
 #include "gnc/control/laws.hpp"
+#include "gnc/estimation/identifier.hpp"
+#include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
+#include "gnc/fdi/fault_detector.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/io.hpp"
 #include "gnc/mode/mode_manager.hpp"
@@ -33,6 +36,14 @@ struct GncParams {
   DpdGains dpd{};
   GuidanceParams guidance{};
   EstimatorParams estimator{};
+  // estimator.kind == kMekf: the MEKF's noise model and gate. Its dt, gyro_max_rate and
+  // quat_norm_tolerance are the table's dt and estimator fields (build_mekf_config).
+  MekfConfig mekf{};
+  IdentificationParams identification{};  // on-line identification of J_tot, r_SO/BCM, k_i
+  FaultDetectorParams fdi{};               // thruster fault detection and isolation (gnc/fdi)
+  // Relative 1 sigma of the table's J_tot when the detector runs without identification (the
+  // asteroid known to ~10 %): the detector's model-uncertainty term, so it stays quiet.
+  double fdi_table_rel_sigma{0.1};
   ModeParams mode{};
   // SPEC §4: the study's pseudoinverse, Eq. (53), or the fuel-optimal allocation, Eq. (52).
   AllocatorKind allocator{AllocatorKind::kPseudoInverse};
@@ -45,6 +56,16 @@ GncParams study_gnc_params(double u_max);
 
 // The gains of every law, as ControlLaws takes them.
 LawGains law_gains(const GncParams& p);
+
+// The MEKF's and the identifier's configuration as the table defines them: tuning from
+// p.mekf / p.identification.config, tick, sample checks, geometry and priors from the table.
+MekfConfig build_mekf_config(const GncParams& p);
+IdentifierConfig build_identifier_config(const GncParams& p);
+
+// The model the table flies with a different J_tot, r_SO/BCM and thruster strengths: r_SO/BCM := r,
+// J_ast := J_tot - (the spacecraft's part of Eq. (1) at the new r), strength := k. The result is
+// validated by the caller (validate() refuses a J_ast that is not positive definite).
+GncParams with_model(const GncParams& p, const Mat3& j_tot, const Vec3& r, const Vec16& k);
 
 using ParamCheck = Check;
 

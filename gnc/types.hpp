@@ -17,5 +17,10 @@ using Mat36 = Eigen::Matrix<double, 3, 6>;
 
 inline constexpr int kChannels = 8;  // SPEC §4: eight signed thruster channels
 inline constexpr int kPods = 4;      // SPEC §4: four RCS pods
+// Sixteen physical thrusters: thruster 2c fires channel c's "+" direction, 2c+1 its "-" (SPEC §4;
+// with the default HAL wiring this is also the physical index 4 * pod + position).
+inline constexpr int kThrusters = 2 * kChannels;
+
+using Vec16 = Eigen::Matrix<double, kThrusters, 1>;
 
 }  // namespace rocksteady::gnc

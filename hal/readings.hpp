@@ -48,11 +48,16 @@ constexpr int thruster_index(int pod, int position) {
   return pod * kThrustersPerPod + position;
 }
 
-// What the thruster bank drives: 16 on/off thrusters with their force.
+// What the thruster bank drives: 16 on/off thrusters with their force, and one latch valve per pod
+// (closed: none of the pod's four thrusters can fire; a stuck-open thruster valve included).
 struct ThrusterOutputs {
   bool enabled{false};
   std::array<bool, kThrusters> on{};
   std::array<double, kThrusters> force{};  // N, >= 0; zero when off
+  std::array<bool, gnc::kPods> valve_open{true, true, true, true};
 };
+
+// The pod of a physical thruster.
+constexpr int thruster_pod(int thruster) { return thruster / kThrustersPerPod; }
 
 }  // namespace rocksteady::hal

@@ -67,7 +67,10 @@ BankConfigCheck ThrusterBank::configure(const ThrusterBankConfig& config,
 BankStatus ThrusterBank::command(const gnc::ThrusterCommand& cmd, ThrusterOutputs& out) const {
   out = ThrusterOutputs{};
   BankStatus status{};
-  if (!configured_ || !cmd.enabled) return status;
+  if (!configured_) return status;
+  // The latch valves follow their own commands, whether the thrusters are enabled or not.
+  out.valve_open = cmd.valve_open;
+  if (!cmd.enabled) return status;
   out.enabled = true;
   for (int i = 0; i < gnc::kChannels; ++i) {
     const double u = cmd.force(i);

@@ -67,8 +67,8 @@ class ThrusterBank {
   bool configured() const { return configured_; }
   const ThrusterBankConfig& config() const { return config_; }
 
-  // Channel forces -> physical thrusters. Everything off when the command is disabled or the bank is
-  // not configured.
+  // Channel forces -> physical thrusters. Every thruster off when the command is disabled or the bank
+  // is not configured. The latch valves take the command's valve_open (all open when unconfigured).
   BankStatus command(const gnc::ThrusterCommand& cmd, ThrusterOutputs& out) const;
 
   // Physical thrusters -> signed channel forces (u_i = F_plus - F_minus); for plants and telemetry.

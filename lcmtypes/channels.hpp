@@ -13,5 +13,6 @@ inline constexpr const char* kCmdAck = "RS_CMD_ACK";             // cmd_ack_t, f
 inline constexpr const char* kPlantTruth = "RS_PLANT_TRUTH";     // plant_truth_t, plant -> logs
 inline constexpr const char* kTrajUplink = "RS_TRAJ_UPLINK";     // trajectory_chunk_t, ground -> fsw
 inline constexpr const char* kParams = "RS_PARAMS";              // param_table_t, fsw -> ground
+inline constexpr const char* kPlantFault = "RS_PLANT_FAULT";     // plant_fault_cmd_t, ground -> plant
 
 }  // namespace rocksteady::channels

@@ -98,18 +98,32 @@ if [[ -z "$only" || "$only" == "baremetal" ]]; then
     echo "cross: FAIL: the firmware image exited with $rc" >&2
     exit 1
   fi
+  stage "bare metal: every module on (MEKF, identification, fault detection, L1), 3000 s of despin"
+  timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
+      -icount shift=0 \
+      -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=3000,arg=goal=despin,arg=modules=all \
+      -kernel "$elf" || rc=$?
+  if ((rc != 0)); then
+    echo "cross: FAIL: the firmware image (modules=all) exited with $rc" >&2
+    exit 1
+  fi
   if ((bench)); then
     stage "bare metal: instructions per Gnc::step (qemu-system-arm -singlestep -d exec)"
     trace=$(mktemp)
-    for start in detumble hold; do
-      # 5 simulated seconds: too short for the image's own pass criteria, so its exit code is not
-      # checked here (the full run above is the check); only the trace is used.
-      timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
-          -singlestep -d exec,nochain -D "$trace" \
-          -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=5,arg=start=$start \
-          -kernel "$elf" >/dev/null 2>&1 || true
-      printf '  cortex-m7 %-8s ' "$start"
-      awk -f tests/cross/count_insns.awk "$trace"
+    for modules in study all; do
+      for start in detumble hold; do
+        # Too short for the image's own pass criteria, so its exit code is not checked here (the
+        # full runs above are the check); only the trace is used. 45 s with every module on covers
+        # two identification windows and their update steps.
+        seconds=5
+        [[ "$modules" == all ]] && seconds=45
+        timeout 600 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
+            -singlestep -d exec,nochain -D "$trace" \
+            -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=$seconds,arg=start=$start,arg=modules=$modules \
+            -kernel "$elf" >/dev/null 2>&1 || true
+        printf '  cortex-m7 %-6s %-8s ' "$modules" "$start"
+        awk -f tests/cross/count_insns.awk "$trace"
+      done
     done
     rm -f "$trace"
   fi

@@ -68,7 +68,7 @@ export B_FSW="$fsw" B_PLANT="$plant" B_SECS="$secs" B_RATES="$rates" B_OUT="$out
         "$B_PLANT" --lcm-url "$url" --case 1 --mode realtime --duration $((B_SECS + 3)) "${px[@]}" \
             > "$B_OUT/plant.log" 2>&1 &
         pp=$!
-        "$B_FSW" --lcm-url "$url" --case 1 --clock realtime --rate "$rate" --start-mode DETUMBLE \
+        "$B_FSW" --lcm-url "$url" --lab-mode --case 1 --clock realtime --rate "$rate" --start-mode DETUMBLE \
             --exit-after "$B_SECS" --jitter "${fx[@]}" > "$B_OUT/fsw.log" 2>&1
         rc=$?
         kill $pp 2> /dev/null; wait $pp 2> /dev/null

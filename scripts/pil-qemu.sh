@@ -92,7 +92,7 @@ run() {
   local name=$1 port=$2; shift 2
   local url="udpm://239.255.76.67:$port?ttl=0"
   "$@" --lcm-url "$url" --mission "$mission" --gnc "$gnc" --case "$case_file" --law ntcl \
-      --clock lockstep --start-mode DETUMBLE --tlm-every 10 > "$out/$name.fsw.log" 2>&1 &
+      --clock lockstep --lab-mode --start-mode DETUMBLE --tlm-every 10 > "$out/$name.fsw.log" 2>&1 &
   local fsw=$!
   local rc=0
   # Generous echo timeout: an emulated tick can take a while; a resend is harmless (the fsw answers

@@ -18,6 +18,8 @@
 #                        otherwise lockstep runs on three buses, sensor frames on port P, thruster
 #                        commands on P+1, ground channels (logged) on P+2, with the hot channels read
 #                        directly by each loop (--direct-rx): several times faster, the same figures
+# Commanding is authenticated: each run makes a fresh command key file <out>/<case>.key (mode 0600,
+# `rocksteady-ground keygen`) for the flight software; ground tools use it with --key-file.
 # Exit status: 0 ok, 1 the run failed (the children's last lines are printed), 2 usage error.
 # Live on a workstation with lcm-spy instead: see fsw/main/README.md.
 set -euo pipefail
@@ -66,7 +68,8 @@ fi
 
 fsw="$build/fsw/main/rocksteady-fsw"
 plant="$build/ground/plantd/rocksteady-plant"
-for p in "$fsw" "$plant"; do
+ground="$build/ground/cli/rocksteady-ground"
+for p in "$fsw" "$plant" "$ground"; do
   [[ -x "$p" ]] || { echo "pil.sh: $p not found: build first (cmake --preset release && cmake --build --preset release)" >&2; exit 2; }
 done
 command -v lcm-logger >/dev/null || { echo "pil.sh: lcm-logger not found (apt-get install liblcm-bin)" >&2; exit 2; }
@@ -76,13 +79,18 @@ if [[ "$case_arg" =~ ^[0-9]+$ ]]; then name="case$case_arg"; else name="$(basena
 mkdir -p "$out"
 log="$out/$name.lcmlog"
 rm -f "$log"
+# A fresh command key for this run (never committed, never reused): the flight software verifies
+# every ground command with it; its replay state goes beside it.
+key="$out/$name.key"
+rm -f "$key" "$key.state"
+"$ground" keygen "$key" > /dev/null
 channels='RS_(GNC_TLM|PLANT_TRUTH|EVENTS|CMD_ACK|GROUND_CMD|TRAJ_UPLINK)'
 ((log_all)) && channels='.*'
 clock=$mode; [[ "$mode" == lockstep ]] || clock=realtime
 
 export PIL_FSW="$fsw" PIL_PLANT="$plant" PIL_CASE="$case_arg" PIL_LAW="$law" PIL_LOG="$log"
 export PIL_CHANNELS="$channels" PIL_OUT="$out" PIL_NAME="$name" PIL_TLM="$tlm_every"
-export PIL_MODE="$mode" PIL_CLOCK="$clock" PIL_DURATION="$duration"
+export PIL_MODE="$mode" PIL_CLOCK="$clock" PIL_DURATION="$duration" PIL_KEY="$key"
 export PIL_URL="udpm://239.255.76.67:$port?ttl=0" PIL_LOG_URL="udpm://239.255.76.67:$port?ttl=0"
 PIL_BUSES=""
 if ((!one_bus && !log_all)) && [[ "$mode" == lockstep ]]; then
@@ -98,7 +106,7 @@ unshare -rn bash -c '
   ip link set lo up && ip link set lo multicast on && ip route add 239.255.76.67 dev lo
   lcm-logger -q --lcm-url="$PIL_LOG_URL" --channel="$PIL_CHANNELS" -f "$PIL_LOG" > /dev/null 2>&1 & logger=$!
   "$PIL_FSW" --lcm-url "$PIL_URL" --case "$PIL_CASE" --law "$PIL_LAW" --clock "$PIL_CLOCK" \
-      --start-mode DETUMBLE --tlm-every "$PIL_TLM" -v $PIL_BUSES > "$PIL_OUT/$PIL_NAME.fsw.log" 2>&1 & fsw=$!
+      --key-file "$PIL_KEY" --start-mode DETUMBLE --tlm-every "$PIL_TLM" -v $PIL_BUSES > "$PIL_OUT/$PIL_NAME.fsw.log" 2>&1 & fsw=$!
   trap "kill $fsw $logger 2>/dev/null" EXIT
   sleep 0.5   # the logger and the flight software subscribe; the plant waits for frame 0 anyway
   dur=(); [[ -n "$PIL_DURATION" ]] && dur=(--duration "$PIL_DURATION")
@@ -122,4 +130,5 @@ fi
 echo "LCM log:      $log ($(du -h "$log" | cut -f1)); flight software log: $out/$name.fsw.log; time series: $out/$name.csv"
 echo "Replay it:    lcm-logplayer -s 10 $log   (with ground/spy/rocksteady-spy running, see fsw/main/README.md)"
 echo "Plot it:      $build/ground/cli/rocksteady-ground plot $log"
+echo "Command key:  $key (the flight's; ground tools: rocksteady-ground --key-file $key send ...)"
 exit 0

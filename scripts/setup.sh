@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev
   default-jdk-headless libjchart2d-java
-  libyaml-cpp-dev libcli11-dev
+  libyaml-cpp-dev libcli11-dev libsodium-dev
   coinor-libipopt-dev
   gnuplot-nox
   iproute2 util-linux
@@ -24,7 +24,8 @@ if [[ "${1:-}" == "--cross" ]]; then
   # which scripts/cross.sh does); LCM is not multi-arch and is unpacked into a private sysroot.
   packages+=(g++-aarch64-linux-gnu qemu-user gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
              qemu-system-arm
-             libstdc++6:arm64 libgtest-dev:arm64 libgmock-dev:arm64 libglib2.0-dev:arm64)
+             libstdc++6:arm64 libgtest-dev:arm64 libgmock-dev:arm64 libglib2.0-dev:arm64
+             libsodium-dev:arm64)
 fi
 
 missing=()

@@ -47,6 +47,16 @@ bool text_ok(const std::string& text, int max_len) {
 
 DecodeStatus range(bool ok) { return ok ? DecodeStatus::kOk : DecodeStatus::kOutOfRange; }
 
+// Canonical form: unused slots of a fixed-size array are all-zero bits, so every bit of a message
+// is either a field the authenticator covers or a zero the decoder enforces (fsw/auth).
+bool zero_bits(const void* p, std::size_t n) {
+  const auto* b = static_cast<const unsigned char*>(p);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (b[i] != 0) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 const char* to_string(DecodeStatus s) {
@@ -88,7 +98,7 @@ DecodeStatus check(const rocksteady::sensor_frame_t& m) {
 DecodeStatus check(const rocksteady::thruster_cmd_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
   if (m.seq < 0 || !std::isfinite(m.t) || !is_bool(m.enabled) || !all_bool(m.thruster_on) ||
-      !finite(m.channel_force) || !finite(m.thruster_force)) {
+      !finite(m.channel_force) || !finite(m.thruster_force) || !all_bool(m.valve_closed)) {
     return DecodeStatus::kOutOfRange;
   }
   for (const double f : m.thruster_force) {
@@ -102,7 +112,7 @@ DecodeStatus check(const rocksteady::gnc_telemetry_t& m) {
   return range(std::isfinite(m.t) && m.tick >= 0 && m.rate_group_count >= 0 &&
                m.rate_group_count <= rocksteady::gnc_telemetry_t::RATE_GROUPS &&
                is_bool(m.trajectory_loaded) && is_bool(m.saturated) &&
-               is_bool(m.thrusters_enabled) && is_bool(m.table_loaded) && non_negative(m.rg_cycles) &&
+               is_bool(m.thrusters_enabled) && is_bool(m.table_loaded) && is_bool(m.lab_mode) && non_negative(m.rg_cycles) &&
                non_negative(m.rg_slips) && non_negative(m.rg_missed));
 }
 
@@ -117,7 +127,9 @@ DecodeStatus check(const rocksteady::ground_cmd_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
   // Structure only: the opcode and its arguments are judged by the flight application's command
   // table, which answers with a rejection reason instead of dropping the command.
-  return range(m.nargs >= 0 && m.nargs <= rocksteady::ground_cmd_t::MAX_ARGS);
+  if (m.nargs < 0 || m.nargs > rocksteady::ground_cmd_t::MAX_ARGS) return DecodeStatus::kOutOfRange;
+  const std::size_t used = static_cast<std::size_t>(m.nargs);
+  return range(zero_bits(&m.args[used], sizeof(double) * (rocksteady::ground_cmd_t::MAX_ARGS - used)));
 }
 
 DecodeStatus check(const rocksteady::cmd_ack_t& m) {
@@ -129,7 +141,15 @@ DecodeStatus check(const rocksteady::cmd_ack_t& m) {
 
 DecodeStatus check(const rocksteady::plant_truth_t& m) {
   if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
-  return range(m.seq >= 0 && std::isfinite(m.t));
+  return range(m.seq >= 0 && std::isfinite(m.t) && all_bool(m.valve_open) &&
+               is_bool(m.command_timeout));
+}
+
+// Wire validity only; what the command asks (op, thruster, kind, factor) is the plant's to judge,
+// with a reason in its answer.
+DecodeStatus check(const rocksteady::plant_fault_cmd_t& m) {
+  if (const DecodeStatus h = header(m); h != DecodeStatus::kOk) return h;
+  return range(m.seq >= 0 && std::isfinite(m.onset_s) && std::isfinite(m.factor));
 }
 
 DecodeStatus check(const rocksteady::trajectory_chunk_t& m) {
@@ -149,6 +169,13 @@ DecodeStatus check(const rocksteady::trajectory_chunk_t& m) {
   for (int i = 0; i < count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (!std::isfinite(m.t[k]) || !finite(m.omega_d[k]) || !finite(m.omega_d_dot[k])) {
+      return DecodeStatus::kOutOfRange;
+    }
+  }
+  for (int i = count; i < C::SAMPLES; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!zero_bits(&m.t[k], sizeof m.t[k]) || !zero_bits(m.omega_d[k], sizeof m.omega_d[k]) ||
+        !zero_bits(m.omega_d_dot[k], sizeof m.omega_d_dot[k])) {
       return DecodeStatus::kOutOfRange;
     }
   }

@@ -19,6 +19,7 @@
 #include "rocksteady/event_t.hpp"
 #include "rocksteady/gnc_telemetry_t.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
+#include "rocksteady/plant_fault_cmd_t.hpp"
 #include "rocksteady/plant_truth_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
 #include "rocksteady/thruster_cmd_t.hpp"
@@ -73,6 +74,7 @@ DecodeStatus check(const rocksteady::cmd_ack_t& m);
 DecodeStatus check(const rocksteady::plant_truth_t& m);
 DecodeStatus check(const rocksteady::trajectory_chunk_t& m);
 DecodeStatus check(const rocksteady::param_table_t& m);
+DecodeStatus check(const rocksteady::plant_fault_cmd_t& m);
 
 // Each type's channel (lcmtypes/channels.hpp).
 template <class T> const char* channel_of();
@@ -85,6 +87,7 @@ template <> inline const char* channel_of<rocksteady::cmd_ack_t>() { return chan
 template <> inline const char* channel_of<rocksteady::plant_truth_t>() { return channels::kPlantTruth; }
 template <> inline const char* channel_of<rocksteady::trajectory_chunk_t>() { return channels::kTrajUplink; }
 template <> inline const char* channel_of<rocksteady::param_table_t>() { return channels::kParams; }
+template <> inline const char* channel_of<rocksteady::plant_fault_cmd_t>() { return channels::kPlantFault; }
 
 // Types whose only variable-length field is a trailing string.
 template <class T> struct HasTrailingString { static constexpr bool value = false; };

@@ -53,6 +53,9 @@ rocksteady::thruster_cmd_t to_message(const hal::ThrusterOutputs& outputs, const
     m.thruster_on[i] = outputs.on[k] ? 1 : 0;
     m.thruster_force[i] = outputs.on[k] ? outputs.force[k] : 0.0;
   }
+  for (int p = 0; p < gnc::kPods; ++p) {
+    m.valve_closed[p] = outputs.valve_open[static_cast<std::size_t>(p)] ? 0 : 1;
+  }
   return m;
 }
 
@@ -64,6 +67,7 @@ hal::ThrusterOutputs to_outputs(const rocksteady::thruster_cmd_t& m) {
     o.on[k] = o.enabled && m.thruster_on[i] != 0;
     o.force[k] = o.on[k] ? m.thruster_force[i] : 0.0;
   }
+  for (int p = 0; p < gnc::kPods; ++p) o.valve_open[static_cast<std::size_t>(p)] = m.valve_closed[p] == 0;
   return o;
 }
 
@@ -98,6 +102,48 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   put(out.command.force, m.channel_force);
   m.fuel_kg = g.fuel_kg;
   m.sensor_rejects = g.sensor_rejects;
+  const gnc::EstimationTelemetry& e = g.est;
+  m.mekf_active = e.mekf ? 1 : 0;
+  put(e.gyro_bias, m.gyro_bias);
+  put(e.attitude_sigma, m.attitude_sigma);
+  put(e.bias_sigma, m.gyro_bias_sigma);
+  m.star_gated = e.star_gated;
+  m.identifying = e.identifying ? 1 : 0;
+  put(e.j, m.id_j);
+  put(e.j_sigma, m.id_j_sigma);
+  put(e.r, m.id_r);
+  put(e.r_sigma, m.id_r_sigma);
+  put(e.k, m.id_k);
+  put(e.k_sigma, m.id_k_sigma);
+  m.id_inertia_confident = e.inertia_confident ? 1 : 0;
+  m.id_offset_confident = e.offset_confident ? 1 : 0;
+  m.id_thruster_confident = e.thruster_confident;
+  m.id_excited_inertia = e.excited_inertia ? 1 : 0;
+  m.id_excited_offset = e.excited_offset ? 1 : 0;
+  m.id_excited_thrusters = e.excited_thrusters;
+  m.id_offset_unobservable = static_cast<std::int8_t>(e.offset_unobservable);
+  put(e.residual_torque, m.id_residual_torque);
+  m.id_residual_chi2 = e.residual_chi2;
+  m.id_windows = e.windows;
+  m.id_candidate = static_cast<std::int8_t>(e.candidate);
+  m.model_adoptions = e.adoptions;
+  const gnc::FdiTelemetry& f = g.fdi;
+  m.fdi_enabled = f.enabled ? 1 : 0;
+  put(f.residual, m.fdi_residual);
+  m.fdi_chi2 = f.chi2;
+  m.fdi_noise_sigma = f.noise_sigma;
+  m.fdi_best = f.best;
+  m.fdi_best_llr = f.best_llr;
+  m.fdi_runner_up_llr = f.runner_up_llr;
+  m.fdi_suspected_on = f.suspected_on;
+  m.fdi_suspected_off = f.suspected_off;
+  m.fdi_confirmed_on = f.confirmed_on;
+  m.fdi_confirmed_off = f.confirmed_off;
+  for (int p = 0; p < gnc::kPods; ++p) m.valve_open[p] = f.valve_open[static_cast<std::size_t>(p)] ? 1 : 0;
+  m.isolation_inhibited = f.isolation_inhibited ? 1 : 0;
+  m.fdi_windows = f.windows;
+  m.reduced_authority = g.alloc.reduced_authority ? 1 : 0;
+  m.alloc_rank = static_cast<std::int8_t>(g.alloc.rank);
 }
 
 }  // namespace rocksteady::wire

@@ -13,6 +13,11 @@ std::int64_t to_ns(double s) {
   return static_cast<std::int64_t>(std::llround(s * static_cast<double>(gnc::kNsPerS)));
 }
 
+// Event arguments are int32: counts saturate instead of wrapping negative.
+std::int32_t sat_i32(std::uint64_t v) {
+  return v > 2147483647u ? 2147483647 : static_cast<std::int32_t>(v);
+}
+
 }  // namespace
 
 // ----------------------------------------------------------------------------------------------
@@ -34,6 +39,8 @@ InitResult FlightApp::init(const FlightConfig& config, const Clock& clock) {
   }
   const gnc::ParamCheck p = gnc_.init(config.gnc);
   if (!p.ok) return InitResult{false, p.field, p.reason};
+  const auth::CommandSecurity::InitCheck sc = security_.init(config.security);
+  if (!sc.ok) return InitResult{false, sc.field, sc.reason};
   config_ = config;
   clock_ = &clock;
 
@@ -44,16 +51,24 @@ InitResult FlightApp::init(const FlightConfig& config, const Clock& clock) {
   events_.reset();
   const std::int64_t interval = to_ns(config_.sensor_event_interval_s);
   time_base_.configure(TimeBaseConfig{exec_.gnc_period_s(), config_.max_frame_time_jump_s,
-                                      config_.frame_resync_count, interval});
+                                      config_.frame_resync_count, config_.frame_resync_run,
+                                      interval});
   translator_.configure(interval);
   missed_throttle_.configure(to_ns(config_.executive.slip_event_interval_s));
   missed_throttle_.reset();
+  auth_throttle_.configure(interval);
+  auth_throttle_.reset();
+  if (security_.lab_mode()) {
+    events_.emit(Severity::kWarning, EventId::kLabMode, 0, 0,
+                 "LAB MODE: ground commands are NOT authenticated");
+  }
   latest_frame_ = gnc::SensorSample{};
   fresh_frame_ = false;
   consecutive_slips_ = 0;
   overrun_request_ = false;
   next_index_ = 0;
   sensor_rejects_base_ = 0;
+  device_rejects_ = 0;
   trajectory_loaded_ = false;
   return InitResult{};
 }
@@ -91,9 +106,8 @@ void FlightApp::run_tick(const Tick& tick, const gnc::SensorSample* frame,
   if (plan.base_missed > 0) {
     std::uint32_t suppressed = 0;
     if (missed_throttle_.allow(clock_->now_ns(), suppressed)) {
-      events_.emit(Severity::kWarning, EventId::kMissedTicks,
-                   static_cast<std::int32_t>(plan.base_missed),
-                   static_cast<std::int32_t>(suppressed),
+      events_.emit(Severity::kWarning, EventId::kMissedTicks, sat_i32(plan.base_missed),
+                   sat_i32(suppressed),
                    "%" PRIu32 " base tick(s) missed (%" PRIu32 " report(s) suppressed)",
                    plan.base_missed, suppressed);
     }
@@ -198,7 +212,7 @@ HealthTelemetry FlightApp::health() const {
   h.frames_accepted = time_base_.frames_accepted();
   h.frames_rejected = time_base_.frames_rejected();
   h.frameless_ticks = time_base_.frameless_ticks();
-  h.sensor_rejects = gout_.telemetry.sensor_rejects - sensor_rejects_base_;
+  h.sensor_rejects = gout_.telemetry.sensor_rejects - sensor_rejects_base_ + device_rejects_;
   h.table_loads = params_.loads();
   h.table_activations = params_.activations();
   h.table_loaded = params_.table().loaded();
@@ -208,6 +222,10 @@ HealthTelemetry FlightApp::health() const {
   h.uplink_chunks_rejected = uplink_.chunks_rejected();
   h.trajectories_loaded = uplink_.loaded();
   h.trajectory_loaded = trajectory_loaded_;
+  h.lab_mode = security_.lab_mode();
+  h.auth_key_id = security_.active_key_id();
+  h.auth_rejected = security_.auth_rejected();
+  h.replays_rejected = security_.replays_rejected();
   return h;
 }
 
@@ -217,15 +235,48 @@ HealthTelemetry FlightApp::health() const {
 
 DispatchContext FlightApp::dispatch_context() {
   return DispatchContext{clock_ != nullptr, gnc_,    trajectory_loaded_, time_base_.onboard_time(),
-                         params_,           uplink_, events_};
+                         params_,           uplink_, events_,           security_};
+}
+
+void FlightApp::report_auth_failure(auth::AuthResult r, int what, std::int64_t seq) {
+  std::uint32_t suppressed = 0;
+  if (clock_ == nullptr || !auth_throttle_.allow(clock_->now_ns(), suppressed)) return;
+  events_.emit(Severity::kWarning, EventId::kAuthRejected, static_cast<std::int32_t>(r), what,
+               "%s seq %" PRId64 " refused: %s (%" PRIu32 " report(s) suppressed)",
+               what == 0 ? "command" : "uplink chunk", seq, auth::to_string(r), suppressed);
 }
 
 CommandAck FlightApp::submit(const GroundCommand& cmd) {
+  if (clock_ != nullptr) {
+    const auth::AuthResult a = security_.verify(cmd);
+    if (a != auth::AuthResult::kOk && a != auth::AuthResult::kLabMode) {
+      report_auth_failure(a, 0, cmd.seq);
+      const bool replay = a == auth::AuthResult::kReplay || a == auth::AuthResult::kBadCounter;
+      return commands_.refuse(cmd,
+                              replay ? RejectReason::kStaleSequence
+                                     : RejectReason::kNotAuthenticated,
+                              auth::to_string(a));
+    }
+  }
   return commands_.submit(cmd, dispatch_context());
 }
 
 ChunkStatus FlightApp::receive_chunk(const TrajectoryChunk& chunk) {
+  if (clock_ == nullptr) return ChunkStatus::kBusy;
+  const auth::AuthResult a = security_.verify(chunk);
+  if (a != auth::AuthResult::kOk && a != auth::AuthResult::kLabMode) {
+    report_auth_failure(a, 1, chunk.seq);
+    return ChunkStatus::kNotAuthenticated;
+  }
   return uplink_.receive(chunk, events_);
+}
+
+void FlightApp::rotate_key(std::int32_t key_id) {
+  const std::int32_t from = security_.active_key_id();
+  if (security_.rotate(key_id)) {
+    events_.emit(Severity::kInfo, EventId::kKeyRotated, from, key_id,
+                 "command key %" PRId32 " -> %" PRId32, from, key_id);
+  }
 }
 
 void FlightApp::load_trajectory(std::int32_t upload_id) {
@@ -236,6 +287,7 @@ void FlightApp::reset_counters() {
   commands_.reset_counters();
   time_base_.reset_counters();
   sensor_rejects_base_ = gout_.telemetry.sensor_rejects;
+  device_rejects_ = 0;
   uplink_.reset_counters();
   exec_.reset_counters();
   events_.reset_dropped();

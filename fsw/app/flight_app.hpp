@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 
+#include "fsw/auth/auth.hpp"
 #include "fsw/commands/dispatcher.hpp"
 #include "fsw/events/event_log.hpp"
 #include "fsw/events/event_translator.hpp"
@@ -39,8 +40,13 @@ struct FlightConfig {
   // After this many consecutive rejected frames, the next frame with a finite time re-anchors the
   // time base (e.g. the sensor front end restarted its clock).
   std::uint32_t frame_resync_count{50};
+  // ... and then only a run of this many frames with consistent times re-anchors it (never one).
+  std::uint32_t frame_resync_run{3};
   // This many consecutive GNC cycles that slipped -> SAFE (thrusters off) with an event; 0: never.
   std::uint32_t overrun_safe_slips{10};
+  // Command keys and persisted replay state, or lab mode (explicit; see fsw/auth/auth.hpp). The
+  // default (no keys, no lab mode) is refused by init().
+  auth::SecurityConfig security{};
 };
 
 // {ok, field, reason}: the project's one check result (gnc/check.hpp).
@@ -70,9 +76,26 @@ class FlightApp final : private BoundaryActions {
   // Validates a ground command now and answers it; an accepted command that changes the flight
   // state (mode, law, target, table activation, trajectory hand-over, counter reset) takes effect
   // at the start of the next GNC tick. Raises an event either way.
+  // With command keys the command must be authentic and fresh (fsw/auth): anything else is
+  // answered NOT_AUTHENTICATED / STALE_SEQUENCE and changes nothing.
   CommandAck submit(const GroundCommand& cmd);
+  // A command the flight software gives itself from its own start-up configuration (never bus
+  // input): checked and executed like a ground command, without authentication.
+  CommandAck submit_local(const GroundCommand& cmd) {
+    return commands_.submit(cmd, dispatch_context());
+  }
   // Stores one chunk of a trajectory uplink (events on start, completion, rejection).
   ChunkStatus receive_chunk(const TrajectoryChunk& chunk);
+  // The downlink authenticator of an acknowledgement (false in lab mode: no authenticator).
+  bool sign_ack(auth::AckFields& ack, auth::MacBytes& mac) const {
+    return security_.sign_ack(ack, mac);
+  }
+  bool sign_event(auth::EventFields& event, auth::MacBytes& mac) const {
+    return security_.sign_event(event, mac);
+  }
+  // What must survive a reboot (the bus layer persists it when its generation changes).
+  const auth::SecurityState& security_state() const { return security_.state(); }
+  const auth::CommandSecurity& security() const { return security_; }
 
   // One base tick from a tick source. `frame`: the sensor sample that arrived for this tick, or
   // nullptr. A GNC cycle without a fresh frame runs with an invalid sample at the scheduled time,
@@ -83,6 +106,10 @@ class FlightApp final : private BoundaryActions {
   void gnc_tick(const gnc::SensorSample& sample, Outputs& out);
   // One base tick without a frame; the GNC cycle (if due) runs at time t with an invalid sample.
   void gnc_tick_without_frame(double t, Outputs& out);
+
+  // Readings the devices rejected before the flight core saw them (non-finite values): counted in
+  // HealthTelemetry::sensor_rejects.
+  void note_sensor_rejects(std::uint32_t n) { device_rejects_ += n; }
 
   // --- Outputs besides Outputs ------------------------------------------------------------------
   bool pop_event(Event& e) { return events_.pop(e); }
@@ -110,6 +137,8 @@ class FlightApp final : private BoundaryActions {
   void activate_params() override { params_.activate(gnc_, events_); }
   void load_trajectory(std::int32_t upload_id) override;
   void reset_counters() override;
+  void rotate_key(std::int32_t key_id) override;
+  void report_auth_failure(auth::AuthResult r, int what, std::int64_t seq);
 
   DispatchContext dispatch_context();
   void run_tick(const Tick& tick, const gnc::SensorSample* frame, const double* t_frameless,
@@ -130,6 +159,8 @@ class FlightApp final : private BoundaryActions {
   UplinkLifecycle uplink_{};
   EventLog events_{};
   EventTranslator translator_{};
+  auth::CommandSecurity security_{};
+  Throttle auth_throttle_{};
 
   gnc::SensorSample latest_frame_{};
   bool fresh_frame_{false};
@@ -137,6 +168,7 @@ class FlightApp final : private BoundaryActions {
   bool overrun_request_{false};  // this tick's SAFE request is the overrun protection's
   std::uint64_t next_index_{0};  // for the lockstep conveniences
   std::uint32_t sensor_rejects_base_{0};
+  std::uint32_t device_rejects_{0};
   bool trajectory_loaded_{false};
   Throttle missed_throttle_{};
 };

@@ -21,6 +21,8 @@ static_assert(static_cast<std::int32_t>(Opcode::kParamLoad) == GroundCmd::OP_PAR
 static_assert(static_cast<std::int32_t>(Opcode::kParamActivate) == GroundCmd::OP_PARAM_ACTIVATE);
 static_assert(static_cast<std::int32_t>(Opcode::kParamDiscard) == GroundCmd::OP_PARAM_DISCARD);
 static_assert(static_cast<std::int32_t>(Opcode::kParamDump) == GroundCmd::OP_PARAM_DUMP);
+static_assert(static_cast<std::int32_t>(Opcode::kParamLoadIdentified) ==
+              GroundCmd::OP_PARAM_LOAD_IDENTIFIED);
 static_assert(kOpcodeCount == GroundCmd::OP_COUNT);
 static_assert(kMaxDumpParams == rocksteady::param_table_t::MAX_PARAMS);
 static_assert(kMaxParamValues == rocksteady::param_table_t::MAX_VALUES);
@@ -77,6 +79,8 @@ GroundCommand to_command(const rocksteady::ground_cmd_t& m) {
   for (int i = 0; i < kMaxCommandArgs && i < m.nargs; ++i) {
     c.args[static_cast<std::size_t>(i)] = m.args[i];
   }
+  c.key_id = m.key_id;
+  for (int i = 0; i < kMacSize; ++i) c.mac[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(m.mac[i]);
   return c;
 }
 
@@ -99,6 +103,11 @@ void to_chunk(const rocksteady::trajectory_chunk_t& m, TrajectoryChunk& out) {
       s = gnc::TrajectorySample{};
     }
   }
+  out.seq = m.seq;
+  out.key_id = m.key_id;
+  for (int i = 0; i < kMacSize; ++i) {
+    out.mac[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(m.mac[i]);
+  }
 }
 
 void reserve_text(rocksteady::cmd_ack_t& m) {
@@ -119,6 +128,55 @@ void to_message(const CommandAck& ack, double t, rocksteady::cmd_ack_t& m) {
   m.reason = static_cast<std::int32_t>(ack.reason);
   m.detail = ack.detail;
   set_text(m.text, ack.text, rocksteady::cmd_ack_t::MAX_TEXT);
+  m.key_id = 0;
+  std::memset(m.mac, 0, sizeof m.mac);
+}
+
+bool sign(const FlightApp& app, rocksteady::cmd_ack_t& m) {
+  auth::AckFields f = ack_fields(m);
+  auth::MacBytes mac{};
+  const bool signed_ = app.sign_ack(f, mac);
+  m.key_id = f.key_id;
+  for (int i = 0; i < kMacSize; ++i) m.mac[i] = static_cast<std::int8_t>(mac[static_cast<std::size_t>(i)]);
+  return signed_;
+}
+
+auth::EventFields event_fields(const rocksteady::event_t& m) {
+  auth::EventFields f;
+  f.t = m.t;
+  f.seq = m.seq;
+  f.severity = m.severity;
+  f.id = m.id;
+  f.arg0 = m.arg0;
+  f.arg1 = m.arg1;
+  f.key_id = m.key_id;
+  f.text = m.text.c_str();
+  f.text_len = m.text.size();
+  return f;
+}
+
+bool sign(const FlightApp& app, rocksteady::event_t& m) {
+  auth::EventFields f = event_fields(m);
+  auth::MacBytes mac{};
+  const bool signed_ = app.sign_event(f, mac);
+  m.key_id = f.key_id;
+  for (int i = 0; i < kMacSize; ++i) m.mac[i] = static_cast<std::int8_t>(mac[static_cast<std::size_t>(i)]);
+  return signed_;
+}
+
+auth::AckFields ack_fields(const rocksteady::cmd_ack_t& m) {
+  auth::AckFields f;
+  f.t = m.t;
+  f.seq = m.seq;
+  f.sender_id = m.sender_id;
+  f.opcode = m.opcode;
+  f.accepted = m.accepted != 0;
+  f.reason = m.reason;
+  f.detail = m.detail;
+  f.key_id = m.key_id;
+  f.text = m.text.c_str();
+  f.text_len = m.text.size();
+  return f;
 }
 
 void to_message(const Event& e, rocksteady::event_t& m) {
@@ -131,6 +189,8 @@ void to_message(const Event& e, rocksteady::event_t& m) {
   m.arg0 = e.arg0;
   m.arg1 = e.arg1;
   set_text(m.text, e.text.data(), rocksteady::event_t::MAX_TEXT);
+  m.key_id = 0;
+  std::memset(m.mac, 0, sizeof m.mac);
 }
 
 void to_message(const ParamDump& d, rocksteady::param_table_t& m) {
@@ -179,6 +239,10 @@ void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m) {
   m.uplink_total_chunks = h.uplink_chunk_count;
   m.uplink_chunks_rejected = h.uplink_chunks_rejected;
   m.trajectories_loaded = h.trajectories_loaded;
+  m.lab_mode = h.lab_mode ? 1 : 0;
+  m.auth_key_id = h.auth_key_id;
+  m.auth_rejected = i64(h.auth_rejected);
+  m.replays_rejected = i64(h.replays_rejected);
 }
 
 void fill_rx(const wire::RxCounters& rx, rocksteady::gnc_telemetry_t& m) {

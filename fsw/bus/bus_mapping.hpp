@@ -31,8 +31,15 @@ void to_chunk(const rocksteady::trajectory_chunk_t& m, TrajectoryChunk& out);
 void reserve_text(rocksteady::cmd_ack_t& m);
 void reserve_text(rocksteady::event_t& m);
 
-// CommandAck -> cmd_ack_t at on-board time t (text truncated to MAX_TEXT).
+// CommandAck -> cmd_ack_t at on-board time t (text truncated to MAX_TEXT), without authenticator.
 void to_message(const CommandAck& ack, double t, rocksteady::cmd_ack_t& m);
+// The acknowledgement's fields as the authenticator covers them (text points into m).
+auth::AckFields ack_fields(const rocksteady::cmd_ack_t& m);
+// Adds the downlink authenticator (key_id, mac); false in lab mode (key_id 0, zero mac).
+bool sign(const FlightApp& app, rocksteady::cmd_ack_t& m);
+// The event's fields as the authenticator covers them, and its downlink authenticator.
+auth::EventFields event_fields(const rocksteady::event_t& m);
+bool sign(const FlightApp& app, rocksteady::event_t& m);
 // Event -> event_t.
 void to_message(const Event& e, rocksteady::event_t& m);
 // ParamDump -> param_table_t.

@@ -12,6 +12,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "fsw/auth/key_file.hpp"
 #include "gnc/units.hpp"
 #include "lcmtypes/channels.hpp"
 #include "wire/convert.hpp"
@@ -157,7 +158,10 @@ void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/,
   }
   ++n.stats_.commands;
   const CommandAck ack = n.computer_.submit(to_command(n.scratch_cmd_));
+  // Persist the consumed counter before the acknowledgement goes out.
+  n.persist_security();
   to_message(ack, n.computer_.onboard_time(), n.ack_msg_);
+  sign(n.computer_.app(), n.ack_msg_);
   n.publish(channels::kCmdAck, n.ack_msg_);
   if (n.computer_.take_param_dump(n.dump_)) {  // PARAM_DUMP: the table goes out with the ack
     to_message(n.dump_, n.params_msg_);
@@ -177,7 +181,20 @@ void FlightNode::on_chunk(const lcm_recv_buf_t* rbuf, const char* /*channel*/, v
   ++n.stats_.chunks;
   to_chunk(n.scratch_chunk_, n.chunk_);
   n.computer_.receive_chunk(n.chunk_);  // the application raises the events, counts rejections
+  n.persist_security();
   n.drain_events();
+}
+
+void FlightNode::persist_security() {
+  const auth::SecurityState& s = computer_.app().security_state();
+  if (state_file_.empty() || s.generation == state_written_) return;
+  const std::string err = auth::write_state_file(state_file_, s);
+  if (err.empty()) {
+    state_written_ = s.generation;
+  } else {
+    bus_event(Severity::kError, BusEventId::kStateFile, 0, 0, "cannot persist the command state");
+    std::fprintf(stderr, "rocksteady-fsw: %s\n", err.c_str());
+  }
 }
 
 void FlightNode::note_rx_reject(int channel, const wire::RxCounters& c) {
@@ -207,6 +224,7 @@ void FlightNode::drain_events() {
   Event e;
   while (computer_.pop_event(e)) {
     to_message(e, event_msg_);
+    sign(computer_.app(), event_msg_);
     publish(channels::kEvents, event_msg_);
   }
 }
@@ -222,6 +240,7 @@ void FlightNode::bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::
   e.arg1 = arg1;
   std::snprintf(e.text.data(), e.text.size(), "%s", text);
   to_message(e, event_msg_);
+  sign(computer_.app(), event_msg_);
   publish(channels::kEvents, event_msg_);
 }
 
@@ -258,6 +277,7 @@ void FlightNode::tick(const Tick& t, const NodeOptions& o) {
     watchdog_.feed();
   }
   if (r.gnc_ran) publish_telemetry(o);
+  persist_security();  // a key rotation takes effect at the tick boundary
   drain_events();
   if (o.has_start_mode && !start_done_ && r.gnc_ran && computer_.health().frames_accepted > 0) {
     start_done_ = true;
@@ -267,7 +287,8 @@ void FlightNode::tick(const Tick& t, const NodeOptions& o) {
     c.opcode = static_cast<std::int32_t>(Opcode::kSetMode);
     c.arg_count = 1;
     c.args[0] = static_cast<double>(static_cast<int>(o.start_mode));
-    to_message(computer_.submit(c), computer_.onboard_time(), ack_msg_);
+    to_message(computer_.submit_local(c), computer_.onboard_time(), ack_msg_);
+    sign(computer_.app(), ack_msg_);
     publish(channels::kCmdAck, ack_msg_);
     drain_events();
   }

@@ -38,6 +38,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <lcm/lcm.h>
@@ -61,6 +62,7 @@ enum class BusEventId : std::int32_t {
   kRxRejected = 202,  // throttled; arg0 = channel (0 sensors, 1 ground cmd, 2 uplink), arg1 = total
   kWatchdog = 203,    // error; no GNC cycle within the watchdog time: thrusters off, process exits
                       // arg0 = ms since the last GNC cycle, arg1 = base tick of that cycle
+  kStateFile = 204,   // error; the command-security state could not be written
 };
 
 // Exit status after the software watchdog fired (a supervisor restarts the process).
@@ -136,6 +138,9 @@ class FlightNode {
   // Sensor frames read from this socket by the loop itself instead of through LCM's receive thread
   // (call before subscribe; the flight bus must then carry nothing else the node needs).
   void set_direct_sensor_rx(rt::UdpmReceiver* rx) { direct_ = rx; }
+  // Where the command-security state is persisted whenever it changes ("" = nowhere: the replay
+  // windows then restart empty after a reboot; fsw/auth/key_file.hpp).
+  void set_state_file(const std::string& path) { state_file_ = path; }
   bool subscribe();
   // Runs until *stop becomes non-zero or an exit limit is reached. Returns 0, or 1 on a bus error.
   int run(const NodeOptions& options, const volatile std::sig_atomic_t* stop);
@@ -162,6 +167,7 @@ class FlightNode {
   void sync_sensor_stats();
   void publish_telemetry(const NodeOptions& o);
   void drain_events();
+  void persist_security();
   void bus_event(Severity sev, BusEventId id, std::int32_t arg0, std::int32_t arg1,
                  const char* text);
   void note_rx_reject(int channel, const wire::RxCounters& c);
@@ -198,6 +204,8 @@ class FlightNode {
   bool have_index_{false};
   bool bus_error_{false};
   bool start_done_{false};
+  std::string state_file_;
+  std::uint64_t state_written_{0};  // generation of the security state last written
   unsigned char buf_[4096]{};
   NodeStats stats_{};
   std::uint32_t ground_drain_max_{64};

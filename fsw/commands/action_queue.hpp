@@ -17,6 +17,7 @@ enum class ActionKind : std::uint8_t {
   kActivateParams,
   kLoadTrajectory,
   kResetCounters,
+  kRotateKey,  // key_id becomes the active command key (fsw/auth)
 };
 
 struct Action {
@@ -25,6 +26,7 @@ struct Action {
   gnc::LawId law{gnc::LawId::kNtcl};
   gnc::Vec3 target{gnc::Vec3::Zero()};
   std::int32_t upload_id{0};
+  std::int32_t key_id{0};
 };
 
 class ActionQueue {

@@ -38,6 +38,8 @@ constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
     {Opcode::kParamActivate, 0, 0, kAllModes, {}},
     {Opcode::kParamDiscard, 0, 0, kAllModes, {}},
     {Opcode::kParamDump, 0, 0, kAllModes, {}},
+    {Opcode::kKeyRotate, 1, 1, kAllModes, {integer(1, kIdMax)}},
+    {Opcode::kParamLoadIdentified, 0, 0, kAllModes, {}},
 }};
 
 constexpr bool rows_in_opcode_order() {
@@ -97,18 +99,24 @@ RejectReason SequenceTracker::check(std::int32_t source, std::int64_t seq) const
   const int i = find(source);
   const std::int64_t last = i < 0 ? 0 : slots_[i].last_seq;  // sequence numbers start at 1
   if (seq <= last) return RejectReason::kStaleSequence;
-  if (i < 0 && used_ >= kMaxSources) return RejectReason::kBusy;
-  return RejectReason::kNone;
+  return RejectReason::kNone;  // a new source takes a free slot or the least recently used one
 }
 
 void SequenceTracker::accept(std::int32_t source, std::int64_t seq) {
   int i = find(source);
   if (i < 0) {
-    if (used_ >= kMaxSources) return;
-    i = used_++;
+    if (used_ < kMaxSources) {
+      i = used_++;
+    } else {
+      i = 0;
+      for (int k = 1; k < used_; ++k) {
+        if (slots_[k].used_at < slots_[i].used_at) i = k;
+      }
+    }
     slots_[i].source = source;
   }
   slots_[i].last_seq = seq;
+  slots_[i].used_at = ++clock_;
 }
 
 }  // namespace rocksteady::fsw

@@ -48,11 +48,14 @@ struct CommandCheck {
 // not allowed in `mode`, in that order.
 CommandCheck check_command(const GroundCommand& cmd, gnc::Mode mode);
 
-// Per-source sequence numbers: a command's seq must be above the last accepted one of its source.
+// Lab mode only (with keys, fsw/auth's per-key counter windows replace it): per-source sequence
+// numbers; a command's seq must be above the last accepted one of its source. A new source takes
+// the least recently used slot when all are taken, so sources can never lock each other out (lab
+// mode offers no protection against replay: anyone may send anything).
 class SequenceTracker {
  public:
   static constexpr int kMaxSources = 16;
-  // kNone, kStaleSequence, or kBusy when a new source finds no free slot.
+  // kNone or kStaleSequence.
   RejectReason check(std::int32_t source, std::int64_t seq) const;
   void accept(std::int32_t source, std::int64_t seq);
   void reset() { used_ = 0; }
@@ -62,9 +65,11 @@ class SequenceTracker {
   struct Slot {
     std::int32_t source{0};
     std::int64_t last_seq{0};
+    std::uint64_t used_at{0};
   };
   std::array<Slot, kMaxSources> slots_{};
   int used_{0};
+  std::uint64_t clock_{0};
 };
 
 }  // namespace rocksteady::fsw

@@ -44,7 +44,10 @@ CommandAck CommandDispatcher::submit(const GroundCommand& cmd, const DispatchCon
   if (!ctx.ready) {
     r = reject(RejectReason::kBusy, 0, "flight application not initialised");
   } else {
-    const RejectReason s = seqs_.check(cmd.source, cmd.seq);
+    // Lab mode: per-source sequence numbers; with keys the per-key counter window has already been
+    // checked (and consumed) by the security layer.
+    const RejectReason s = ctx.security.lab_mode() ? seqs_.check(cmd.source, cmd.seq)
+                                                   : RejectReason::kNone;
     if (s == RejectReason::kStaleSequence) {
       r = reject(s, 0, "stale or repeated sequence number");
     } else if (s != RejectReason::kNone) {
@@ -64,7 +67,7 @@ CommandAck CommandDispatcher::submit(const GroundCommand& cmd, const DispatchCon
   last_seq_ = cmd.seq;
   last_opcode_ = cmd.opcode;
   if (r.ok()) {
-    seqs_.accept(cmd.source, cmd.seq);
+    if (ctx.security.lab_mode()) seqs_.accept(cmd.source, cmd.seq);
     ++accepted_;
     ctx.log.emit(Severity::kInfo, EventId::kCommandAccepted, cmd.opcode,
                  static_cast<std::int32_t>(cmd.seq), "%s seq %" PRId64 " from %" PRId32 " accepted",
@@ -77,6 +80,19 @@ CommandAck CommandDispatcher::submit(const GroundCommand& cmd, const DispatchCon
                  "%s (%" PRId32 ") seq %" PRId64 " rejected: %s: %s", name, cmd.opcode, cmd.seq,
                  to_string(r.reason), r.text);
   }
+  return ack;
+}
+
+CommandAck CommandDispatcher::refuse(const GroundCommand& cmd, RejectReason reason,
+                                     const char* text) {
+  CommandAck ack;
+  ack.seq = cmd.seq;
+  ack.source = cmd.source;
+  ack.opcode = cmd.opcode;
+  ack.accepted = false;
+  ack.reason = reason;
+  ack.text = text;
+  ++rejected_;
   return ack;
 }
 
@@ -124,6 +140,23 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
       return ctx.params.discard(ctx.core.params(), ctx.log);
     case Opcode::kParamDump:
       return ctx.params.dump(ctx.core.params(), ctx.onboard_time, ctx.log);
+    case Opcode::kKeyRotate: {
+      const auto id = static_cast<std::int32_t>(cmd.args[0]);
+      if (ctx.security.lab_mode()) {
+        return reject(RejectReason::kNotAllowedInMode, 0, "lab mode: there are no command keys");
+      }
+      if (queue_.has(ActionKind::kRotateKey)) {
+        return reject(RejectReason::kBusy, 0, "a key rotation is already pending");
+      }
+      if (!ctx.security.can_rotate_to(id)) {
+        return reject(RejectReason::kOutOfRange, 0, "key id unknown or not newer than the active");
+      }
+      a.kind = ActionKind::kRotateKey;
+      a.key_id = id;
+      return enqueue_one(a);
+    }
+    case Opcode::kParamLoadIdentified:
+      return ctx.params.load_identified(ctx.core, ctx.log);
   }
   return reject(RejectReason::kUnknownOpcode, cmd.opcode, "unknown opcode");
 }
@@ -131,7 +164,7 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
 CommandCheck CommandDispatcher::execute_set_mode(const GroundCommand& cmd,
                                                  const DispatchContext& ctx) {
   const auto to = static_cast<gnc::Mode>(static_cast<int>(cmd.args[0]));
-  const gnc::TransitionContext tc{ctx.core.estimator().initialised(), projected_trajectory(ctx),
+  const gnc::TransitionContext tc{ctx.core.estimate_ready(), projected_trajectory(ctx),
                                   queue_.projected_law(ctx.core.params().law)};
   const gnc::TransitionCheck c = gnc::check_transition(projected_mode(ctx), to, tc);
   if (c != gnc::TransitionCheck::kOk) return refused_transition(c);
@@ -161,7 +194,7 @@ CommandCheck CommandDispatcher::execute_set_law(const GroundCommand& cmd,
     return refused_transition(gnc::TransitionCheck::kLawCannotTrack);
   }
   if (change_mode) {
-    const gnc::TransitionContext tc{ctx.core.estimator().initialised(), projected_trajectory(ctx),
+    const gnc::TransitionContext tc{ctx.core.estimate_ready(), projected_trajectory(ctx),
                                     law};
     const gnc::TransitionCheck c = gnc::check_transition(pm, to, tc);
     if (c != gnc::TransitionCheck::kOk) return refused_transition(c);
@@ -195,7 +228,7 @@ CommandCheck CommandDispatcher::execute_load_trajectory(const GroundCommand& cmd
   if (u.active() && u.upload_id() == id && !u.pending() && u.complete() && !queue_.has_room(1)) {
     return reject(RejectReason::kBusy, 0, "command queue full");
   }
-  const CommandCheck c = ctx.uplink.request_load(id, ctx.core.params().guidance.eps_trans, ctx.log);
+  const CommandCheck c = ctx.uplink.request_load(id, ctx.core.params(), ctx.log);
   if (!c.ok()) return c;
   Action a;
   a.kind = ActionKind::kLoadTrajectory;
@@ -215,8 +248,11 @@ void CommandDispatcher::apply_pending(gnc::GncCommands& cmds, BoundaryActions& a
       case ActionKind::kActivateParams:
       case ActionKind::kLoadTrajectory:
       case ActionKind::kResetCounters:
+      case ActionKind::kRotateKey:
         if (core_slot_used) {
           stop = true;
+        } else if (a.kind == ActionKind::kRotateKey) {
+          actions.rotate_key(a.key_id);
         } else if (a.kind == ActionKind::kActivateParams) {
           actions.activate_params();
         } else if (a.kind == ActionKind::kLoadTrajectory) {

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 
+#include "fsw/auth/auth.hpp"
 #include "fsw/commands/action_queue.hpp"
 #include "fsw/commands/command_table.hpp"
 #include "fsw/events/event_log.hpp"
@@ -25,6 +26,9 @@ struct DispatchContext {
   ParamLifecycle& params;
   UplinkLifecycle& uplink;
   EventLog& log;
+  // The command security layer. Authentication happens before submit(); in lab mode (nothing is
+  // authenticated) the dispatcher keeps per-source sequence numbers instead of per-key counters.
+  const auth::CommandSecurity& security;
 };
 
 // The actions that happen at the tick boundary before the flight core runs.
@@ -33,6 +37,7 @@ class BoundaryActions {
   virtual void activate_params() = 0;
   virtual void load_trajectory(std::int32_t upload_id) = 0;
   virtual void reset_counters() = 0;
+  virtual void rotate_key(std::int32_t key_id) = 0;
 
  protected:
   BoundaryActions() = default;
@@ -46,6 +51,9 @@ class CommandDispatcher {
   void reset();
 
   CommandAck submit(const GroundCommand& cmd, const DispatchContext& ctx);
+  // A command that failed authentication: answered and counted, nothing else changes (no sequence
+  // state, no queue, no last-command telemetry).
+  CommandAck refuse(const GroundCommand& cmd, RejectReason reason, const char* text);
 
   // At the start of a GNC tick: the longest prefix of the queue that keeps submission order within
   // one tick (the core takes one mode request, one law and one target per tick and applies the law

@@ -39,8 +39,12 @@ TickReport FlightComputer::tick(const Tick& tick) {
       star_.reset();
     }
     sample.t = frame_.t;
-    gyro_.read(frame_.gyro, frame_.t, sample);
-    star_.read(frame_.star, frame_.t, sample);
+    // A reading with non-finite values (NaN, inf) is a rejected sample: counted in the health's
+    // sensor_rejects with the flight core's own rejections.
+    std::uint32_t nonfinite = 0;
+    nonfinite += gyro_.read(frame_.gyro, frame_.t, sample) == hal::ReadingStatus::kNonFinite ? 1 : 0;
+    nonfinite += star_.read(frame_.star, frame_.t, sample) == hal::ReadingStatus::kNonFinite ? 1 : 0;
+    if (nonfinite > 0) app_.note_sensor_rejects(nonfinite);
     frame = &sample;
     echo_seq_ = frame_.seq;
     report.frame = true;

@@ -63,6 +63,7 @@ class FlightComputer {
 
   // --- Ground side (the bus layer or the campaign moves these) ---------------------------------
   CommandAck submit(const GroundCommand& cmd) { return app_.submit(cmd); }
+  CommandAck submit_local(const GroundCommand& cmd) { return app_.submit_local(cmd); }
   ChunkStatus receive_chunk(const TrajectoryChunk& chunk) { return app_.receive_chunk(chunk); }
   bool pop_event(Event& e) { return app_.pop_event(e); }
   bool take_param_dump(ParamDump& out) { return app_.take_param_dump(out); }

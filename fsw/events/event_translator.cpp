@@ -11,9 +11,10 @@ namespace {
 enum class Args : std::uint8_t {
   kFromTo,           // arg0 = from, arg1 = to
   kToReason,         // arg0 = requested mode, arg1 = gnc::TransitionCheck
-  kRejectsThrottled  // arg0 = rejects so far, arg1 = suppressed reports; throttled
+  kRejectsThrottled,  // arg0 = rejects so far, arg1 = suppressed reports; throttled
+  kData               // arg0, arg1 = the event's own data (fault events)
 };
-enum class Detail : std::uint8_t { kNone, kCause, kTimeout, kReason, kRejects };
+enum class Detail : std::uint8_t { kNone, kCause, kTimeout, kReason, kRejects, kArgs };
 
 struct Row {
   gnc::EventId gnc_id;
@@ -24,7 +25,7 @@ struct Row {
   const char* text;  // printf with %s: from, to, detail (in that order; each may be unused)
 };
 
-constexpr std::array<Row, 8> kRows{{
+constexpr std::array<Row, 15> kRows{{
     {gnc::EventId::kModeChanged, EventId::kModeChanged, Severity::kInfo, Args::kFromTo,
      Detail::kCause, "mode %s -> %s (%s)"},
     {gnc::EventId::kAutoHold, EventId::kAutoHold, Severity::kInfo, Args::kFromTo, Detail::kNone,
@@ -38,6 +39,20 @@ constexpr std::array<Row, 8> kRows{{
     {gnc::EventId::kSensorRejected, EventId::kSensorRejected, Severity::kWarning,
      Args::kRejectsThrottled, Detail::kRejects,
      "sensor sample rejected: invalid, non-finite or out of range (%.0s%.0s%s so far)"},
+    {gnc::EventId::kModelAdopted, EventId::kModelAdopted, Severity::kInfo, Args::kFromTo,
+     Detail::kNone, "identified model (J_tot, r_SO/BCM, strengths) adopted in %.0s%s%s"},
+    {gnc::EventId::kModelRefused, EventId::kModelRefused, Severity::kWarning, Args::kFromTo,
+     Detail::kNone, "identified model refused: fails table validation (in %.0s%s%s)"},
+    {gnc::EventId::kFaultSuspected, EventId::kFaultSuspected, Severity::kWarning, Args::kData,
+     Detail::kArgs, "thruster fault suspected in %.0s%s: residual above the no-fault bound (%s)"},
+    {gnc::EventId::kFaultConfirmed, EventId::kFaultConfirmed, Severity::kError, Args::kData,
+     Detail::kArgs, "thruster fault confirmed in %.0s%s, latched until the ground clears it (%s)"},
+    {gnc::EventId::kValveClosed, EventId::kValveClosed, Severity::kWarning, Args::kData,
+     Detail::kArgs, "latch valve closed in %.0s%s to isolate a stuck-on thruster (%s)"},
+    {gnc::EventId::kFaultOverride, EventId::kFaultOverride, Severity::kInfo, Args::kData,
+     Detail::kArgs, "fault management override applied in %.0s%s (%s)"},
+    {gnc::EventId::kReducedAuthority, EventId::kReducedAuthority, Severity::kWarning, Args::kData,
+     Detail::kArgs, "reduced control authority in %.0s%s: some torque directions unreachable (%s)"},
     {gnc::EventId::kTrajectorySwitched, EventId::kTrajectorySwitched, Severity::kInfo,
      Args::kFromTo, Detail::kNone,
      "trajectory switched at the tick boundary (mode %s%.0s): reference re-synchronised%s"},
@@ -71,6 +86,9 @@ void EventTranslator::translate(const gnc::ModeEvents& events, const Translation
     if (row->args == Args::kToReason) {
       arg0 = static_cast<std::int32_t>(e.to);
       arg1 = static_cast<std::int32_t>(e.reason);
+    } else if (row->args == Args::kData) {
+      arg0 = e.arg0;
+      arg1 = e.arg1;
     } else if (row->args == Args::kRejectsThrottled) {
       std::uint32_t suppressed = 0;
       if (!sensor_throttle_.allow(ctx.now_ns, suppressed)) continue;
@@ -93,6 +111,10 @@ void EventTranslator::translate(const gnc::ModeEvents& events, const Translation
         break;
       case Detail::kRejects:
         std::snprintf(detail, sizeof detail, "%u", ctx.sensor_rejects);
+        break;
+      case Detail::kArgs:
+        std::snprintf(detail, sizeof detail, "%d, %d", static_cast<int>(e.arg0),
+                      static_cast<int>(e.arg1));
         break;
     }
 #pragma GCC diagnostic push

@@ -66,7 +66,8 @@ std::uint32_t RateGroup::cycles_between(std::uint64_t from, std::uint64_t to) co
   // Multiples of the divider in [from + 1, to - 1].
   const std::uint64_t upto = (to - 1) / divider_;
   const std::uint64_t below = from / divider_;
-  return static_cast<std::uint32_t>(upto - below);
+  const std::uint64_t n = upto - below;
+  return n > 0xFFFFFFFFull ? 0xFFFFFFFFu : static_cast<std::uint32_t>(n);
 }
 
 SlipReport RateGroup::begin(std::int64_t tick_start_ns, std::int64_t now_ns) {
@@ -126,7 +127,9 @@ TickPlan Executive::plan(const Tick& tick) {
   }
   p.valid = true;
   if (have_tick_) {
-    p.base_missed = static_cast<std::uint32_t>(tick.index - last_index_ - 1);
+    // Saturating (a gap of 2^32 ticks must not wrap to a small number).
+    const std::uint64_t gap = tick.index - last_index_ - 1;
+    p.base_missed = gap > 0xFFFFFFFFull ? 0xFFFFFFFFu : static_cast<std::uint32_t>(gap);
     for (int g = 0; g < kGroupCount; ++g) {
       p.missed[g] = groups_[g].cycles_between(last_index_, tick.index);
       groups_[g].add_missed(p.missed[g]);
@@ -136,7 +139,8 @@ TickPlan Executive::plan(const Tick& tick) {
   have_tick_ = true;
   last_index_ = tick.index;
   ++base_ticks_;
-  base_missed_ += p.base_missed;
+  base_missed_ = base_missed_ > 0xFFFFFFFFu - p.base_missed ? 0xFFFFFFFFu
+                                                             : base_missed_ + p.base_missed;
   return p;
 }
 

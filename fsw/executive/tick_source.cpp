@@ -33,6 +33,20 @@ bool LockstepSource::on_frame(std::int64_t seq, std::int64_t arrival_ns) {
     ++stale_frames_;
     return false;
   }
+  if (have_first_ && seq - latest_seq_ > kMaxSeqJump) {
+    ++jump_rejects_;
+    const bool consistent = candidate_run_ > 0 && seq > candidate_seq_ &&
+                            seq - candidate_seq_ <= kResyncStep;
+    candidate_run_ = consistent ? candidate_run_ + 1 : 1;
+    candidate_seq_ = seq;
+    if (candidate_run_ < kResyncRun) return false;
+    // A run of consistent frames: the sender's numbering really moved. Continue the ticks from
+    // the last one handed out, without counting the jump as missed ticks.
+    ++resyncs_;
+    const auto next_index = have_returned_ ? last_index_ + 1 : 0;
+    first_seq_ = seq - static_cast<std::int64_t>(next_index);
+  }
+  candidate_run_ = 0;
   if (!have_first_) {
     have_first_ = true;
     first_seq_ = seq;
@@ -49,7 +63,8 @@ bool LockstepSource::next(Tick& tick) {
   const auto index = static_cast<std::uint64_t>(latest_seq_ - first_seq_);
   std::uint32_t missed = 0;
   if (have_returned_ && index > last_index_ + 1) {
-    missed = static_cast<std::uint32_t>(index - last_index_ - 1);
+    const std::uint64_t gap = index - last_index_ - 1;  // <= kMaxSeqJump by on_frame
+    missed = gap > 0xFFFFFFFFull ? 0xFFFFFFFFu : static_cast<std::uint32_t>(gap);
   }
   have_returned_ = true;
   last_index_ = index;

@@ -46,12 +46,22 @@ class RealTimeClockSource final : public TickSource {
 
 class LockstepSource final : public TickSource {
  public:
+  // A frame more than this many sequence numbers ahead of the newest accepted one is implausible
+  // (one spoofed frame must not become 10^15 missed ticks): rejected and counted, never adopted
+  // from one frame. Only a run of kResyncRun such frames, each 1..kResyncStep above the previous,
+  // re-synchronises the numbering (the ticks then continue without a gap).
+  static constexpr std::int64_t kMaxSeqJump = 1000;
+  static constexpr std::uint32_t kResyncRun = 5;
+  static constexpr std::int64_t kResyncStep = 10;
+
   // A sensor frame numbered `seq` arrived at `arrival_ns`. False (counted) for a negative, repeated
-  // or older sequence number: such a frame makes no tick.
+  // or older sequence number, or an implausible jump: such a frame makes no tick.
   bool on_frame(std::int64_t seq, std::int64_t arrival_ns);
   bool next(Tick& tick) override;
-  std::uint32_t missed_total() const { return missed_total_; }
-  std::uint32_t stale_frames() const { return stale_frames_; }
+  std::uint64_t missed_total() const { return missed_total_; }
+  std::uint64_t stale_frames() const { return stale_frames_; }
+  std::uint64_t jump_rejects() const { return jump_rejects_; }
+  std::uint64_t resyncs() const { return resyncs_; }
 
  private:
   bool have_first_{false};
@@ -61,8 +71,12 @@ class LockstepSource final : public TickSource {
   bool pending_{false};
   bool have_returned_{false};
   std::uint64_t last_index_{0};  // last tick handed out
-  std::uint32_t missed_total_{0};
-  std::uint32_t stale_frames_{0};
+  std::uint64_t missed_total_{0};
+  std::uint64_t stale_frames_{0};
+  std::uint64_t jump_rejects_{0};
+  std::uint64_t resyncs_{0};
+  std::uint32_t candidate_run_{0};  // consecutive implausible frames consistent with each other
+  std::int64_t candidate_seq_{0};
 };
 
 }  // namespace rocksteady::fsw

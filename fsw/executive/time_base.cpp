@@ -16,6 +16,8 @@ void FrameTimeBase::reset() {
   have_frame_t_ = false;
   last_frame_t_ = 0.0;
   consecutive_rejects_ = 0;
+  resync_run_ = 0;
+  resync_t_ = 0.0;
   have_gnc_t_ = false;
   last_gnc_t_ = 0.0;
   cycles_missed_ = 0;
@@ -41,10 +43,20 @@ bool FrameTimeBase::accept(double t, std::int64_t now_ns, EventLog& log) {
       why = "time jumps ahead of the on-board time";
     }
     if (!ok && std::isfinite(t) && consecutive_rejects_ >= config_.frame_resync_count) {
-      log.emit(Severity::kWarning, EventId::kFrameRejected, 0, 0,
-               "frame time base re-synchronised at t=%.6g s after %" PRIu32 " rejected frames", t,
-               consecutive_rejects_);
-      ok = true;
+      // A candidate for a new time base: adopted only after a run of consistent frames.
+      const bool consistent =
+          resync_run_ > 0 && t > resync_t_ && t - resync_t_ <= config_.max_frame_time_jump_s;
+      resync_run_ = consistent ? resync_run_ + 1 : 1;
+      resync_t_ = t;
+      if (resync_run_ >= (config_.frame_resync_run > 0 ? config_.frame_resync_run : 1)) {
+        log.emit(Severity::kWarning, EventId::kFrameRejected, 0, 0,
+                 "frame time base re-synchronised at t=%.6g s after %" PRIu32
+                 " rejected frames and %" PRIu32 " consistent ones",
+                 t, consecutive_rejects_, resync_run_);
+        ok = true;
+        have_gnc_t_ = false;  // the on-board time follows the new base, without a missed-tick gap
+        cycles_missed_ = 0;
+      }
     }
   }
   if (!ok) {
@@ -61,6 +73,7 @@ bool FrameTimeBase::accept(double t, std::int64_t now_ns, EventLog& log) {
   have_frame_t_ = true;
   last_frame_t_ = t;
   consecutive_rejects_ = 0;
+  resync_run_ = 0;
   ++frames_accepted_;
   return true;
 }

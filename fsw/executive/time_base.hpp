@@ -1,8 +1,9 @@
 // The frame time base: which sensor frames' time tags the application accepts, and the on-board
 // time of the GNC cycles. A frame's time must be finite, after the previous frame's and at most
 // max_frame_time_jump_s ahead of the on-board time; a rejected frame is counted and evented
-// (throttled). After frame_resync_count rejected frames in a row, the next finite time re-anchors
-// the base (a restarted sensor front end). Without a frame, a GNC cycle runs at the scheduled time:
+// (throttled). After frame_resync_count rejected frames in a row, a run of frame_resync_run frames
+// whose times are consistent with each other (increasing, steps of at most max_frame_time_jump_s)
+// re-anchors the base at the last of them (a restarted sensor front end); one frame never does. Without a frame, a GNC cycle runs at the scheduled time:
 // the last cycle's time plus one period per cycle since.
 #pragma once
 
@@ -17,6 +18,7 @@ struct TimeBaseConfig {
   double gnc_period_s{0.1};
   double max_frame_time_jump_s{60.0};
   std::uint32_t frame_resync_count{50};
+  std::uint32_t frame_resync_run{3};  // >= 1
   std::int64_t event_interval_ns{0};  // throttle of the frame-rejected events
 };
 
@@ -50,6 +52,8 @@ class FrameTimeBase {
   bool have_frame_t_{false};
   double last_frame_t_{0.0};
   std::uint32_t consecutive_rejects_{0};
+  std::uint32_t resync_run_{0};  // consistent candidate frames so far
+  double resync_t_{0.0};        // time of the last candidate
   bool have_gnc_t_{false};
   double last_gnc_t_{0.0};
   std::uint32_t cycles_missed_{0};

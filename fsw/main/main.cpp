@@ -25,6 +25,7 @@
 #include "fsw/bus/bus_mapping.hpp"
 #include "fsw/bus/flight_node.hpp"
 #include "config/config_files.hpp"
+#include "fsw/auth/key_file.hpp"
 #include "fsw/computer/flight_computer.hpp"
 #include "fsw/executive/clock.hpp"
 #include "hal/lcm/lcm_ports.hpp"
@@ -135,6 +136,17 @@ int main(int argc, char** argv) {
          "ground messages decoded per base tick; the rest of the tick's are dropped, counted")
       ->check(CLI::Range(1u, 100000u))
       ->capture_default_str();
+  std::string key_file, state_file;
+  bool lab_mode = false;
+  cli.add_option("--key-file", key_file,
+                 "command keys (mode 0600, owner only; made by `rocksteady-ground keygen`): ground "
+                 "commands and uplink chunks must carry their HMAC, acknowledgements carry one");
+  cli.add_option("--state-file", state_file,
+                 "replay-protection state (active key, highest counter per key), restored at start "
+                 "and rewritten whenever it changes (default: <key-file>.state)");
+  cli.add_flag("--lab-mode", lab_mode,
+               "LAB MODE: no keys, commands NOT authenticated (announced by an event, flagged in "
+               "every telemetry packet)");
   double watchdog_ms = 0.0;
   cli.add_option("--watchdog-ms", watchdog_ms,
                  "software watchdog: no GNC cycle for this long -> event 203, all thrusters off, "
@@ -153,6 +165,15 @@ int main(int argc, char** argv) {
       ->group("Fault injection (tests only)");
   CLI11_PARSE(cli, argc, argv);
 
+  if (lab_mode == !key_file.empty()) {
+    std::fprintf(stderr, "rocksteady-fsw: give exactly one of --key-file (authenticated commands) "
+                         "and --lab-mode (no authentication)\n");
+    return 2;
+  }
+  if (lab_mode && !state_file.empty()) {
+    std::fprintf(stderr, "rocksteady-fsw: --state-file needs --key-file\n");
+    return 2;
+  }
   if (mission_path.empty()) mission_path = config_dir + "/mission.yaml";
   if (gnc_path.empty()) gnc_path = config_dir + "/gnc.yaml";
 
@@ -164,6 +185,24 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  fc.security.lab_mode = lab_mode;
+  if (!lab_mode) {
+    if (const std::string err = fsw::auth::load_key_file(key_file, fc.security.keys); !err.empty()) {
+      std::fprintf(stderr, "rocksteady-fsw: %s\n", err.c_str());
+      return 2;
+    }
+    if (state_file.empty()) state_file = key_file + ".state";
+    bool missing = false;
+    if (const std::string err = fsw::auth::load_state_file(state_file, fc.security, missing);
+        !err.empty()) {
+      std::fprintf(stderr, "rocksteady-fsw: %s\n", err.c_str());
+      return 2;
+    }
+    std::printf("rocksteady-fsw: %d command key(s) loaded%s\n", fc.security.keys.count,
+                missing ? ", no state file yet (first start)" : ", replay state restored");
+  } else {
+    std::printf("rocksteady-fsw: LAB MODE: ground commands are NOT authenticated\n");
+  }
   if (!law_name.empty() && !parse_law(law_name, fc.gnc.law)) {
     std::fprintf(stderr, "rocksteady-fsw: unknown law '%s'\n", law_name.c_str());
     return 2;
@@ -296,6 +335,7 @@ int main(int argc, char** argv) {
   {
     bus::FlightNode node(lcm, computer, sensors, thrusters, clock);
     node.set_ground_bus(ground);
+    if (!lab_mode) node.set_state_file(state_file);
     rocksteady::rt::UdpmReceiver direct;
     if (direct_rx) {
       const char* env = std::getenv("LCM_DEFAULT_URL");

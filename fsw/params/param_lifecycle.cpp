@@ -50,6 +50,25 @@ CommandCheck ParamLifecycle::load(const GroundCommand& cmd, EventLog& log) {
   return CommandCheck{};
 }
 
+CommandCheck ParamLifecycle::load_identified(const gnc::Gnc& core, EventLog& log) {
+  gnc::IdentifiedModel m;
+  const gnc::ModelCandidate c = core.identified_model(m);
+  if (c != gnc::ModelCandidate::kOk) {
+    return CommandCheck{RejectReason::kInvalidTable, static_cast<std::int32_t>(c),
+                        gnc::to_string(c)};
+  }
+  const ParamLoadResult r = table_.load_model(m.j, m.r, m.k);
+  if (!r.ok()) {
+    log.emit(Severity::kWarning, EventId::kModelRefused, 0, 0,
+             "identified model refused: %s %s", r.text, r.why);
+    return CommandCheck{r.reason, r.detail, r.text};
+  }
+  ++loads_;
+  log.emit(Severity::kInfo, EventId::kModelLoaded, 0, 0,
+           "identified model loaded into the inactive table (activate to fly it)");
+  return CommandCheck{};
+}
+
 CommandCheck ParamLifecycle::check_stage() const {
   if (table_.staged())
     return CommandCheck{RejectReason::kBusy, 0, "an activation is already pending"};
@@ -59,6 +78,12 @@ CommandCheck ParamLifecycle::check_stage() const {
 }
 
 CommandCheck ParamLifecycle::discard(const gnc::GncParams& active, EventLog& log) {
+  // An activation already accepted for the next tick boundary goes through: the discard is refused
+  // (never acknowledged while the table it claims to drop is still activated).
+  if (table_.staged()) {
+    return CommandCheck{RejectReason::kBusy, 0,
+                        "an activation is pending at the next tick: nothing to discard"};
+  }
   if (!table_.loaded())
     return CommandCheck{RejectReason::kNothingToActivate, 0, "no parameter load"};
   table_.discard(active);

@@ -18,6 +18,9 @@ class ParamLifecycle {
   void reset(const gnc::GncParams& active);
 
   CommandCheck load(const GroundCommand& cmd, EventLog& log);
+  // PARAM_LOAD_IDENTIFIED: the core's identified model (J_tot, r_SO/BCM, confident strengths) into
+  // the inactive table, validated like any load; the ground then activates it (PARAM_ACTIVATE).
+  CommandCheck load_identified(const gnc::Gnc& core, EventLog& log);
   // May the inactive table be staged for the next boundary? Then stage it (the caller queues the
   // activation in between).
   CommandCheck check_stage() const;

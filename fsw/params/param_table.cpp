@@ -208,6 +208,17 @@ ParamLoadResult ParamTable::load(std::int32_t id, const double* values, int n) {
   return ParamLoadResult{};
 }
 
+ParamLoadResult ParamTable::load_model(const gnc::Mat3& j_tot, const gnc::Vec3& r,
+                                       const gnc::Vec16& k) {
+  scratch_ = gnc::with_model(inactive_, j_tot, r, k);
+  const gnc::ParamCheck c = gnc::validate(scratch_);
+  if (!c.ok) return ParamLoadResult{RejectReason::kInvalidTable, 0, c.field, c.reason};
+  inactive_ = scratch_;
+  loaded_ = true;
+  ++loads_;
+  return ParamLoadResult{};
+}
+
 bool ParamTable::stage() {
   if (!loaded_) return false;
   staged_table_ = inactive_;

@@ -80,6 +80,8 @@ class ParamTable {
   // Loads into a copy of the inactive table and validates the whole copy; only a valid copy
   // becomes the inactive table (the inactive table is always valid).
   ParamLoadResult load(std::int32_t id, const double* values, int n);
+  // The same for a whole model: J_tot, r_SO/BCM and thruster strengths (gnc::with_model).
+  ParamLoadResult load_model(const gnc::Mat3& j_tot, const gnc::Vec3& r, const gnc::Vec16& k);
   bool loaded() const { return loaded_; }
   const gnc::GncParams& inactive() const { return inactive_; }
 

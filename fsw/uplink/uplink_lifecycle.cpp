@@ -2,6 +2,11 @@
 
 #include <cinttypes>
 
+#include <Eigen/Eigenvalues>
+
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
+
 namespace rocksteady::fsw {
 
 void UplinkLifecycle::reset() {
@@ -38,7 +43,49 @@ ChunkStatus UplinkLifecycle::receive(const TrajectoryChunk& chunk, EventLog& log
   return r.status;
 }
 
-CommandCheck UplinkLifecycle::request_load(std::int32_t id, double eps_trans, EventLog& log) {
+namespace {
+
+// Beyond gnc::validate_trajectory (samples only): what the flight will actually follow.
+//  - |omega_d_dot| at every sample at most the largest angular acceleration the thrusters can give
+//    the body: sum of the torque columns' norms times u_max over lambda_min(J_hat) (Eqs. 1, 5); a
+//    plan asking for more cannot be tracked (the finding: +-1 rad/s^2 drove |omega_r| to 9.9 rad/s);
+//  - |omega_d| of the cubic Hermite interpolation the reference uses (gnc::interpolate) between
+//    samples, at kProbes points per interval, within eps_trans (1% for a plan that rides the bound).
+constexpr int kProbes = 16;
+constexpr double kInterpolationSlack = 1.01;
+
+const char* dynamics_error(const gnc::TrajectoryTable& t, const gnc::GncParams& p) {
+  const gnc::Mat3 j = gnc::total_inertia(p.mass_hat);
+  const Eigen::SelfAdjointEigenSolver<gnc::Mat3> es(j, Eigen::EigenvaluesOnly);
+  const double j_min = es.eigenvalues()(0);
+  const auto b = gnc::torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
+  double tau_max = 0.0;
+  for (int i = 0; i < b.cols(); ++i) tau_max += b.col(i).norm() * p.rcs.u_max;
+  const double alpha_max = j_min > 0.0 ? tau_max / j_min : 0.0;
+  const double eps = p.guidance.eps_trans * kInterpolationSlack;
+  for (int i = 0; i < t.count; ++i) {
+    if (t.samples[static_cast<std::size_t>(i)].omega_d_dot.norm() > alpha_max) {
+      return "omega_d_dot above what the thrusters can produce";
+    }
+  }
+  for (int i = 0; i + 1 < t.count; ++i) {
+    const double t0 = t.samples[static_cast<std::size_t>(i)].t;
+    const double t1 = t.samples[static_cast<std::size_t>(i + 1)].t;
+    for (int k = 1; k < kProbes; ++k) {
+      const double tk = t0 + (t1 - t0) * static_cast<double>(k) / kProbes;
+      if (gnc::interpolate(t, tk).omega_d.norm() > eps) {
+        return "interpolated omega_d exceeds eps_trans between samples";
+      }
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+CommandCheck UplinkLifecycle::request_load(std::int32_t id, const gnc::GncParams& params,
+                                           EventLog& log) {
+  const double eps_trans = params.guidance.eps_trans;
   if (!uplink_.active() || uplink_.upload_id() != id) {
     return CommandCheck{RejectReason::kOutOfRange, 0, "no uplink with that id"};
   }
@@ -56,6 +103,14 @@ CommandCheck UplinkLifecycle::request_load(std::int32_t id, double eps_trans, Ev
     uplink_.clear();
     return CommandCheck{RejectReason::kTrajectoryRejected, static_cast<std::int32_t>(e),
                         gnc::to_string(e)};
+  }
+  if (const char* why = dynamics_error(uplink_.table(), params); why != nullptr) {
+    log.emit(Severity::kWarning, EventId::kTrajectoryRejected, id,
+             static_cast<std::int32_t>(gnc::TrajectoryError::kRateAboveBound),
+             "trajectory uplink %" PRId32 " rejected: %s; uplink discarded", id, why);
+    uplink_.clear();
+    return CommandCheck{RejectReason::kTrajectoryRejected,
+                        static_cast<std::int32_t>(gnc::TrajectoryError::kRateAboveBound), why};
   }
   uplink_.set_pending(true);
   return CommandCheck{};

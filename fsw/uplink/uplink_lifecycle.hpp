@@ -19,7 +19,8 @@ class UplinkLifecycle {
   ChunkStatus receive(const TrajectoryChunk& chunk, EventLog& log);
   // LOAD_TRAJECTORY: the complete table is finalised and validated now; on success it waits for
   // the boundary (the caller queues the hand-over).
-  CommandCheck request_load(std::int32_t upload_id, double eps_trans, EventLog& log);
+  // The table must pass gnc::validate_trajectory and the dynamics check below.
+  CommandCheck request_load(std::int32_t upload_id, const gnc::GncParams& params, EventLog& log);
   CommandCheck abort(std::int32_t upload_id, EventLog& log);
   // At the tick boundary: hand the table to the core (skipped if the uplink was aborted meanwhile).
   // True when the core took it.

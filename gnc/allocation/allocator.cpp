@@ -1,5 +1,7 @@
 #include "gnc/allocation/allocator.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <Eigen/LU>
@@ -17,6 +19,116 @@ double torque_matrix_rcond(const Mat38& b) {
   const double hi = es.eigenvalues().maxCoeff();
   const double lo = es.eigenvalues().minCoeff();
   return hi > 0.0 && lo > 0.0 ? lo / hi : 0.0;
+}
+
+AllocatorLimits nominal_limits(double u_max) {
+  AllocatorLimits l;
+  l.lo.setConstant(-u_max);
+  l.hi.setConstant(u_max);
+  l.bias.setZero();
+  return l;
+}
+
+namespace {
+
+// Tolerances of the failure-handling path.
+constexpr double kRankTol = 1e-9;   // eigenvalue of B_F B_F' (relative to the largest) counted as 0
+constexpr double kSignTol = 1e-12;  // |u_i| / u_max below this is zero (sign checks)
+constexpr double kSpanTol = 1e-9;   // relative tolerance of the cone test
+constexpr int kMaxPasses = kChannels;
+
+// Eigen-decomposition of a symmetric 3x3 (closed form: no heap, no iteration count).
+struct Sym3 {
+  Mat3 v{Mat3::Identity()};
+  Vec3 lambda{Vec3::Zero()};
+};
+Sym3 eig3(const Mat3& m) {
+  Eigen::SelfAdjointEigenSolver<Mat3> es;
+  es.computeDirect(m);
+  return Sym3{es.eigenvectors(), es.eigenvalues()};
+}
+
+// Rank of the columns of b (as the number of eigenvalues of b b' above kRankTol of the largest).
+int rank_of(const Mat38& b) {
+  const Sym3 e = eig3(b * b.transpose());
+  const double top = e.lambda.cwiseAbs().maxCoeff();
+  if (!(top > 0.0)) return 0;
+  int r = 0;
+  for (int i = 0; i < 3; ++i) r += e.lambda(i) > kRankTol * top ? 1 : 0;
+  return r;
+}
+
+// Eq. (53) re-derived for the columns of b_f (the others zero): B_F' (B_F B_F')^+, the
+// minimum-norm least-squares inverse (the right inverse when rank 3).
+Mat83 pinv_of(const Mat38& b_f, int& rank) {
+  const Sym3 e = eig3(b_f * b_f.transpose());
+  const double top = e.lambda.cwiseAbs().maxCoeff();
+  rank = 0;
+  Mat3 inv = Mat3::Zero();
+  if (top > 0.0) {
+    for (int i = 0; i < 3; ++i) {
+      if (e.lambda(i) > kRankTol * top) {
+        inv += e.v.col(i) * e.v.col(i).transpose() / e.lambda(i);
+        ++rank;
+      }
+    }
+  }
+  return b_f.transpose() * inv;
+}
+
+// The limits as the allocator uses them: within [-u_max, u_max] and their sign; NaN -> out.
+void clip_limits(const AllocatorLimits& in, double u_max, Vec8& lo, Vec8& hi, Vec3& bias) {
+  for (int i = 0; i < kChannels; ++i) {
+    const double l = in.lo(i), h = in.hi(i);
+    if (std::isnan(l) || std::isnan(h)) {
+      lo(i) = hi(i) = 0.0;
+      continue;
+    }
+    lo(i) = std::min(0.0, std::max(-u_max, l));
+    hi(i) = std::max(0.0, std::min(u_max, h));
+  }
+  bias = in.bias.allFinite() ? in.bias : Vec3::Zero();
+}
+
+}  // namespace
+
+Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
+  Authority a;
+  Mat38 b_act = Mat38::Zero();
+  // The one-way thrust torques the limits allow: +B_i where hi_i > 0, -B_i where lo_i < 0.
+  std::array<Vec3, 2 * kChannels> gen{};
+  int n = 0;
+  for (int i = 0; i < kChannels; ++i) {
+    const bool up = hi(i) > 0.0, down = lo(i) < 0.0;
+    if (!(up || down) || !(b.col(i).norm() > 0.0)) continue;
+    ++a.active_channels;
+    b_act.col(i) = b.col(i);
+    if (up) gen[static_cast<std::size_t>(n++)] = b.col(i);
+    if (down) gen[static_cast<std::size_t>(n++)] = -b.col(i);
+  }
+  a.rank = rank_of(b_act);
+  if (a.rank < 3) return a;
+  // The cone of the generators is R^3 unless some y != 0 has y'g >= 0 for every generator g; the
+  // extreme rays of that dual cone are orthogonal to two independent generators, so it is enough to
+  // try y = +-(g_a x g_b) over the pairs.
+  for (int p = 0; p < n; ++p) {
+    for (int q = p + 1; q < n; ++q) {
+      const Vec3& ga = gen[static_cast<std::size_t>(p)];
+      const Vec3& gb = gen[static_cast<std::size_t>(q)];
+      const Vec3 y = ga.cross(gb);
+      if (!(y.norm() > kSpanTol * ga.norm() * gb.norm())) continue;
+      for (const double sign : {1.0, -1.0}) {
+        bool separates = true;
+        for (int j = 0; j < n && separates; ++j) {
+          const Vec3& g = gen[static_cast<std::size_t>(j)];
+          separates = sign * y.dot(g) >= -kSpanTol * y.norm() * g.norm();
+        }
+        if (separates) return a;  // a half-space holds every generator: spans is false
+      }
+    }
+  }
+  a.spans = true;
+  return a;
 }
 
 const char* to_string(AllocatorKind k) {
@@ -69,6 +181,84 @@ void Allocator::allocate(const Vec3& u_c, Vec8& u, AllocatorStatus& status) cons
     }
   }
   status.torque_achieved = b_hat_ * u;
+}
+
+void Allocator::allocate(const Vec3& u_c, const AllocatorLimits& limits, Vec8& u,
+                         AllocatorStatus& status) const {
+  Vec8 lo, hi;
+  Vec3 bias;
+  clip_limits(limits, u_max_, lo, hi, bias);
+  status.torque_requested = u_c;
+  status.l1_fallback = false;
+  status.l1_iterations = 0;
+  if ((lo.array() == -u_max_).all() && (hi.array() == u_max_).all() && (bias.array() == 0.0).all()) {
+    allocate(u_c, u, status);  // nominal: the study's allocation, bit for bit
+    status.active_channels = kChannels;
+    status.rank = 3;
+    status.reduced_authority = false;
+    status.impossible = false;
+    status.shortfall = u_c - status.torque_achieved;
+    return;
+  }
+  const Authority auth = authority(b_hat_, lo, hi);
+  status.active_channels = static_cast<std::uint8_t>(auth.active_channels);
+  status.rank = static_cast<std::uint8_t>(auth.rank);
+  status.reduced_authority = !auth.spans;
+  status.impossible = auth.rank == 0;
+
+  // The channels' torque: what u_c asks beyond the bias.
+  const Vec3 tau = u_c - bias;
+  u.setZero();
+  std::array<bool, kChannels> free{};
+  for (int i = 0; i < kChannels; ++i) free[static_cast<std::size_t>(i)] = lo(i) < hi(i);
+  const double sign_tol = kSignTol * u_max_;
+  int rank = 0;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    Mat38 b_f = Mat38::Zero();
+    for (int i = 0; i < kChannels; ++i) {
+      if (free[static_cast<std::size_t>(i)]) b_f.col(i) = b_hat_.col(i);
+    }
+    u = pinv_of(b_f, rank) * tau;  // Eq. (53) for the free channels
+    // A channel pushed the way its interval forbids (e.g. the "+" half of a failed thruster) stays
+    // at zero; the others take over.
+    bool changed = false;
+    for (int i = 0; i < kChannels; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (!free[k]) continue;
+      if ((u(i) > sign_tol && !(hi(i) > 0.0)) || (u(i) < -sign_tol && !(lo(i) < 0.0))) {
+        free[k] = false;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  for (int i = 0; i < kChannels; ++i) {
+    if (!free[static_cast<std::size_t>(i)]) u(i) = 0.0;
+  }
+  // Direction-preserving rescale into the box (SPEC §4's rescale, for asymmetric bounds).
+  double scale = 1.0;
+  for (int i = 0; i < kChannels; ++i) {
+    if (u(i) > hi(i)) scale = std::min(scale, hi(i) / u(i));
+    if (u(i) < lo(i)) scale = std::min(scale, lo(i) / u(i));
+  }
+  scale = std::max(0.0, scale);
+  u *= scale;
+  for (int i = 0; i < kChannels; ++i) u(i) = std::min(hi(i), std::max(lo(i), u(i)));  // rounding
+  status.saturated = scale < 1.0;
+  status.scale = scale;
+  if (kind_ == AllocatorKind::kL1) {
+    // Eq. (52) within the same bounds for the torque the pseudoinverse's forces make (attainable:
+    // those forces attain it).
+    const L1Solution s = l1_.solve(b_hat_ * u, lo, hi);
+    status.l1_iterations = s.iterations;
+    if (s.ok && s.u.lpNorm<1>() <= u.lpNorm<1>() * (1.0 + 1e-12) + 1e-12 * u_max_) {
+      u = s.u;
+    } else {
+      status.l1_fallback = true;
+    }
+  }
+  status.torque_achieved = b_hat_ * u + bias;
+  status.shortfall = u_c - status.torque_achieved;
 }
 
 }  // namespace rocksteady::gnc

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "gnc/allocation/l1_allocation.hpp"
 #include "gnc/types.hpp"
@@ -18,14 +19,40 @@ enum class AllocatorKind : std::uint8_t {
 inline constexpr int kAllocatorKindCount = 2;
 const char* to_string(AllocatorKind k);  // "pinv", "l1"
 
+// What each channel may still do, and the torque nobody commands (failure handling). Per channel an
+// asymmetric interval [lo_i, hi_i], lo_i <= 0 <= hi_i, of *effective* force (the force the channel's
+// torque column B_i multiplies): a failed or isolated "+" thruster gives hi_i = 0, a pod behind a
+// closed latch valve gives lo = hi = 0 on both its channels (the channel is out), a "+" thruster of
+// strength k gives hi_i = k u_max (the caller divides by k when it commands that thruster).
+// `bias` is a known torque the channels do not control, e.g. a stuck-on thruster's B_i u_max until
+// its valve closes: the allocator makes B_hat u + bias ~ u_c. Bounds are clipped to the allocator's
+// [-u_max, u_max] (so the default +-infinity means the whole channel) and to their sign
+// (lo_i <= 0 <= hi_i); a NaN bound takes the channel out, a non-finite bias counts as zero.
+struct AllocatorLimits {
+  Vec8 lo{Vec8::Constant(-std::numeric_limits<double>::infinity())};  // N
+  Vec8 hi{Vec8::Constant(std::numeric_limits<double>::infinity())};   // N
+  Vec3 bias{Vec3::Zero()};                                            // N m
+};
+// Every channel whole, no bias: the limits of a healthy RCS at u_max.
+AllocatorLimits nominal_limits(double u_max);
+
 struct AllocatorStatus {
   Vec3 torque_requested{Vec3::Zero()};  // u_c
-  Vec3 torque_achieved{Vec3::Zero()};   // B_hat u after the rescale
+  Vec3 torque_achieved{Vec3::Zero()};   // B_hat u after the rescale, plus the limits' bias
   bool saturated{false};                // the rescale was active this tick
   double scale{1.0};                    // u_max / |u|_inf when saturated, else 1
   // kL1 only: the linear program could not certify a solution and the pseudoinverse's forces flew.
   bool l1_fallback{false};
   std::uint16_t l1_iterations{0};  // kL1 only: simplex iterations, both phases
+  // Authority left by the limits (always full with nominal limits):
+  std::uint8_t active_channels{kChannels};  // channels with lo_i < hi_i
+  std::uint8_t rank{3};                     // rank of their torque columns
+  // Some torque direction cannot be produced: rank < 3, or the cone of the usable one-way thrust
+  // torques (+B_i where hi_i > 0, -B_i where lo_i < 0) does not span R^3. Control goes on with the
+  // best achievable torque.
+  bool reduced_authority{false};
+  bool impossible{false};              // no channel left (rank 0): no control at all
+  Vec3 shortfall{Vec3::Zero()};        // u_c - torque_achieved
 };
 
 class Allocator {
@@ -37,6 +64,14 @@ class Allocator {
   // Eq. (53) plus rescale; with kL1, then Eq. (52) for the same (rescaled) torque, so both kinds
   // achieve the same torque and kL1 never spends more |u|_1. Writes channel forces and the status.
   void allocate(const Vec3& u_c, Vec8& u, AllocatorStatus& status) const;
+  // The same under per-channel limits and a bias torque (failures): B_hat u + bias ~ u_c with
+  // lo <= u <= hi. Eq. (53) re-derived for the active channels, B_F' (B_F B_F')^+ (least squares
+  // when they span less than R^3); a channel whose force would take a sign its interval forbids is
+  // set to zero and the rest re-solved (at most 8 passes); then the whole vector is scaled to fit
+  // the box, which keeps the direction of the channels' torque u_c - bias. kL1: then Eq. (52) for
+  // that torque within the same bounds. Nominal limits give exactly allocate(u_c, u, status).
+  void allocate(const Vec3& u_c, const AllocatorLimits& limits, Vec8& u,
+                AllocatorStatus& status) const;
   AllocatorKind kind() const { return kind_; }
   const Mat38& b_hat() const { return b_hat_; }
   const Mat83& pinv() const { return pinv_; }
@@ -52,6 +87,15 @@ class Allocator {
 
 // Reciprocal condition number of B B' (0 when rank-deficient); used by parameter validation.
 double torque_matrix_rcond(const Mat38& b);
+
+// The authority the limits leave (independent of the torque asked): how many channels are active,
+// the rank of their columns, and whether the cone of their one-way thrust torques spans R^3.
+struct Authority {
+  int active_channels{0};
+  int rank{0};
+  bool spans{false};  // every torque direction can be produced (full authority, in direction)
+};
+Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi);
 
 // Eq. (54): fuel mass flow, kg/s, for channel forces u.
 inline double fuel_rate(const Vec8& u, double isp_s, double g0) {

@@ -87,7 +87,7 @@ bool run_phase(Lp& lp, const Vec3& tau) {
     double violation = 0.0;
     for (int j = 0; j < kStructural; ++j) {
       const auto k = static_cast<std::size_t>(j);
-      if (lp.basic[k]) continue;
+      if (lp.basic[k] || !(lp.ub[k] > 0.0)) continue;  // a variable fixed at zero never enters
       const double d = lp.cost(j) - y.dot(lp.column(j));
       const double v = lp.upper[k] ? d : -d;  // > 0: moving off the bound lowers the cost
       if (v > kCostTol && v > violation) {
@@ -162,9 +162,19 @@ bool L1Allocation::configure(const Mat38& b_hat, double u_max, Pricing pricing) 
 
 // Eq. (52): min |u|_1 s.t. B_hat u = tau, |u|_inf <= u_max.
 L1Solution L1Allocation::solve(const Vec3& tau) const {
+  return solve(tau, Vec8::Constant(-u_max_), Vec8::Constant(u_max_));
+}
+
+// Eq. (52) with per-channel bounds: u+_i in [0, hi_i], u-_i in [0, -lo_i].
+L1Solution L1Allocation::solve(const Vec3& tau, const Vec8& lo, const Vec8& hi) const {
   L1Solution out;
-  if (!(u_max_ > 0.0) || !tau.allFinite()) return out;
+  if (!(u_max_ > 0.0) || !tau.allFinite() || !lo.allFinite() || !hi.allFinite()) return out;
   const Vec3 tau_s = tau / (u_max_ * b_scale_);
+  std::array<double, kStructural> bound{};
+  for (int i = 0; i < kChannels; ++i) {
+    bound[static_cast<std::size_t>(i)] = std::min(1.0, std::max(0.0, hi(i) / u_max_));
+    bound[static_cast<std::size_t>(i + kChannels)] = std::min(1.0, std::max(0.0, -lo(i) / u_max_));
+  }
 
   Lp lp;
   lp.a = &b_scaled_;
@@ -174,7 +184,7 @@ L1Solution L1Allocation::solve(const Vec3& tau) const {
     const auto k = static_cast<std::size_t>(j);
     lp.basic[k] = j >= kStructural;
     lp.upper[k] = false;
-    lp.ub[k] = j < kStructural ? 1.0 : kInf;
+    lp.ub[k] = j < kStructural ? bound[k] : kInf;
   }
   lp.basis = {kStructural, kStructural + 1, kStructural + 2};
 
@@ -206,14 +216,15 @@ L1Solution L1Allocation::solve(const Vec3& tau) const {
   for (int r = 0; r < 3; ++r)
     x[static_cast<std::size_t>(lp.basis[static_cast<std::size_t>(r)])] = xb(r);
   for (int j = 0; j < kVars; ++j) {
-    const double hi = j < kStructural ? 1.0 : 0.0;
+    const double top = j < kStructural ? bound[static_cast<std::size_t>(j)] : 0.0;
     const double v = x[static_cast<std::size_t>(j)];
-    if (!(v >= -kFeasTol && v <= hi + kFeasTol)) return out;
+    if (!(v >= -kFeasTol && v <= top + kFeasTol)) return out;
   }
   Vec8 v;
   for (int i = 0; i < kChannels; ++i) {
     const double d = x[static_cast<std::size_t>(i)] - x[static_cast<std::size_t>(i + kChannels)];
-    v(i) = std::min(1.0, std::max(-1.0, d));
+    v(i) = std::min(bound[static_cast<std::size_t>(i)],
+                    std::max(-bound[static_cast<std::size_t>(i + kChannels)], d));
   }
   if ((b_scaled_ * v - tau_s).lpNorm<Eigen::Infinity>() > kFeasTol) return out;
   out.u = u_max_ * v;

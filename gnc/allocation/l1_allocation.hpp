@@ -41,6 +41,9 @@ class L1Allocation {
   bool configure(const Mat38& b_hat, double u_max, Pricing pricing = Pricing::kDantzigThenBland);
   // Eq. (52) for the torque `tau` (N m).
   L1Solution solve(const Vec3& tau) const;
+  // Eq. (52) with per-channel asymmetric bounds lo_i <= u_i <= hi_i (lo_i <= 0 <= hi_i, |.| <=
+  // u_max; a channel with lo_i = hi_i = 0 is out): min |u|_1 s.t. B_hat u = tau.
+  L1Solution solve(const Vec3& tau, const Vec8& lo, const Vec8& hi) const;
 
  private:
   Mat38 b_scaled_{Mat38::Zero()};  // B_hat / b_scale_

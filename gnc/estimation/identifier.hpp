@@ -24,10 +24,6 @@
 
 namespace rocksteady::gnc {
 
-// Sixteen physical thrusters: thruster 2c fires channel c's "+" direction, 2c+1 its "-" (SPEC §4).
-inline constexpr int kThrusters = 2 * kChannels;
-
-using Vec16 = Eigen::Matrix<double, kThrusters, 1>;
 using Mat16 = Eigen::Matrix<double, kThrusters, kThrusters>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat316 = Eigen::Matrix<double, 3, kThrusters>;
@@ -271,6 +267,23 @@ class Identifier {
   IdentifierExcitation exc_{};
   IdentifierObservability obs_{};
   IdentifierCounters counters_{};
+};
+
+// How an identified model reaches the flight: through the parameter table, at a tick boundary,
+// only when the confidence test passes (DESIGN.md "Modes": tables switch at a boundary).
+enum class ModelAdoption : std::uint8_t {
+  kOff = 0,   // estimate and report only; the ground adopts by command
+  kAuto = 1,  // the core adopts a confident, changed model itself (never faster than the interval)
+};
+inline constexpr int kModelAdoptionCount = 2;
+
+struct IdentificationParams {
+  bool enabled{false};  // run the identifier in the tick
+  ModelAdoption adopt{ModelAdoption::kOff};
+  double adopt_interval_s{300.0};  // s, at least this long between two automatic adoptions
+  // The identifier's tuning. Its dt, thruster geometry and priors (j0, r0, k0) are not read from
+  // here: they are the active table's dt, rcs and mass_hat, filled in by build_identifier_config.
+  IdentifierConfig config{};
 };
 
 }  // namespace rocksteady::gnc

@@ -9,7 +9,12 @@
 
 namespace rocksteady::gnc {
 
-enum class EstimatorKind : std::uint8_t { kPassThrough = 0, kFilter = 1 };
+enum class EstimatorKind : std::uint8_t {
+  kPassThrough = 0,  // perfect sensors: the estimate is the measurement
+  kFilter = 1,       // SPEC §6
+  kMekf = 2,         // multiplicative EKF with gyro bias (gnc/estimation/mekf.hpp)
+};
+inline constexpr int kEstimatorKindCount = 3;
 
 struct EstimatorParams {  // SPEC §6
   EstimatorKind kind{EstimatorKind::kPassThrough};

@@ -15,6 +15,9 @@ struct RcsLayout {
   std::array<Vec3, kChannels> channel_direction{};
   std::array<int, kChannels> channel_pod{};  // which pod each channel belongs to
   double u_max{200.0};                        // per-channel force limit, N
+  // Strength factor k_i of each physical thruster (index 2c "+", 2c+1 "-" of channel c): the force
+  // it produces per newton commanded. 1 = as calibrated; the identifier's estimate once adopted.
+  Vec16 strength{Vec16::Ones()};
 };
 
 // The SPEC §4 conceptual layout: pods at azimuth 45/135/225/315 deg, radius `radius`, plane z = `z`.

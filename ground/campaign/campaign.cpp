@@ -1,6 +1,7 @@
 #include "ground/campaign/campaign.hpp"
 
 #include <nlohmann/json.hpp>
+#include "ground/campaign/estimation_report.hpp"
 #include "ground/campaign/fsw_flight_side.hpp"
 
 #include <unistd.h>
@@ -105,6 +106,7 @@ void write_results_json(const std::string& path, const CampaignReport& rep) {
                     {"strategy", r.strategy},
                     {"status", to_string(r.status)},
                     {"note", r.note},
+                    {"faults", r.faults},
                     {"t_omega_conv_s", opt(r.t_omega_conv_s)},
                     {"fuel_at_t_omega_kg", opt(r.fuel_at_t_omega_kg)},
                     {"t_q_conv_s", opt(r.t_q_conv_s)},
@@ -121,6 +123,8 @@ void write_results_json(const std::string& path, const CampaignReport& rep) {
                     {"simulated_s", r.sim_s},
                     {"wall_s", r.wall_s},
                     {"plan_wall_s", r.plan_wall_s},
+                    {"estimation", estimation_json(r.estimation)},
+                    {"fdi", fdi_json(r.fdi)},
                     {"timeseries", r.timeseries_path},
                     {"plot", r.plot_path}});
   }
@@ -139,7 +143,7 @@ void write_runs_csv(const std::string& path, const std::vector<RunResult>& resul
   std::ofstream out = open_out(path);
   out << "case,strategy,status,note,final_mode,final_rate_rad_s,final_q_error,fuel_estimate_kg,"
          "ticks,allocator_saturated_ticks,plant_clipped_ticks,simulated_s,wall_s,plan_wall_s,"
-         "timeseries,plot\n";
+         "timeseries,plot,faults\n";
   for (const RunResult& r : results) {
     std::string note = r.note;
     std::replace(note.begin(), note.end(), ',', ';');
@@ -148,7 +152,8 @@ void write_runs_csv(const std::string& path, const std::vector<RunResult>& resul
         << r.final_mode << "," << fmt_g(r.final_rate_rad_s) << "," << fmt_g(r.final_q_error) << ","
         << fmt(r.fuel_hat_kg, 4) << "," << r.ticks << "," << r.saturated_ticks << ","
         << r.clipped_ticks << "," << fmt(r.sim_s, 1) << "," << fmt(r.wall_s, 3) << ","
-        << fmt(r.plan_wall_s, 3) << "," << r.timeseries_path << "," << r.plot_path << "\n";
+        << fmt(r.plan_wall_s, 3) << "," << r.timeseries_path << "," << r.plot_path << ","
+        << r.faults << "\n";
   }
 }
 
@@ -301,7 +306,7 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
   const config::GncConfig gnc_cfg = config::load_gnc(spec.gnc_file);
   std::vector<config::RunSetup> setups;
   for (const std::string& f : spec.case_files) {
-    setups.push_back(config::assemble(mission, gnc_cfg, config::load_case(f)));
+    setups.push_back(config::load_case_run(mission, gnc_cfg, f));
     rep.cases.push_back(setups.back().case_name);
   }
   for (const Strategy& s : spec.strategies) rep.strategies.push_back(s.name);

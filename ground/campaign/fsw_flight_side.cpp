@@ -20,6 +20,9 @@ void FswFlightSide::setup(const FlightSetup& s, hal::SensorSource& sensors,
   fsw::FlightConfig cfg;
   cfg.gnc = s.params;
   cfg.executive = fsw::lockstep_executive(s.params.dt);
+  // In process, no bus: the campaign is the only commander of this computer. Lab mode (explicit,
+  // flagged in its telemetry); the bus's authentication is tested in tests/fsw and tests/pil.
+  cfg.security.lab_mode = true;
   const fsw::InitResult r = computer_->init(fsw::default_computer_config(cfg), clock_);
   if (!r.ok) {
     throw std::runtime_error(std::string("flight software rejected parameter ") + r.field + ": " +

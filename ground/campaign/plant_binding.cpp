@@ -12,6 +12,7 @@ bool PlantBinding::poll(hal::RawSensors& out) {
 
 void PlantBinding::write(const hal::ThrusterOutputs& outputs, std::int64_t seq, double /*t*/) {
   thrusters_ = outputs;
+  plant_.receive(outputs);
   last_seq_ = seq;
   ++writes_;
 }

@@ -17,11 +17,13 @@ class PlantBinding final : public hal::SensorSource, public hal::ThrusterSink {
 
   // The plant's frame for the current period, once per period.
   bool poll(hal::RawSensors& out) override;
-  // Holds the firing for the next advance().
+  // Hands the firing (and the latch-valve commands) to the plant's valve driver, which holds it for
+  // the next advance().
   void write(const hal::ThrusterOutputs& outputs, std::int64_t seq, double t) override;
 
-  // One control period of the plant with the thrusters last written (all off before any write).
-  void advance() { plant_.advance(thrusters_); }
+  // One control period of the plant with the thrusters last written (all off before any write; all
+  // off as well once the plant's command timeout, if set, has passed without a write).
+  void advance() { plant_.advance(); }
 
   const hal::ThrusterOutputs& thrusters() const { return thrusters_; }
   // The signed channel forces of that firing, by the plant's own wiring.

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <exception>
 
+#include "gnc/estimation/identifier.hpp"
+#include "gnc/math/rotation.hpp"
 #include "ground/campaign/plant_binding.hpp"
 #include "ground/plant/plant.hpp"
 
@@ -22,6 +24,12 @@ const char* to_string(RunStatus s) {
 gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& strategy) {
   gnc::GncParams p = setup.flight;
   p.law = strategy.law;
+  if (strategy.mekf) p.estimator.kind = gnc::EstimatorKind::kMekf;
+  if (strategy.identify) {
+    p.identification.enabled = true;
+    p.identification.adopt = gnc::ModelAdoption::kAuto;
+  }
+  if (strategy.fdi) p.fdi.enabled = true;
   return p;
 }
 
@@ -32,6 +40,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   r.case_name = setup.case_name;
   r.case_number = setup.case_number;
   r.strategy = strategy.name;
+  r.faults = plant::describe(setup.truth.faults);
   if (strategy.needs_trajectory() && trajectory == nullptr) {
     r.status = RunStatus::kNoReference;
     r.note = no_reference_note;
@@ -83,10 +92,86 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   q_conv.add(0.0, attitude_error(plant.mrp(), q_final), 0.0);
   r.max_rate_rad_s = plant.omega().norm();
 
+  // Estimation against the truth: the estimate of tick k belongs to the state before the plant
+  // advances.
+  EstimationReport& est = r.estimation;
+  est.estimator = fs.params.estimator.kind == gnc::EstimatorKind::kMekf     ? "mekf"
+                  : fs.params.estimator.kind == gnc::EstimatorKind::kFilter ? "filter"
+                                                                            : "passthrough";
+  est.identifying = fs.params.identification.enabled;
+  const double marks[] = {60.0, 300.0, 1000.0, 3000.0};
+  std::size_t next_mark = 0;
+  if (est.identifying) {
+    for (double m : marks) est.marks.push_back(IdentificationMark{m});
+  }
+  const Eigen::Matrix3d j_true = plant.inertia();
+  const Eigen::Vector3d r_true = setup.truth.mass.r_so_bcm;
+  const gnc::Vec16 k_true = setup.truth.thruster_strength;
+  double sq_att = 0.0;
+  double sq_rate = 0.0;
+  std::uint64_t n_est = 0;
+  auto score_estimate = [&](const gnc::GncOutput& o) {
+    const double t = plant.t();
+    if (t >= 60.0) {
+      const gnc::Vec4 qh = gnc::mrp::to_quaternion(o.telemetry.q_hat);
+      const gnc::Vec4& qt = plant.beta();
+      const double c = std::min(1.0, std::fabs(qh.dot(qt)));
+      const double angle = 2.0 * std::atan2(std::sqrt(std::max(0.0, 1.0 - c * c)), c);
+      const double werr = (o.telemetry.omega_hat - plant.omega()).norm();
+      sq_att += angle * angle;
+      sq_rate += werr * werr;
+      est.attitude_max_rad = std::max(est.attitude_max_rad, angle);
+      est.rate_max_rad_s = std::max(est.rate_max_rad_s, werr);
+      ++n_est;
+    }
+    if (next_mark < est.marks.size() && t >= marks[next_mark] - 1e-9) {
+      const gnc::EstimationTelemetry& e = o.telemetry.est;
+      IdentificationMark& m = est.marks[next_mark++];
+      const Eigen::Matrix3d j_hat = gnc::inertia_matrix(e.j);
+      m.reached = true;
+      m.j_rel = (j_hat - j_true).norm() / j_true.norm();
+      m.r_err_m = (e.r - r_true).norm();
+      m.k_max_err = (e.k - k_true).cwiseAbs().maxCoeff();
+      const gnc::Vec6 da = gnc::inertia_params(j_hat) - gnc::inertia_params(j_true);
+      m.j_nees = da.cwiseQuotient(e.j_sigma.cwiseMax(1e-300)).squaredNorm();
+      m.r_nees = (e.r - r_true).cwiseQuotient(e.r_sigma.cwiseMax(1e-300)).squaredNorm();
+      m.inertia_confident = e.inertia_confident;
+      m.offset_confident = e.offset_confident;
+      m.offset_unobservable = e.offset_unobservable;
+    }
+  };
+
   std::uint64_t pending_progress = 0;
   for (std::uint64_t k = 0; k < n_ticks; ++k) {
     flight.step();
     const gnc::GncOutput& out = flight.output();
+    score_estimate(out);
+    if (fs.params.fdi.enabled) {
+      const gnc::FdiTelemetry& f = out.telemetry.fdi;
+      FdiReport& d = r.fdi;
+      d.enabled = true;
+      const double t = plant.t();
+      if (!d.first_suspicion_s && f.suspicions > 0) d.first_suspicion_s = t;
+      const std::uint16_t now = static_cast<std::uint16_t>(f.confirmed_on | f.confirmed_off);
+      if (!d.first_confirmation_s && now != 0) {
+        d.first_confirmation_s = t;
+        for (int i = 0; i < 16; ++i) {
+          if ((now >> i) & 1u) {
+            d.thruster = i;
+            d.kind = ((f.confirmed_on >> i) & 1u) ? "stuck-on" : "stuck-off";
+            break;
+          }
+        }
+      }
+      if (!d.valve_closed_s) {
+        for (bool v : f.valve_open) {
+          if (!v) d.valve_closed_s = t;
+        }
+      }
+      d.confirmed_on = f.confirmed_on;
+      d.confirmed_off = f.confirmed_off;
+      d.suspicions = f.suspicions;
+    }
     if (log_every != 0 && k % log_every == 0) {
       // The row at time t_k: the state, the estimate and the command computed from it.
       record(out);
@@ -125,6 +210,14 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   r.final_rate_rad_s = plant.omega().norm();
   r.final_q_error = attitude_error(plant.mrp(), q_final);
   r.final_mode = gnc::to_string(out.telemetry.mode);
+  if (n_est > 0) {
+    est.attitude_rms_rad = std::sqrt(sq_att / static_cast<double>(n_est));
+    est.rate_rms_rad_s = std::sqrt(sq_rate / static_cast<double>(n_est));
+  }
+  est.model_adoptions = out.telemetry.est.adoptions;
+  for (int i = 0; i < 16; ++i) {
+    r.fdi.confirmations += (((r.fdi.confirmed_on | r.fdi.confirmed_off) >> i) & 1u) ? 1 : 0;
+  }
   r.ticks = plant.ticks();
   r.clipped_ticks = plant.clipped_periods();
   r.sim_s = plant.t();

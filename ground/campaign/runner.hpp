@@ -35,6 +35,48 @@ struct TimeRow {
   gnc::Mode mode{gnc::Mode::kIdle};
 };
 
+// Identification against the truth at one instant (the marks: 60, 300, 1000, 3000 s).
+struct IdentificationMark {
+  double t_s{0.0};
+  bool reached{false};   // the run lasted that long with the identifier on
+  double j_rel{0.0};     // ||J_hat - J||_F / ||J||_F
+  double r_err_m{0.0};   // ||r_hat - r||
+  double k_max_err{0.0}; // max_i |k_hat_i - k_i|
+  // Normalised squared errors with the reported 1 sigma (diagonal): chi-square with 6 and 3 dof
+  // when the sigmas are consistent with the errors.
+  double j_nees{0.0};
+  double r_nees{0.0};
+  bool inertia_confident{false};
+  bool offset_confident{false};
+  int offset_unobservable{0};
+};
+
+// The estimator and the identifier against the truth over one run.
+struct EstimationReport {
+  std::string estimator;           // "passthrough", "filter", "mekf"
+  double attitude_rms_rad{0.0};    // angle between the estimated and the true attitude, t >= 60 s
+  double attitude_max_rad{0.0};
+  double rate_rms_rad_s{0.0};      // |omega_hat - omega|, t >= 60 s
+  double rate_max_rad_s{0.0};
+  bool identifying{false};
+  std::vector<IdentificationMark> marks;
+  std::uint32_t model_adoptions{0};
+};
+
+// Fault detection against the injected truth.
+struct FdiReport {
+  bool enabled{false};
+  std::optional<double> first_suspicion_s;  // first window above the no-fault bound
+  std::optional<double> first_confirmation_s;
+  int thruster{-1};           // first confirmed thruster (flight index 2c "+", 2c+1 "-")
+  std::string kind;           // stuck-on | stuck-off
+  int confirmations{0};       // thrusters confirmed over the run
+  std::uint16_t confirmed_on{0};
+  std::uint16_t confirmed_off{0};
+  std::optional<double> valve_closed_s;
+  std::uint32_t suspicions{0};
+};
+
 enum class RunStatus { kOk, kNoReference, kError };
 const char* to_string(RunStatus s);
 
@@ -44,6 +86,7 @@ struct RunResult {
   std::string strategy;
   RunStatus status{RunStatus::kOk};
   std::string note;
+  std::string faults{"none"};  // the plant's injected thruster faults (plant::describe)
   std::optional<double> t_omega_conv_s;
   std::optional<double> fuel_at_t_omega_kg;
   std::optional<double> t_q_conv_s;
@@ -60,6 +103,8 @@ struct RunResult {
   double sim_s{0.0};
   double wall_s{0.0};
   double plan_wall_s{0.0};
+  EstimationReport estimation;
+  FdiReport fdi;
   std::vector<TimeRow> series;  // decimated
   std::string timeseries_path;
   std::string plot_path;

@@ -2,7 +2,9 @@
 
 namespace rocksteady::campaign {
 
-std::optional<Strategy> parse_strategy(const std::string& name) {
+namespace {
+
+std::optional<Strategy> parse_base(const std::string& name) {
   if (name == "dpd") return Strategy{name, gnc::LawId::kDpd, ReferenceKind::kDpdRef};
   const std::size_t plus = name.find('+');
   if (plus == std::string::npos) return std::nullopt;
@@ -28,6 +30,25 @@ std::optional<Strategy> parse_strategy(const std::string& name) {
     }
   }
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Strategy> parse_strategy(const std::string& name) {
+  const std::size_t colon = name.find(':');
+  std::optional<Strategy> s = parse_base(name.substr(0, colon));
+  if (!s) return std::nullopt;
+  s->name = name;
+  std::size_t at = colon;
+  while (at != std::string::npos) {
+    const std::size_t next = name.find(':', at + 1);
+    const std::string mod = name.substr(at + 1, next == std::string::npos ? next : next - at - 1);
+    bool& flag = mod == "mekf" ? s->mekf : mod == "id" ? s->identify : s->fdi;
+    if ((mod != "mekf" && mod != "id" && mod != "fdi") || flag) return std::nullopt;
+    flag = true;
+    at = next;
+  }
+  return s;
 }
 
 const std::vector<std::string>& study_strategy_names() {

@@ -22,11 +22,17 @@ struct Strategy {
   gnc::LawId law{gnc::LawId::kNtcl};
   ReferenceKind reference{ReferenceKind::kDpdRef};
   PlanHorizon horizon{PlanHorizon::kDefault};
+  // Modifiers beyond the study (name suffixes): ":mekf" flies the MEKF instead of the case's
+  // estimator; ":id" runs the on-line identification with automatic model adoption.
+  bool mekf{false};
+  bool identify{false};
+  bool fdi{false};  // ":fdi": thruster fault detection and isolation on
   bool needs_trajectory() const { return reference == ReferenceKind::kFuelOptimal; }
 };
 
 // Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal,
-// fuel_optimal_study (the fuel-optimal plan with the study's horizon).
+// fuel_optimal_study (the fuel-optimal plan with the study's horizon); optional suffixes ":mekf",
+// ":id" and ":fdi" in any order ("ntcl+dpd_ref:mekf:id", "dpd:id:fdi").
 std::optional<Strategy> parse_strategy(const std::string& name);
 // The six columns of the study's results table, in its order.
 const std::vector<std::string>& study_strategy_names();

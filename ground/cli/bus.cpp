@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "ground/cli/dictionary.hpp"
+#include "ground/cli/ground_auth.hpp"
 #include "wire/codec.hpp"
 #include "wire/uplink.hpp"
 #include "lcmtypes/channels.hpp"
@@ -38,6 +39,10 @@ class AckWaiter {
     rocksteady::cmd_ack_t ack;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), ack, &rx_)) return;
     if (ack.seq == cmd_.seq && ack.sender_id == cmd_.sender_id && ack.opcode == cmd_.opcode) {
+      if (verify_ack(ack) == AckAuth::kForged) {
+        ++forged_;
+        return;
+      }
       if (!matched_) ack_ = ack;
       matched_ = true;
     } else {
@@ -47,12 +52,14 @@ class AckWaiter {
   bool matched() const { return matched_; }
   const rocksteady::cmd_ack_t& ack() const { return ack_; }
   std::uint64_t others() const { return others_; }
+  std::uint64_t forged() const { return forged_; }
   const wire::RxCounters& rx() const { return rx_; }
 
  private:
   rocksteady::ground_cmd_t cmd_;
   rocksteady::cmd_ack_t ack_{};
   bool matched_{false};
+  std::uint64_t forged_{0};
   std::uint64_t others_{0};
   wire::RxCounters rx_{};
 };
@@ -65,6 +72,8 @@ class UplinkWatcher {
     rocksteady::event_t e;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), e)) return;
     if (e.arg0 != id_) return;
+    // Only the flight's authentic events count (a forged uplink_complete must not end the upload).
+    if (verify_event(e) == AckAuth::kForged) return;
     switch (e.id) {
       case kEventUplinkComplete:
         complete_ = true;
@@ -74,13 +83,14 @@ class UplinkWatcher {
         last_rejection_ = Clock::now();
         if (log_ != nullptr) {
           std::fprintf(log_, "chunk rejected: %s\n",
-                       e.text.empty() ? chunk_status_name(e.arg1).c_str() : e.text.c_str());
+                       e.text.empty() ? chunk_status_name(e.arg1).c_str()
+                                      : sanitize_text(e.text).c_str());
         }
         break;
       case kEventUplinkAbandoned:
         abandoned_ = true;
         if (log_ != nullptr)
-          std::fprintf(log_, "uplink abandoned by the flight: %s\n", e.text.c_str());
+          std::fprintf(log_, "uplink abandoned by the flight: %s\n", sanitize_text(e.text).c_str());
         break;
       default:
         break;
@@ -134,13 +144,16 @@ class Monitor {
     rocksteady::event_t e;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), e, &counts_.rx)) return;
     ++counts_.events;
-    show("EVENT " + format_event(e));
+    // With a key: the flight's events are signed; anything else is shown as such.
+    const bool forged = auth_configured() && verify_event(e) == AckAuth::kForged;
+    show(std::string(forged ? "EVENT (unauthenticated) " : "EVENT ") + format_event(e));
   }
   void on_ack(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     rocksteady::cmd_ack_t a;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), a, &counts_.rx)) return;
     ++counts_.acks;
-    show("ACK " + format_ack(a));
+    const bool forged = auth_configured() && verify_ack(a) == AckAuth::kForged;
+    show(std::string(forged ? "ACK (FORGED) " : "ACK ") + format_ack(a));
   }
   const MonitorCounts& counts() const { return counts_; }
 
@@ -217,13 +230,22 @@ int SendResult::exit_code() const {
       return kExitRejected;
     case Outcome::kTimeout:
     case Outcome::kError:
+    case Outcome::kForged:
       return kExitRunFailed;
   }
   return kExitRunFailed;
 }
 
-SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s) {
+SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd_in, double timeout_s) {
   SendResult r;
+  rocksteady::ground_cmd_t cmd = cmd_in;
+  try {
+    authenticate(cmd);
+  } catch (const std::exception& e) {
+    r.error = e.what();
+    return r;
+  }
+  r.lab_mode = auth_lab_mode();
   AckWaiter waiter(cmd);
   lcm::Subscription* sub = lcm.subscribe(channels::kCmdAck, &AckWaiter::on_ack, &waiter);
   if (sub == nullptr) {
@@ -246,13 +268,14 @@ SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, dou
   }
   lcm.unsubscribe(sub);
   r.other_acks = waiter.others();
+  r.forged_acks = waiter.forged();
   r.rx = waiter.rx();
   if (waiter.matched()) {
     r.ack = waiter.ack();
     r.outcome =
         r.ack.accepted != 0 ? SendResult::Outcome::kAccepted : SendResult::Outcome::kRejected;
   } else if (r.error.empty()) {
-    r.outcome = SendResult::Outcome::kTimeout;
+    r.outcome = waiter.forged() > 0 ? SendResult::Outcome::kForged : SendResult::Outcome::kTimeout;
   }
   return r;
 }
@@ -276,8 +299,16 @@ class ParamCatcher {
 };
 }  // namespace
 
-ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s) {
+ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd_in,
+                          double timeout_s) {
   ParamReadback r;
+  rocksteady::ground_cmd_t cmd = cmd_in;
+  try {
+    authenticate(cmd);
+  } catch (const std::exception& e) {
+    r.send.error = e.what();
+    return r;
+  }
   ParamCatcher catcher;
   AckWaiter waiter(cmd);
   lcm::Subscription* tsub = lcm.subscribe(channels::kParams, &ParamCatcher::on_table, &catcher);
@@ -298,13 +329,15 @@ ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, do
   if (tsub != nullptr) lcm.unsubscribe(tsub);
   if (asub != nullptr) lcm.unsubscribe(asub);
   r.send.other_acks = waiter.others();
+  r.send.forged_acks = waiter.forged();
   r.send.rx = waiter.rx();
   if (waiter.matched()) {
     r.send.ack = waiter.ack();
     r.send.outcome = r.send.ack.accepted != 0 ? SendResult::Outcome::kAccepted
                                               : SendResult::Outcome::kRejected;
   } else if (r.send.error.empty()) {
-    r.send.outcome = SendResult::Outcome::kTimeout;
+    r.send.outcome = waiter.forged() > 0 ? SendResult::Outcome::kForged
+                                         : SendResult::Outcome::kTimeout;
   }
   r.have_table = catcher.have();
   r.table = catcher.table();
@@ -352,7 +385,17 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
        ++pass) {
     r.passes_used = pass;
     const std::uint64_t rejections_before = watcher.rejections();
-    for (const rocksteady::trajectory_chunk_t& c : chunks) {
+    for (rocksteady::trajectory_chunk_t& c : chunks) {
+      // Every transmission is a new message: the key's next counter, a new authenticator.
+      try {
+        c.seq = next_counter(options.state_dir, options.sender);
+        authenticate(c);
+      } catch (const std::exception& e) {
+        r.message = e.what();
+        lcm.unsubscribe(ev);
+        lcm.unsubscribe(tlm);
+        return r;
+      }
       if (lcm.publish(channels::kTrajUplink, &c) != 0) {
         r.message = "publishing on " + std::string(channels::kTrajUplink) + " failed";
         lcm.unsubscribe(ev);

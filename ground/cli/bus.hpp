@@ -25,17 +25,21 @@ inline constexpr int kExitRunFailed = 1;
 inline constexpr int kExitUsage = 2;
 
 struct SendResult {
-  enum class Outcome { kAccepted, kRejected, kTimeout, kError };
+  // kForged: acknowledgements of this command arrived, none with a valid downlink authenticator.
+  enum class Outcome { kAccepted, kRejected, kTimeout, kError, kForged };
   Outcome outcome{Outcome::kError};
   rocksteady::cmd_ack_t ack{};  // the matching acknowledgement (accepted / rejected)
   std::string error;            // kError: what failed
   std::uint64_t other_acks{0};  // acknowledgements of other commands seen meanwhile
+  std::uint64_t forged_acks{0};  // acknowledgements of this command that failed authentication
+  bool lab_mode{false};          // the ground is in lab mode: the ack was not authenticated
   wire::RxCounters rx{};   // decode outcomes on RS_CMD_ACK
   int exit_code() const;
 };
 
-// Publishes `cmd` on RS_GROUND_CMD and waits up to `timeout_s` for the cmd_ack_t that echoes its
-// seq, sender and opcode.
+// Authenticates `cmd` (ground_auth.hpp; its seq must be the key's next counter), publishes it on
+// RS_GROUND_CMD and waits up to `timeout_s` for an authentic cmd_ack_t that echoes its seq, sender
+// and opcode. Acknowledgements that fail authentication are counted, never believed.
 SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s);
 
 struct ParamReadback {
@@ -57,6 +61,9 @@ struct UploadOptions {
                                   // and LCM queues 30 messages per subscription
   double wait_s{5.0};             // per pass: how long to wait for uplink_complete
   int passes{3};                  // send every chunk up to this many times (repeats are harmless)
+  // Each chunk sent takes the key's next counter from here (ground_auth.hpp next_counter).
+  std::string state_dir;
+  std::int32_t sender{1};
 };
 
 struct UploadResult {

@@ -5,6 +5,7 @@
 
 #include "ground/cli/bus.hpp"
 #include "ground/cli/commands.hpp"
+#include "ground/cli/ground_auth.hpp"
 #include "ground/cli/monitor_format.hpp"
 #include "ground/cli/sequence_store.hpp"
 
@@ -53,7 +54,7 @@ GateResult CommandGate::send(const std::string& command, const std::vector<std::
       throw std::runtime_error(
           "no state directory for sequence numbers ($XDG_STATE_HOME or $HOME)");
     }
-    r.seq = SequenceStore(sequence_file(options_.state_dir, options_.sender)).next();
+    r.seq = next_counter(options_.state_dir, options_.sender);
     stamp(e.cmd, r.seq, options_.sender);
     std::unique_ptr<lcm::LCM> own;
     if (lcm == nullptr) {
@@ -78,6 +79,11 @@ GateResult CommandGate::send(const std::string& command, const std::vector<std::
       case SendResult::Outcome::kError:
         r.outcome = GateResult::Outcome::kError;
         r.message = s.error;
+        break;
+      case SendResult::Outcome::kForged:
+        r.outcome = GateResult::Outcome::kError;
+        r.message = "FORGED: " + std::to_string(s.forged_acks) + " acknowledgement(s) of seq " +
+                    std::to_string(r.seq) + " failed authentication; no authentic one arrived";
         break;
     }
   } catch (const std::exception& ex) {

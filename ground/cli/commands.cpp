@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "gnc/math/rotation.hpp"
+#include "gnc/param_bounds.hpp"
 #include "ground/cli/dictionary.hpp"
 #include "ground/dictionary/dictionary.hpp"
 
@@ -37,11 +38,17 @@ const std::vector<CommandHelp> kHelp{
     {"discard-gains", "discard-gains", "drop the loads: inactive table := active table"},
     {"dump-params", "dump-params",
      "read the active parameter table back on RS_PARAMS (params get prints it)"},
+    {"load-identified", "load-identified",
+     "load the flight's identified model (J_tot, r_SO/BCM, thruster strengths) into the inactive "
+     "table; refused unless the identification is confident (activate-gains flies it)"},
     {"reset-counters", "reset-counters",
      "reset the command/health counters (cycle counts are kept)"},
     {"load-trajectory", "load-trajectory UPLOAD_ID",
      "hand a completely uplinked trajectory to the flight core (not in TRACK)"},
     {"abort-uplink", "abort-uplink UPLOAD_ID", "discard a trajectory uplink in progress"},
+    {"key-rotate", "key-rotate KEY_ID",
+     "make command key KEY_ID (higher than the active one) active at the next tick; then send "
+     "with --key-id KEY_ID"},
     {"upload-trajectory", "upload-trajectory FILE",
      "uplink a planner trajectory file in chunks, wait for the flight to complete it, then load "
      "it"},
@@ -215,6 +222,13 @@ Encoded set_gain(const std::vector<std::string>& args) {
       return fail(name + ": value " + std::to_string(i + 1) + " is out of range (|v| <= 1e30)");
     }
   }
+  // The flight's own physical ranges (gnc/param_bounds.cpp), checked before anything is sent.
+  if (p->kind == ParamKind::kScalar && !gnc::within_bound(p->name, values[0])) {
+    const gnc::ParamBound* b = gnc::find_param_bound(p->name);
+    return fail(name + ": " + p->name + " = " + number_text(values[0]) +
+                " is outside its physical range [" + number_text(b->lo) + ", " +
+                number_text(b->hi) + "] " + b->units + ": " + b->why);
+  }
   std::vector<double> a{static_cast<double>(p->id)};
   a.insert(a.end(), values.begin(), values.end());
   std::string description =
@@ -255,6 +269,9 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
   if (name == "activate-gains") return no_args(Msg::OP_PARAM_ACTIVATE, "PARAM_ACTIVATE");
   if (name == "discard-gains") return no_args(Msg::OP_PARAM_DISCARD, "PARAM_DISCARD");
   if (name == "dump-params") return no_args(Msg::OP_PARAM_DUMP, "PARAM_DUMP");
+  if (name == "load-identified") {
+    return no_args(Msg::OP_PARAM_LOAD_IDENTIFIED, "PARAM_LOAD_IDENTIFIED");
+  }
   if (name == "set-mode") {
     if (args.size() != 1) return wrong_count(name, "1 argument", args.size());
     const auto mode = mode_from_name(args[0]);
@@ -277,6 +294,14 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
     const std::int32_t op = load ? static_cast<std::int32_t>(Msg::OP_LOAD_TRAJECTORY)
                                  : static_cast<std::int32_t>(Msg::OP_ABORT_UPLINK);
     return make(op, {id}, std::string(load ? "LOAD_TRAJECTORY " : "ABORT_UPLINK ") + args[0]);
+  }
+  if (name == "key-rotate") {
+    if (args.size() != 1) return wrong_count(name, "1 argument (the new key id)", args.size());
+    double id = 0.0;
+    if (!parse_number(args[0], id) || id < 1.0 || id > 2147483647.0 || std::trunc(id) != id) {
+      return fail(name + ": the key id must be a positive integer, got '" + args[0] + "'");
+    }
+    return make(Msg::OP_KEY_ROTATE, {id}, "KEY_ROTATE " + args[0]);
   }
   if (name == "upload-trajectory") {
     return fail("upload-trajectory is a procedure of many messages, not one command");

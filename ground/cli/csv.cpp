@@ -74,7 +74,7 @@ void visit(const rocksteady::sensor_frame_t& m, Sink& s) {
 
 void visit(const rocksteady::thruster_cmd_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(seq); RS_D(t); RS_I(enabled);
-  RS_A(channel_force); RS_A(thruster_on); RS_A(thruster_force);
+  RS_A(channel_force); RS_A(thruster_on); RS_A(thruster_force); RS_A(valve_closed);
 }
 
 void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
@@ -84,6 +84,16 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_A(integral);
   RS_A(torque_requested); RS_A(torque_achieved); RS_I(saturated); RS_D(alloc_scale);
   RS_I(thrusters_enabled); RS_A(channel_force); RS_D(fuel_kg);
+  RS_I(mekf_active); RS_A(gyro_bias); RS_A(attitude_sigma); RS_A(gyro_bias_sigma);
+  RS_I(star_gated); RS_I(identifying); RS_A(id_j); RS_A(id_j_sigma); RS_A(id_r); RS_A(id_r_sigma);
+  RS_A(id_k); RS_A(id_k_sigma); RS_I(id_inertia_confident); RS_I(id_offset_confident);
+  RS_I(id_thruster_confident); RS_I(id_excited_inertia); RS_I(id_excited_offset);
+  RS_I(id_excited_thrusters); RS_I(id_offset_unobservable); RS_A(id_residual_torque);
+  RS_D(id_residual_chi2); RS_I(id_windows); RS_I(id_candidate); RS_I(model_adoptions);
+  RS_I(fdi_enabled); RS_A(fdi_residual); RS_D(fdi_chi2); RS_D(fdi_noise_sigma); RS_I(fdi_best);
+  RS_D(fdi_best_llr); RS_D(fdi_runner_up_llr); RS_I(fdi_suspected_on); RS_I(fdi_suspected_off);
+  RS_I(fdi_confirmed_on); RS_I(fdi_confirmed_off); RS_A(valve_open); RS_I(isolation_inhibited);
+  RS_I(fdi_windows); RS_I(reduced_authority); RS_I(alloc_rank);
   RS_I(base_ticks); RS_I(base_missed); RS_I(rate_group_count);
   RS_A(rg_cycles); RS_A(rg_last_exec_ns); RS_A(rg_max_exec_ns); RS_A(rg_slips); RS_A(rg_missed);
   RS_I(cmd_accepted); RS_I(cmd_rejected); RS_I(cmd_last_seq); RS_I(cmd_last_opcode);
@@ -94,21 +104,23 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_I(table_loads); RS_I(table_activations); RS_I(table_loaded);
   RS_I(uplink_id); RS_I(uplink_chunks_received); RS_I(uplink_total_chunks);
   RS_I(uplink_chunks_rejected); RS_I(trajectories_loaded);
+  RS_I(lab_mode); RS_I(auth_key_id); RS_I(auth_rejected); RS_I(replays_rejected);
 }
 
 void visit(const rocksteady::event_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_D(t); RS_I(seq); RS_I(severity); RS_I(id); RS_I(arg0); RS_I(arg1);
+  RS_I(key_id); RS_A(mac);
   s.text("text", m.text);
 }
 
 void visit(const rocksteady::ground_cmd_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(seq); RS_I(sender_id); RS_I(opcode); RS_I(nargs); RS_A(args);
-  RS_A(mac);
+  RS_I(key_id); RS_A(mac);
 }
 
 void visit(const rocksteady::cmd_ack_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_D(t); RS_I(seq); RS_I(sender_id); RS_I(opcode); RS_I(accepted);
-  RS_I(reason); RS_I(detail);
+  RS_I(reason); RS_I(detail); RS_I(key_id); RS_A(mac);
   s.text("text", m.text);
 }
 
@@ -116,12 +128,15 @@ void visit(const rocksteady::plant_truth_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(seq); RS_D(t);
   RS_A(quat); RS_A(q); RS_A(omega); RS_D(omega_norm); RS_A(channel_force); RS_A(torque_control);
   RS_A(torque_disturbance); RS_D(fuel_used_kg);
+  RS_A(fault_kind); RS_A(fault_factor); RS_A(fault_onset); RS_A(thruster_force); RS_A(valve_open);
+  RS_I(command_timeout);
 }
 
 void visit(const rocksteady::trajectory_chunk_t& m, Sink& s) {
   RS_I(kind); RS_I(version); RS_I(upload_id); RS_I(chunk_index); RS_I(total_chunks);
   RS_I(total_samples); RS_I(first_sample); RS_I(count); RS_I(table_crc);
   RS_A(t); RS_A(omega_d); RS_A(omega_d_dot);
+  RS_I(seq); RS_I(key_id); RS_A(mac);
 }
 
 #undef RS_I

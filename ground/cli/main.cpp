@@ -24,6 +24,8 @@
 #include "gnc/model/rcs.hpp"
 #include "ground/cli/bus.hpp"
 #include "ground/cli/commands.hpp"
+#include "ground/cli/ground_auth.hpp"
+#include "fsw/auth/key_file.hpp"
 #include "ground/cli/csv.hpp"
 #include "ground/cli/dictionary.hpp"
 #include "ground/cli/plot.hpp"
@@ -71,16 +73,23 @@ struct SendArgs {
 // the next number from the state file.
 class SeqSource {
  public:
-  explicit SeqSource(const SendArgs& a) : fixed_(a.seq), dry_run_(a.dry_run) {
-    const std::string dir = a.state_dir.empty() ? cli::default_state_dir() : a.state_dir;
-    if (!dir.empty()) path_ = cli::sequence_file(dir, a.sender);
+  explicit SeqSource(const SendArgs& a) : fixed_(a.seq), dry_run_(a.dry_run), sender_(a.sender) {
+    dir_ = a.state_dir.empty() ? cli::default_state_dir() : a.state_dir;
+    if (!dir_.empty()) path_ = cli::sequence_file(dir_, a.sender);
   }
+  const std::string& dir() const { return dir_; }
   std::int64_t next() {
+    // With a command key: the key's counter (unless --seq), never a dry-run peek.
+    if (fixed_ <= 0 && !dry_run_ && !cli::auth_lab_mode()) return cli::next_counter(dir_, sender_);
     if (fixed_ > 0) {
       const std::int64_t s = fixed_++;
       if (!path_.empty() && !dry_run_) {
         try {
-          cli::SequenceStore(path_).next(s);
+          if (cli::auth_lab_mode()) {
+            cli::SequenceStore(path_).next(s);
+          } else {
+            cli::next_counter(dir_, sender_, s);  // the key's counter follows it
+          }
         } catch (const std::exception&) {
           // --seq works without a usable state file
         }
@@ -98,7 +107,9 @@ class SeqSource {
  private:
   std::int64_t fixed_;
   bool dry_run_;
+  std::int32_t sender_;
   std::int64_t peeked_{0};
+  std::string dir_;
   std::string path_;
 };
 
@@ -111,6 +122,12 @@ std::unique_ptr<lcm::LCM> open_bus(const std::string& url) {
 }
 
 void print_hint(const rocksteady::cmd_ack_t& ack) {
+  if (ack.accepted == 0 && ack.reason == rocksteady::cmd_ack_t::REASON_NOT_AUTHENTICATED) {
+    std::fprintf(stderr,
+                 "hint: the flight did not accept this key; its active key id is %d (give "
+                 "--key-id %d if the key file has it)\n",
+                 ack.key_id, ack.key_id);
+  }
   if (ack.accepted == 0 && ack.reason == rocksteady::cmd_ack_t::REASON_STALE_SEQUENCE) {
     std::fprintf(stderr,
                  "hint: the flight has accepted a higher sequence number from sender %d; give "
@@ -145,6 +162,20 @@ int send_one(lcm::LCM* lcm, rocksteady::ground_cmd_t cmd, const std::string& des
     case cli::SendResult::Outcome::kError:
       std::printf("ERROR: %s\n", r.error.c_str());
       break;
+    case cli::SendResult::Outcome::kForged:
+      std::printf("FORGED: %llu acknowledgement(s) of seq %lld failed authentication; no authentic "
+                  "acknowledgement within %g s\n",
+                  static_cast<unsigned long long>(r.forged_acks), static_cast<long long>(cmd.seq),
+                  a.timeout);
+      break;
+  }
+  if (r.forged_acks > 0 && r.outcome != cli::SendResult::Outcome::kForged) {
+    std::fprintf(stderr, "warning: %llu forged acknowledgement(s) of this command ignored\n",
+                 static_cast<unsigned long long>(r.forged_acks));
+  }
+  if (r.lab_mode && (r.outcome == cli::SendResult::Outcome::kAccepted ||
+                     r.outcome == cli::SendResult::Outcome::kRejected)) {
+    std::fprintf(stderr, "note: lab mode: the acknowledgement is not authenticated\n");
   }
   if (r.rx.rejected() > 0) {
     std::fprintf(stderr, "note: %s acknowledgement messages\n",
@@ -226,6 +257,8 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   options.chunk_interval_s = a.chunk_interval;
   options.wait_s = a.wait;
   options.passes = a.passes;
+  options.state_dir = seqs.dir();
+  options.sender = a.sender;
   const cli::UploadResult r = cli::upload_chunks(*lcm, *table, options, stderr);
   std::fprintf(stderr, "%s\n", r.message.c_str());
   if (!r.complete) {
@@ -318,6 +351,28 @@ int main(int argc, char** argv) {
   std::string url;
   app.add_option("--lcm-url", url,
                  "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)");
+  cli::AuthOptions auth_opt;
+  app.add_option("--key-file", auth_opt.key_file,
+                 "command keys (mode 0600; default $ROCKSTEADY_KEY_FILE): commands and uplink "
+                 "chunks are signed, acknowledgements verified (a forged one is reported)");
+  app.add_option("--key-id", auth_opt.key_id,
+                 "the key that signs (default $ROCKSTEADY_KEY_ID, else the lowest id in the file; "
+                 "after KEY_ROTATE the new id)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--lab", auth_opt.lab,
+               "the flight runs with --lab-mode: nothing is signed, acknowledgements are not "
+               "authenticated (default when $ROCKSTEADY_LAB_MODE=1 and no key file is given)");
+
+  std::string keygen_path;
+  int keygen_count = 2;
+  CLI::App* keygen = app.add_subcommand(
+      "keygen", "write a new command key file (mode 0600) for rocksteady-fsw --key-file and the "
+                "ground tools' --key-file");
+  keygen->add_option("file", keygen_path, "the key file to create (never overwritten)")->required();
+  keygen->add_option("--keys", keygen_count,
+                     "keys in the file, ids 1..N (the flight starts with 1; KEY_ROTATE moves up)")
+      ->check(CLI::Range(1, rocksteady::fsw::auth::kMaxKeys))
+      ->capture_default_str();
 
   SendArgs s;
   CLI::App* send = app.add_subcommand("send", "send one command and wait for its acknowledgement");
@@ -477,6 +532,22 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return cli::kExitUsage;
+  }
+
+  if (*keygen) {
+    const std::string err =
+        rocksteady::fsw::auth::generate_key_file(keygen_path, keygen_count);
+    if (!err.empty()) {
+      std::fprintf(stderr, "error: %s\n", err.c_str());
+      return 2;
+    }
+    std::printf("%s: %d command key(s), ids 1..%d, mode 0600\n", keygen_path.c_str(),
+                keygen_count, keygen_count);
+    return 0;
+  }
+  if (const std::string err = cli::configure_auth(auth_opt); !err.empty()) {
+    std::fprintf(stderr, "error: %s\n", err.c_str());
+    return 2;
   }
 
   if (*send) return run_send(s, url);

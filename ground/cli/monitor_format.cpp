@@ -127,10 +127,49 @@ std::string format_status_line(const rocksteady::gnc_telemetry_t& m, const Monit
       static_cast<unsigned long long>(c.rx.rejected()));
 }
 
+std::string sanitize_text(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  const auto* b = reinterpret_cast<const unsigned char*>(text.data());
+  const std::size_t n = text.size();
+  auto escape = [&](unsigned char c) {
+    static const char* const kHex = "0123456789abcdef";
+    out += "\\x";
+    out += kHex[c >> 4];
+    out += kHex[c & 15];
+  };
+  for (std::size_t i = 0; i < n;) {
+    const unsigned char c = b[i];
+    if (c < 0x20 || c == 0x7f) {
+      escape(c);
+      ++i;
+      continue;
+    }
+    if (c < 0x80) {
+      out += static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    // A well-formed UTF-8 sequence (2..4 bytes, no overlong lead, no C1 controls U+0080..U+009F).
+    int len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+    bool ok = len > 0 && i + static_cast<std::size_t>(len) <= n;
+    for (int k = 1; ok && k < len; ++k) ok = (b[i + static_cast<std::size_t>(k)] & 0xC0) == 0x80;
+    if (ok && c == 0xC2 && b[i + 1] < 0xA0) ok = false;  // C1 controls (e.g. CSI 0x9b)
+    if (!ok) {
+      escape(c);
+      ++i;
+      continue;
+    }
+    out.append(text, i, static_cast<std::size_t>(len));
+    i += static_cast<std::size_t>(len);
+  }
+  return out;
+}
+
 std::string format_event(const rocksteady::event_t& e) {
   std::string s = fmt("[t=%.3f] %-7s %s (%d) arg0=%d arg1=%d", e.t, severity_name(e.severity),
                       event_name(e.id).c_str(), e.id, e.arg0, e.arg1);
-  if (!e.text.empty()) s += ": " + e.text;
+  if (!e.text.empty()) s += ": " + sanitize_text(e.text);
   return s;
 }
 
@@ -139,7 +178,7 @@ std::string format_ack_verdict(const rocksteady::cmd_ack_t& a) {
   std::string s = "REJECTED: " + reason_name(a.reason);
   const std::string detail = reason_detail(a.reason, a.detail);
   if (!detail.empty()) s += " (" + detail + ")";
-  if (!a.text.empty() && a.text != detail) s += ": " + a.text;
+  if (!a.text.empty() && a.text != detail) s += ": " + sanitize_text(a.text);
   return s;
 }
 

@@ -30,6 +30,11 @@ std::vector<std::string> format_status(const rocksteady::gnc_telemetry_t& m,
 // One line with the same essentials ("t=12.300 mode=HOLD law=ntcl ...").
 std::string format_status_line(const rocksteady::gnc_telemetry_t& m, const MonitorCounts& c);
 
+// Text from the bus made safe for a terminal: control characters (ESC and every byte below 0x20,
+// DEL) and bytes that are not valid UTF-8 become \xNN, so no message can move the cursor, clear
+// the screen, set the title or hide a line. Every tool prints bus text through this.
+std::string sanitize_text(const std::string& text);
+
 // "[t=12.300] WARNING command_rejected (101) arg0=2 arg1=7: SET_TARGET ... rejected ..."
 std::string format_event(const rocksteady::event_t& e);
 // "ACCEPTED" or "REJECTED: <reason> (<detail>): <text>", without the seq prefix.

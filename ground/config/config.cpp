@@ -1,5 +1,6 @@
 #include "ground/config/config.hpp"
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -42,6 +43,9 @@ RunSetup assemble(const MissionConfig& m, const GncConfig& g, const CaseConfig& 
   } catch (const std::invalid_argument& e) {
     throw ConfigError(c.file + " + " + m.file, "", e.what());
   }
+  if (c.plant_truth.IsDefined() && !c.plant_truth.IsNull()) {
+    apply_plant_truth(c.plant_truth, c.file, t);
+  }
 
   // Estimates (the flight software), Eq. (6): estimate = true - error.
   s.flight = flight_params(m, g, c);
@@ -53,8 +57,72 @@ RunSetup load_run(const std::string& mission_path, const std::string& gnc_path,
                   const std::string& case_path) {
   const MissionConfig m = load_mission(mission_path);
   const GncConfig g = load_gnc(gnc_path);
-  const CaseConfig c = load_case(case_path);
-  return assemble(m, g, c);
+  return load_case_run(m, g, case_path);
+}
+
+RunSetup load_case_run(const MissionConfig& mission, const GncConfig& gnc,
+                       const std::string& case_path) {
+  RunSetup s = assemble(mission, gnc, load_case(case_path));
+  apply_case_plant_keys(case_path, s.truth);
+  return s;
+}
+
+std::vector<plant::ThrusterFault> parse_faults(const YAML::Node& list, const std::string& file,
+                                               const std::string& key) {
+  if (!list.IsSequence()) {
+    throw ConfigError(file, key, "expected a list of faults ({thruster, kind, onset_s, factor})");
+  }
+  std::vector<plant::ThrusterFault> out;
+  std::array<bool, hal::kThrusters> seen{};
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string at = key + "[" + std::to_string(i) + "]";
+    if (!list[i].IsMap()) throw ConfigError(file, at, "expected a mapping {thruster, kind, ...}");
+    MapReader r(list[i], file, at);
+    plant::ThrusterFault f;
+    f.thruster = r.integer("thruster");
+    if (f.thruster < 0 || f.thruster >= hal::kThrusters) {
+      r.fail("thruster", "must be in [0, 15] (4 pod + position), got " + std::to_string(f.thruster));
+    }
+    const std::string kind = r.text("kind");
+    if (!plant::parse_fault_kind(kind, f.kind)) {
+      r.fail("kind", "expected stuck_off, stuck_on or degraded, got '" + kind + "'");
+    }
+    f.onset_s = r.has("onset_s") ? r.non_negative("onset_s") : 0.0;
+    if (f.kind == plant::FaultKind::kDegraded) {
+      f.factor = r.number("factor");
+      if (!(f.factor > 0.0 && f.factor < 1.0)) r.fail("factor", "must be in (0, 1)");
+    } else if (r.has("factor")) {
+      r.fail("factor", "only a degraded thruster has a factor");
+    }
+    r.finish();
+    if (seen[static_cast<std::size_t>(f.thruster)]) {
+      r.fail("thruster", "thruster " + std::to_string(f.thruster) + " already has a fault");
+    }
+    seen[static_cast<std::size_t>(f.thruster)] = true;
+    out.push_back(f);
+  }
+  return out;
+}
+
+void apply_case_plant_keys(const std::string& case_path, plant::PlantParams& truth) {
+  const YAML::Node doc = load_yaml_file(case_path);
+  if (!doc.IsMap()) return;  // load_case has reported it
+  plant::PlantParams t = truth;
+  if (const YAML::Node f = doc["faults"]; f.IsDefined() && !f.IsNull()) {
+    t.faults = parse_faults(f, case_path, "faults");
+  }
+  if (const YAML::Node v = doc["valve_driver_timeout_s"]; v.IsDefined()) {
+    YAML::Node wrap;
+    wrap["valve_driver_timeout_s"] = v;
+    MapReader r(wrap, case_path, "");
+    t.command_timeout_s = r.non_negative("valve_driver_timeout_s");
+  }
+  try {
+    plant::validate(t);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(case_path, "faults", e.what());
+  }
+  truth = t;
 }
 
 void apply_plant_truth(const YAML::Node& node, const std::string& file, plant::PlantParams& truth) {

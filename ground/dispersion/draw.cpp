@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ground/campaign/estimation_report.hpp"
 #include "ground/campaign/fsw_flight_side.hpp"
 #include "ground/plant/plant.hpp"
 
@@ -82,6 +83,8 @@ StrategyOutcome outcome_of(const campaign::RunResult& r, double eps_trans) {
   o.saturated_ticks = r.saturated_ticks;
   o.sim_s = r.sim_s;
   o.wall_s = r.wall_s;
+  o.estimation = r.estimation;
+  o.fdi = r.fdi;
   return o;
 }
 
@@ -103,11 +106,39 @@ Readback read_back(const plant::Plant& plant, const gnc::GncParams& flown) {
   b.u_max_true_n = t.rcs.u_max;
   b.u_max_flight_n = flown.rcs.u_max;
   b.allocator = flown.allocator == gnc::AllocatorKind::kL1 ? "l1" : "pinv";
+  b.faults = plant::describe(plant.params().faults);
   return b;
 }
 
+namespace {
+
+// The draw's thruster fault added to the plant's (replacing a case file's fault of that thruster).
+void add_fault(const DrawParams& d, config::RunSetup& s, const std::string& file) {
+  if (!d.has_fault) return;
+  auto& faults = s.truth.faults;
+  for (auto it = faults.begin(); it != faults.end();) {
+    it = it->thruster == d.fault.thruster ? faults.erase(it) : it + 1;
+  }
+  faults.push_back(d.fault);
+  try {
+    plant::validate(s.truth);
+  } catch (const std::invalid_argument& e) {
+    throw config::ConfigError(file, "faults", e.what());
+  }
+}
+
+}  // namespace
+
 config::RunSetup make_setup(const config::MissionConfig& mission, const config::GncConfig& gnc,
                             const DispersionSpec& spec, const DrawParams& d) {
+  if (!d.case_file.empty()) {  // a fault dispersion over study cases: the case as `campaign` flies it
+    config::RunSetup s = config::load_case_run(mission, gnc, d.case_file);
+    s.case_name = "draw" + std::to_string(d.index);
+    s.duration_s = spec.duration_s;
+    if (spec.override_allocator) s.flight.allocator = spec.allocator;
+    add_fault(d, s, spec.file);
+    return s;
+  }
   config::MissionConfig m = mission;
   m.initial_mrp = d.mrp0;
   m.initial_omega = d.omega0;
@@ -124,6 +155,8 @@ config::RunSetup make_setup(const config::MissionConfig& mission, const config::
   c.duration_s = spec.duration_s;
   c.seed = d.noise_seed;
   config::RunSetup s = config::assemble(m, gnc, c);
+  s.truth.thruster_strength = d.thruster_strength;
+  s.truth.sensors.gyro_bias = d.gyro_bias;
   s.case_name = "draw" + std::to_string(d.index);
   // Estimates, Eq. (6): estimate = true - error.
   s.flight.mass_hat.j_ast = mission.mass.j_ast - d.delta_j;
@@ -132,6 +165,7 @@ config::RunSetup make_setup(const config::MissionConfig& mission, const config::
   if (spec.override_allocator) s.flight.allocator = spec.allocator;
   const gnc::ParamCheck check = gnc::validate(s.flight);
   if (!check.ok) throw config::ConfigError(c.file, check.field, check.reason);
+  add_fault(d, s, spec.file);
   return s;
 }
 
@@ -254,7 +288,20 @@ json to_json(const DrawResult& r, bool with_timing) {
                   {"disturbance_sigma_nm", d.disturbance_sigma_nm},
                   {"noise_seed", d.noise_seed},
                   {"u_max_n", d.u_max_n},
+                  {"thruster_strength",
+                   std::vector<double>(d.thruster_strength.data(),
+                                       d.thruster_strength.data() + gnc::kThrusters)},
+                  {"gyro_bias_rad_s", vec(d.gyro_bias)},
+                  {"case_file", d.case_file},
+                  {"case", d.case_number},
+                  {"fault", d.has_fault ? plant::describe(d.fault) : std::string("none")},
                   {"error", d.error}};
+  if (d.has_fault) {
+    sampled["fault_thruster"] = d.fault.thruster;
+    sampled["fault_kind"] = plant::to_string(d.fault.kind);
+    sampled["fault_onset_s"] = d.fault.onset_s;
+    sampled["fault_factor"] = d.fault.factor;
+  }
   json flown = nullptr;
   if (r.flown) {
     const Readback& b = *r.flown;
@@ -270,7 +317,8 @@ json to_json(const DrawResult& r, bool with_timing) {
              {"noise_seed", b.noise_seed},
              {"u_max_true_n", b.u_max_true_n},
              {"u_max_flight_n", b.u_max_flight_n},
-             {"allocator", b.allocator}};
+             {"allocator", b.allocator},
+             {"faults", b.faults}};
   }
   json runs = json::array();
   json run_wall = json::object();
@@ -292,7 +340,9 @@ json to_json(const DrawResult& r, bool with_timing) {
                     {"ticks", o.ticks},
                     {"plant_clipped_ticks", o.clipped_ticks},
                     {"allocator_saturated_ticks", o.saturated_ticks},
-                    {"simulated_s", o.sim_s}});
+                    {"simulated_s", o.sim_s},
+                    {"estimation", campaign::estimation_json(o.estimation)},
+                    {"fdi", campaign::fdi_json(o.fdi)}});
     run_wall[o.strategy] = o.wall_s;
   }
   json out = {{"result",
@@ -333,7 +383,23 @@ DrawResult draw_from_json(const json& top) {
   d.disturbance_sigma_nm = s.at("disturbance_sigma_nm").get<double>();
   d.noise_seed = s.at("noise_seed").get<std::uint64_t>();
   d.u_max_n = s.at("u_max_n").get<double>();
+  if (s.contains("thruster_strength")) {
+    const auto& k = s.at("thruster_strength");
+    for (int i = 0; i < gnc::kThrusters; ++i) {
+      d.thruster_strength(i) = k.at(static_cast<std::size_t>(i)).get<double>();
+    }
+  }
+  if (s.contains("gyro_bias_rad_s")) d.gyro_bias = to_vec(s.at("gyro_bias_rad_s"));
   d.error = s.at("error").get<std::string>();
+  d.case_file = s.value("case_file", "");
+  d.case_number = s.value("case", 0);
+  if (s.contains("fault_thruster")) {
+    d.has_fault = true;
+    d.fault.thruster = s.at("fault_thruster").get<int>();
+    plant::parse_fault_kind(s.at("fault_kind").get<std::string>(), d.fault.kind);
+    d.fault.onset_s = s.at("fault_onset_s").get<double>();
+    d.fault.factor = s.at("fault_factor").get<double>();
+  }
   const json& f = j.at("flown");
   if (!f.is_null()) {
     Readback b;
@@ -350,6 +416,7 @@ DrawResult draw_from_json(const json& top) {
     b.u_max_true_n = f.at("u_max_true_n").get<double>();
     b.u_max_flight_n = f.at("u_max_flight_n").get<double>();
     b.allocator = f.value("allocator", "");
+    b.faults = f.value("faults", "none");
     r.flown = b;
   }
   r.eps_trans_rad_s = j.at("eps_trans_rad_s").get<double>();
@@ -377,6 +444,8 @@ DrawResult draw_from_json(const json& top) {
     x.clipped_ticks = o.at("plant_clipped_ticks").get<std::uint64_t>();
     x.saturated_ticks = o.at("allocator_saturated_ticks").get<std::uint64_t>();
     x.sim_s = o.at("simulated_s").get<double>();
+    if (o.contains("estimation")) x.estimation = campaign::estimation_from_json(o.at("estimation"));
+    if (o.contains("fdi")) x.fdi = campaign::fdi_from_json(o.at("fdi"));
     if (timing != nullptr && timing->at("run_wall_s").contains(x.strategy)) {
       x.wall_s = timing->at("run_wall_s").at(x.strategy).get<double>();
     }

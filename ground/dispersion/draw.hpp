@@ -32,6 +32,7 @@ struct Readback {
   double u_max_true_n{0.0};
   double u_max_flight_n{0.0};
   std::string allocator;  // the flight software's: pinv or l1
+  std::string faults;     // the plant's thruster faults (plant::describe), "none"
 };
 Readback read_back(const plant::Plant& plant, const gnc::GncParams& flown);
 
@@ -55,6 +56,8 @@ struct StrategyOutcome {
   std::uint64_t saturated_ticks{0};
   double sim_s{0.0};
   double wall_s{0.0};  // timing (not part of the result proper)
+  campaign::EstimationReport estimation;  // estimator and identification against the truth
+  campaign::FdiReport fdi;                // fault detection
 };
 
 struct DrawResult {

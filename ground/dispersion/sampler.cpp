@@ -142,6 +142,7 @@ std::vector<double> Sampler::coordinates(int index) const {
     case Sampling::kRandom:
       break;
     case Sampling::kLatinHypercube: {
+      if (nd == 0) break;
       const double n = static_cast<double>(spec_.draws);
       const auto i = static_cast<std::size_t>(index) % lhs_perm_.front().size();
       for (std::size_t k = 0; k < nd; ++k) u[k] = (lhs_perm_[k][i] + u[k]) / n;
@@ -232,6 +233,47 @@ DrawParams Sampler::draw(int index) const {
     d.mrp0 = mission_.initial_mrp;
   }
   d.noise_seed = spec_.noise_seed_per_draw ? mix_seed(d.seed, kNoiseSeedStream) : spec_.noise_seed;
+  // Truth beyond the study, from its own stream (files without these keys draw nothing).
+  Rng extra(mix_seed(d.seed, kTruthExtrasStream));
+  const double k_sigma = value(spec_.thruster_strength_sigma);
+  for (int i = 0; i < gnc::kThrusters; ++i) {
+    const double e = std::max(-3.0, std::min(3.0, extra.normal()));
+    d.thruster_strength(i) = 1.0 + k_sigma * e;
+  }
+  const double b1 = extra.uniform(), b2 = extra.uniform();
+  d.gyro_bias = value(spec_.gyro_bias_norm_rad_s) * sphere_direction(b1, b2);
+
+  // Fault dispersion: thruster x kind x onset x case, on a grid or at random.
+  const FaultPlan& fp = spec_.faults;
+  if (fp.enabled) {
+    const std::size_t nt = fp.thrusters.size(), nk = fp.kinds.size(), no = fp.onsets_s.size();
+    const std::size_t nc = fp.case_files.empty() ? 1 : fp.case_files.size();
+    std::size_t it = 0, ik = 0, io = 0, ic = 0;
+    if (fp.grid) {
+      std::size_t i = static_cast<std::size_t>(index) % fp.grid_size();
+      it = i % nt;
+      i /= nt;
+      ik = i % nk;
+      i /= nk;
+      io = i % no;
+      ic = i / no;
+    } else {
+      Rng f(mix_seed(d.seed, kFaultStream));
+      it = static_cast<std::size_t>(f.below(nt));
+      ik = static_cast<std::size_t>(f.below(nk));
+      io = static_cast<std::size_t>(f.below(no));
+      ic = static_cast<std::size_t>(f.below(nc));
+    }
+    d.has_fault = true;
+    d.fault.thruster = fp.thrusters[it];
+    d.fault.kind = fp.kinds[ik];
+    d.fault.onset_s = fp.onsets_s[io];
+    d.fault.factor = d.fault.kind == plant::FaultKind::kDegraded ? fp.degraded_factor : 1.0;
+    if (!fp.case_files.empty()) {
+      d.case_file = fp.case_files[ic];
+      d.case_number = fp.case_numbers[ic];
+    }
+  }
   return d;
 }
 

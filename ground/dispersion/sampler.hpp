@@ -68,6 +68,13 @@ struct DrawParams {
   double disturbance_sigma_nm{0.0};
   std::uint64_t noise_seed{1};
   double u_max_n{200.0};
+  gnc::Vec16 thruster_strength{gnc::Vec16::Ones()};  // true strength factors
+  Vec3 gyro_bias{Vec3::Zero()};                      // true constant gyro bias, rad/s
+  // Fault dispersion: the case file flown (empty: the parameters above) and the thruster fault.
+  std::string case_file;
+  int case_number{0};
+  bool has_fault{false};
+  plant::ThrusterFault fault{};
   std::string error;  // non-empty: no valid draw (e.g. no PD estimate within the limit)
 };
 
@@ -93,6 +100,8 @@ enum Stream : std::uint64_t {
   kMatrixStream = 3,
   kNoiseSeedStream = 4,
   kLhsStream = 5,
+  kFaultStream = 6,
+  kTruthExtrasStream = 7,  // thruster strengths, gyro bias
 };
 
 }  // namespace rocksteady::dispersion

@@ -1,6 +1,7 @@
 #include "ground/dispersion/spec.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <limits>
 
@@ -212,6 +213,8 @@ std::vector<std::pair<std::string, const Scalar*>> DispersionSpec::dimensions() 
       {"star_noise_psd", &star_psd},
       {"disturbance_sigma_nm", &disturbance_sigma_nm},
       {"u_max_n", &u_max_n},
+      {"thruster_strength_sigma", &thruster_strength_sigma},
+      {"gyro_bias_norm_rad_s", &gyro_bias_norm_rad_s},
   };
   std::vector<std::pair<std::string, const Scalar*>> out;
   for (const auto& d : all) {
@@ -219,6 +222,96 @@ std::vector<std::pair<std::string, const Scalar*>> DispersionSpec::dimensions() 
   }
   return out;
 }
+
+namespace {
+
+void load_faults(MapReader r, const std::string& path, FaultPlan& f) {
+  f.enabled = true;
+  const YAML::Node th = r.get("thrusters");
+  if (th.IsScalar() && th.as<std::string>() == "all") {
+    for (int i = 0; i < hal::kThrusters; ++i) f.thrusters.push_back(i);
+  } else if (th.IsSequence() && th.size() > 0) {
+    for (std::size_t i = 0; i < th.size(); ++i) {
+      int t = -1;
+      try {
+        t = th[i].as<int>();
+      } catch (const YAML::Exception&) {
+        r.fail("thrusters", "expected 'all' or a list of thrusters 0..15");
+      }
+      if (t < 0 || t >= hal::kThrusters) {
+        r.fail("thrusters", "thruster " + std::to_string(t) + " is not in [0, 15]");
+      }
+      f.thrusters.push_back(t);
+    }
+  } else {
+    r.fail("thrusters", "expected 'all' or a non-empty list of thrusters 0..15");
+  }
+  const YAML::Node kinds = r.get("kinds");
+  if (!kinds.IsSequence() || kinds.size() == 0) {
+    r.fail("kinds", "expected a non-empty list of stuck_off, stuck_on, degraded");
+  }
+  for (std::size_t i = 0; i < kinds.size(); ++i) {
+    plant::FaultKind k = plant::FaultKind::kNone;
+    const std::string name = kinds[i].IsScalar() ? kinds[i].as<std::string>() : "";
+    if (!plant::parse_fault_kind(name, k)) {
+      r.fail("kinds", "expected stuck_off, stuck_on or degraded, got '" + name + "'");
+    }
+    f.kinds.push_back(k);
+  }
+  if (r.has("degraded_factor")) {
+    f.degraded_factor = r.number("degraded_factor");
+    if (!(f.degraded_factor > 0.0 && f.degraded_factor < 1.0)) {
+      r.fail("degraded_factor", "must be in (0, 1)");
+    }
+  }
+  const YAML::Node on = r.get("onsets_s");
+  if (!on.IsSequence() || on.size() == 0) r.fail("onsets_s", "expected a non-empty list of times");
+  for (std::size_t i = 0; i < on.size(); ++i) {
+    double t = -1.0;
+    try {
+      t = on[i].as<double>();
+    } catch (const YAML::Exception&) {
+      r.fail("onsets_s", "expected numbers");
+    }
+    if (!std::isfinite(t) || t < 0.0) r.fail("onsets_s", "every onset must be finite and >= 0");
+    f.onsets_s.push_back(t);
+  }
+  if (r.has("cases")) {
+    const YAML::Node cs = r.get("cases");
+    if (!cs.IsSequence() || cs.size() == 0) r.fail("cases", "expected a non-empty list of cases");
+    const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      const std::string v = cs[i].IsScalar() ? cs[i].Scalar() : "";
+      std::string file;
+      if (!v.empty() && v.find_first_not_of("0123456789") == std::string::npos) {
+        file = (dir / ".." / "cases" / ("case" + v + ".yaml")).lexically_normal().string();
+      } else if (!v.empty()) {
+        file = (dir / v).lexically_normal().string();
+      } else {
+        r.fail("cases", "expected case numbers or case-file paths");
+      }
+      try {
+        f.case_numbers.push_back(config::load_case(file).number);
+      } catch (const config::ConfigError& e) {
+        r.fail("cases", std::string("case '") + v + "': " + e.what());
+      }
+      f.case_files.push_back(file);
+    }
+  }
+  if (r.has("plan")) {
+    const std::string plan = r.text("plan");
+    if (plan == "grid") {
+      f.grid = true;
+    } else if (plan == "random") {
+      f.grid = false;
+    } else {
+      r.fail("plan", "expected grid or random, got '" + plan + "'");
+    }
+  }
+  r.finish();
+}
+
+}  // namespace
 
 DispersionSpec load_spec(const std::string& path) {
   DispersionSpec s;
@@ -273,6 +366,17 @@ DispersionSpec load_spec(const std::string& path) {
     }
   }
 
+  if (doc.has("faults")) load_faults(doc.map("faults"), path, s.faults);
+  if (!s.faults.case_files.empty()) {
+    // Each draw flies a study case file: no dispersed parameters.
+    if (doc.has("parameters")) {
+      doc.fail("parameters", "must be absent when faults.cases is given (each draw flies its case)");
+    }
+    s.u_max_n.value = 1.0;
+    doc.finish();
+    return s;
+  }
+
   MapReader p = doc.map("parameters");
   s.delta_j_norm = scalar(p, "delta_j_ast_norm_kg_m2", false);
   s.delta_j_direction = direction(p, "delta_j_ast_direction", false, true, false);
@@ -298,6 +402,15 @@ DispersionSpec load_spec(const std::string& path) {
     }
   }
   s.u_max_n = scalar(p, "u_max_n", false);
+  if (p.has("thruster_strength_sigma")) {
+    s.thruster_strength_sigma = scalar(p, "thruster_strength_sigma", false);
+    if (s.thruster_strength_sigma.quantile(1.0) > 0.1) {
+      p.fail("thruster_strength_sigma", "above 0.1: a thruster that far off is a fault, not a strength");
+    }
+  }
+  if (p.has("gyro_bias_norm_rad_s")) {
+    s.gyro_bias_norm_rad_s = scalar(p, "gyro_bias_norm_rad_s", false);
+  }
   if (s.u_max_n.quantile(0.0) <= 0.0 && !(s.u_max_n.kind == Scalar::Kind::kNormal)) {
     p.fail("u_max_n", "must be positive");
   }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ground/campaign/strategy.hpp"
+#include "ground/plant/plant.hpp"
 
 namespace rocksteady::dispersion {
 
@@ -46,6 +47,35 @@ const char* to_string(DirectionKind k);
 enum class Sampling { kRandom, kLatinHypercube, kCorners };
 const char* to_string(Sampling s);
 
+// A fault dispersion (optional `faults:` key): one thruster fault per draw, over thruster x kind x
+// onset x (optionally) study case.
+//   faults:
+//     thrusters: all                 # or a list of physical thrusters 0..15 (4 pod + position)
+//     kinds: [stuck_off, stuck_on, degraded]
+//     degraded_factor: 0.5           # thrust factor of the degraded kind, in (0, 1)
+//     onsets_s: [60, 20000, 60000]   # plant time of the onset
+//     cases: [1, 2, 3, 4, 5, 6, 7]   # optional: fly these case files (numbers: <dir>/../cases/caseN.yaml
+//                                    # next to the dispersion file; strings: paths relative to it);
+//                                    # each draw then flies its case as `campaign` does, and the
+//                                    # `parameters` section must be absent
+//     plan: grid                     # grid: draw i is combination i mod the grid size (thruster
+//                                    # fastest, then kind, onset, case); random: each draw picks each
+//                                    # factor uniformly from its own stream
+struct FaultPlan {
+  bool enabled{false};
+  bool grid{true};
+  std::vector<int> thrusters;
+  std::vector<plant::FaultKind> kinds;
+  double degraded_factor{0.5};
+  std::vector<double> onsets_s;
+  std::vector<std::string> case_files;  // empty: the `parameters` draws
+  std::vector<int> case_numbers;        // the case files' `case` numbers
+  std::size_t grid_size() const {
+    return thrusters.size() * kinds.size() * onsets_s.size() *
+           (case_files.empty() ? 1 : case_files.size());
+  }
+};
+
 struct DispersionSpec {
   std::string file;
   std::string name;
@@ -73,6 +103,12 @@ struct DispersionSpec {
   bool noise_seed_per_draw{true};                           // else noise_seed
   std::uint64_t noise_seed{1};
   Scalar u_max_n;
+  // Optional truth beyond the study (absent: none). Per-thruster strength factors k_i = 1 + e_i,
+  // e_i normal with this sigma, truncated to +-3 sigma, drawn independently per thruster; a
+  // constant gyro bias of this norm in a uniformly random direction.
+  Scalar thruster_strength_sigma;
+  Scalar gyro_bias_norm_rad_s;
+  FaultPlan faults{};
 
   // The bounded scalars in a fixed order (the hypercube's dimensions), with their key names.
   std::vector<std::pair<std::string, const Scalar*>> dimensions() const;

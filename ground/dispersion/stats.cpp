@@ -153,6 +153,44 @@ Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& dra
     st.t_omega = percentiles(tw);
     st.t_q = percentiles(tq);
     st.fuel = percentiles(fuel);
+    std::vector<double> att, rate;
+    for (const DrawResult& d : draws) {
+      if (k >= d.runs.size() || d.runs[k].status != "ok") continue;
+      const campaign::EstimationReport& e = d.runs[k].estimation;
+      att.push_back(e.attitude_rms_rad);
+      rate.push_back(e.rate_rms_rad_s);
+      for (std::size_t m = 0; m < e.marks.size(); ++m) {
+        if (!e.marks[m].reached) continue;
+        if (st.identification.size() <= m) st.identification.resize(m + 1);
+        st.identification[m].t_s = e.marks[m].t_s;
+      }
+    }
+    st.attitude_rms_rad = percentiles(att);
+    st.rate_rms_rad_s = percentiles(rate);
+    for (std::size_t m = 0; m < st.identification.size(); ++m) {
+      IdentificationStats& is = st.identification[m];
+      std::vector<double> j, r, kk;
+      int j_in = 0, r_in = 0;
+      for (const DrawResult& d : draws) {
+        if (k >= d.runs.size() || d.runs[k].status != "ok") continue;
+        const campaign::EstimationReport& e = d.runs[k].estimation;
+        if (m >= e.marks.size() || !e.marks[m].reached) continue;
+        const campaign::IdentificationMark& x = e.marks[m];
+        j.push_back(x.j_rel);
+        r.push_back(x.r_err_m);
+        kk.push_back(x.k_max_err);
+        j_in += x.j_nees <= campaign::kChi2Dof6P95 ? 1 : 0;
+        r_in += x.r_nees <= campaign::kChi2Dof3P95 ? 1 : 0;
+        is.inertia_confident += x.inertia_confident ? 1 : 0;
+        is.offset_confident += x.offset_confident ? 1 : 0;
+      }
+      is.n = static_cast<int>(j.size());
+      is.j_rel = percentiles(j);
+      is.r_err_m = percentiles(r);
+      is.k_max_err = percentiles(kk);
+      is.j_nees_in95 = is.n > 0 ? static_cast<double>(j_in) / is.n : 0.0;
+      is.r_nees_in95 = is.n > 0 ? static_cast<double>(r_in) / is.n : 0.0;
+    }
     std::stable_sort(ranks.begin(), ranks.end(), [](const Rank& x, const Rank& y) {
       if (x.severity != y.severity) return x.severity > y.severity;
       if (x.fuel != y.fuel) return x.fuel > y.fuel;
@@ -259,7 +297,7 @@ void write_results_csv(const std::string& path, const DispersionSpec& spec,
   out << "draw,strategy,status,success,t_omega_conv_s,fuel_at_t_omega_kg,t_q_conv_s,fuel_at_t_q_kg,"
          "total_fuel_kg,max_rate_rad_s,final_mode,delta_j_ast_norm_kg_m2,delta_r_so_bcm_norm_m,"
          "initial_rate_norm_rad_s,gyro_noise_psd_rad2_s2,star_noise_psd,disturbance_sigma_nm,"
-         "u_max_n,noise_seed,pd_redraws,note\n";
+         "u_max_n,noise_seed,pd_redraws,note,case,fault\n";
   for (const DrawResult& d : draws) {
     for (const StrategyOutcome& o : d.runs) {
       std::string note = o.note;
@@ -277,7 +315,11 @@ void write_results_csv(const std::string& path, const DispersionSpec& spec,
       } else {
         out << ",,,,,,,";
       }
-      out << "," << d.sampled.pd_redraws << "," << note << "\n";
+      out << "," << d.sampled.pd_redraws << "," << note << ","
+          << (d.sampled.case_number > 0 ? std::to_string(d.sampled.case_number) : std::string()) << ","
+          << (d.flown ? d.flown->faults
+                      : (d.sampled.has_fault ? plant::describe(d.sampled.fault) : std::string("none")))
+          << "\n";
     }
   }
 }
@@ -292,6 +334,21 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                        {"total_fuel_kg", opt_json(w.fuel_kg)},
                        {"reproduce", reproduce + " --draw " + std::to_string(w.draw)}});
     }
+    json id = json::array();
+    for (const IdentificationStats& is : st.identification) {
+      id.push_back({{"t_s", is.t_s},
+                    {"n", is.n},
+                    {"j_rel", pct_json(is.j_rel)},
+                    {"r_err_m", pct_json(is.r_err_m)},
+                    {"k_max_err", pct_json(is.k_max_err)},
+                    {"j_nees_in_chi2_95", is.j_nees_in95},
+                    {"r_nees_in_chi2_95", is.r_nees_in95},
+                    {"inertia_confident", is.inertia_confident},
+                    {"offset_confident", is.offset_confident}});
+    }
+    const json estimation = {{"attitude_rms_rad", pct_json(st.attitude_rms_rad)},
+                             {"rate_rms_rad_s", pct_json(st.rate_rms_rad_s)},
+                             {"identification", id}};
     strategies.push_back({{"strategy", st.strategy},
                           {"draws", st.draws},
                           {"flown", st.flown},
@@ -303,7 +360,8 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                           {"t_omega_conv_s", pct_json(st.t_omega)},
                           {"t_q_conv_s", pct_json(st.t_q)},
                           {"total_fuel_kg", pct_json(st.fuel)},
-                          {"worst_draws", worst}});
+                          {"worst_draws", worst},
+                          {"estimation", estimation}});
   }
   json paired = json::array();
   for (const PairedStats& p : s.paired) {
@@ -450,6 +508,30 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
        << "–" << fmt("%.1f", 100.0 * st.wilson.second) << " % | " << st.no_plan << " | "
        << st.errors << " | " << four(st.t_omega, "%.0f") << " | " << four(st.t_q, "%.0f") << " | "
        << four(st.fuel, "%.1f") << " |\n";
+  }
+  bool any_id = false;
+  for (const StrategyStats& st : s.strategies) any_id = any_id || !st.identification.empty();
+  md << "\n## Estimation against the truth\n\nAttitude and rate error RMS of the estimate (t ≥ 60 s), "
+        "p50 / p95.\n\n| strategy | attitude (rad) | rate (rad/s) |\n|---|---|---|\n";
+  for (const StrategyStats& st : s.strategies) {
+    md << "| `" << st.strategy << "` | " << nc(st.attitude_rms_rad.p50, "%.2e") << " / "
+       << nc(st.attitude_rms_rad.p95, "%.2e") << " | " << nc(st.rate_rms_rad_s.p50, "%.2e")
+       << " / " << nc(st.rate_rms_rad_s.p95, "%.2e") << " |\n";
+  }
+  if (any_id) {
+    md << "\n## Identification against the truth\n\n‖Ĵ−J‖/‖J‖, ‖r̂−r‖ (m), max|k̂−k|: p50 / p95 "
+          "over the draws; NEES in 95 %: fraction of draws whose normalised error is inside the "
+          "chi-square 95 % bound (≈ 0.95 when the 1σ is consistent).\n\n| strategy | t (s) | n | J "
+          "| r (m) | k | J NEES in 95 % | r NEES in 95 % |\n|---|---:|---:|---|---|---|---:|---:|\n";
+    for (const StrategyStats& st : s.strategies) {
+      for (const IdentificationStats& is : st.identification) {
+        md << "| `" << st.strategy << "` | " << fmt("%.0f", is.t_s) << " | " << is.n << " | "
+           << nc(is.j_rel.p50, "%.1e") << " / " << nc(is.j_rel.p95, "%.1e") << " | "
+           << nc(is.r_err_m.p50, "%.3f") << " / " << nc(is.r_err_m.p95, "%.3f") << " | "
+           << nc(is.k_max_err.p50, "%.3f") << " / " << nc(is.k_max_err.p95, "%.3f") << " | "
+           << fmt("%.2f", is.j_nees_in95) << " | " << fmt("%.2f", is.r_nees_in95) << " |\n";
+      }
+    }
   }
   md << "\n## Worst draws\n\n";
   for (const StrategyStats& st : s.strategies) {

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ground/campaign/estimation_report.hpp"
 #include "ground/dispersion/draw.hpp"
 #include "ground/dispersion/spec.hpp"
 
@@ -35,6 +36,19 @@ struct WorstDraw {
   std::optional<double> fuel_kg;
 };
 
+// Identification against the truth at one mark over the draws that reached it.
+struct IdentificationStats {
+  double t_s{0.0};
+  int n{0};
+  Percentiles j_rel, r_err_m, k_max_err;
+  // Fraction of draws whose normalised error lies inside the chi-square 95 % bound (6 dof for J,
+  // 3 for r): about 0.95 when the reported 1 sigma is consistent with the errors.
+  double j_nees_in95{0.0};
+  double r_nees_in95{0.0};
+  int inertia_confident{0};
+  int offset_confident{0};
+};
+
 struct StrategyStats {
   std::string strategy;
   int draws{0};
@@ -46,6 +60,10 @@ struct StrategyStats {
   std::pair<double, double> wilson{0.0, 0.0};
   Percentiles t_omega, t_q, fuel;
   std::vector<WorstDraw> worst;  // five
+  // Estimation against the truth (draws that flew): attitude and rate error RMS of the estimator,
+  // and the identification marks when the strategy identifies.
+  Percentiles attitude_rms_rad, rate_rms_rad_s;
+  std::vector<IdentificationStats> identification;
 };
 
 struct PairedStats {

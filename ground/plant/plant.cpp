@@ -1,6 +1,8 @@
 #include "ground/plant/plant.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -29,6 +31,56 @@ bool spd(const Mat3& m) {
 bool positive(double v) { return std::isfinite(v) && v > 0.0; }
 
 }  // namespace
+
+const char* to_string(FaultKind k) {
+  switch (k) {
+    case FaultKind::kNone: return "none";
+    case FaultKind::kStuckOff: return "stuck_off";
+    case FaultKind::kStuckOn: return "stuck_on";
+    case FaultKind::kDegraded: return "degraded";
+  }
+  return "?";
+}
+
+bool parse_fault_kind(const std::string& name, FaultKind& out) {
+  for (const FaultKind k : {FaultKind::kStuckOff, FaultKind::kStuckOn, FaultKind::kDegraded}) {
+    if (name == to_string(k)) {
+      out = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string check(const ThrusterFault& f) {
+  if (f.thruster < 0 || f.thruster >= hal::kThrusters) return "thruster must be in [0, 15]";
+  if (f.kind != FaultKind::kStuckOff && f.kind != FaultKind::kStuckOn &&
+      f.kind != FaultKind::kDegraded) {
+    return "kind must be stuck_off, stuck_on or degraded";
+  }
+  if (!std::isfinite(f.onset_s) || f.onset_s < 0.0) return "onset_s must be finite and >= 0";
+  if (f.kind == FaultKind::kDegraded && !(f.factor > 0.0 && f.factor < 1.0)) {
+    return "a degraded thruster's factor must be in (0, 1)";
+  }
+  return "";
+}
+
+std::string describe(const ThrusterFault& f) {
+  char b[96];
+  if (f.kind == FaultKind::kDegraded) {
+    std::snprintf(b, sizeof b, "thruster %d degraded x%.3g at %.6g s", f.thruster, f.factor, f.onset_s);
+  } else {
+    std::snprintf(b, sizeof b, "thruster %d %s at %.6g s", f.thruster, to_string(f.kind), f.onset_s);
+  }
+  return b;
+}
+
+std::string describe(const std::vector<ThrusterFault>& faults) {
+  if (faults.empty()) return "none";
+  std::string s;
+  for (const ThrusterFault& f : faults) s += (s.empty() ? "" : "; ") + describe(f);
+  return s;
+}
 
 std::uint64_t stream_seed(std::uint64_t run_seed, std::uint64_t stream_id) {
   // splitmix64 (Steele, Lea, Flood 2014) of the seed mixed with the stream id.
@@ -84,6 +136,20 @@ void validate(const PlantParams& p) {
       fail("thruster_strength", "every factor must be finite and >= 0");
     }
   }
+  std::array<bool, hal::kThrusters> faulted{};
+  for (std::size_t i = 0; i < p.faults.size(); ++i) {
+    const ThrusterFault& f = p.faults[i];
+    const std::string why = check(f);
+    if (!why.empty()) fail("faults[" + std::to_string(i) + "]", why);
+    if (faulted[static_cast<std::size_t>(f.thruster)]) {
+      fail("faults[" + std::to_string(i) + "]",
+           "thruster " + std::to_string(f.thruster) + " has two faults");
+    }
+    faulted[static_cast<std::size_t>(f.thruster)] = true;
+  }
+  if (!std::isfinite(p.command_timeout_s) || p.command_timeout_s < 0.0) {
+    fail("command_timeout_s", "must be finite and >= 0 (0: no timeout)");
+  }
   if (!p.beta0.allFinite() || std::fabs(p.beta0.norm() - 1.0) > 1e-6) {
     fail("beta0", "not a unit quaternion");
   }
@@ -122,6 +188,48 @@ void Plant::reset() {
   gyro_normal_.reset();
   star_normal_.reset();
   dist_normal_.reset();
+  faults_ = p_.faults;
+  active_.fill(FaultKind::kNone);
+  active_factor_.fill(1.0);
+  any_active_ = false;
+  nominal_last_ = true;
+  thrust_.setZero();
+  control_torque_.setZero();
+  valve_open_ = {true, true, true, true};
+  held_cmd_ = hal::ThrusterOutputs{};
+  have_cmd_ = false;
+  cmd_time_ = 0.0;
+  timed_out_ = false;
+  timeout_periods_ = 0;
+}
+
+std::string Plant::inject(const ThrusterFault& f) {
+  std::string why = check(f);
+  if (!why.empty()) return why;
+  clear_fault(f.thruster);
+  faults_.push_back(f);
+  return why;
+}
+
+void Plant::clear_fault(int thruster) {
+  for (auto it = faults_.begin(); it != faults_.end();) {
+    it = it->thruster == thruster ? faults_.erase(it) : it + 1;
+  }
+}
+
+void Plant::clear_faults() { faults_.clear(); }
+
+void Plant::update_active_faults(double t0) {
+  active_.fill(FaultKind::kNone);
+  active_factor_.fill(1.0);
+  any_active_ = false;
+  for (const ThrusterFault& f : faults_) {
+    if (t0 + 1e-9 < f.onset_s) continue;  // not yet
+    const auto i = static_cast<std::size_t>(f.thruster);
+    active_[i] = f.kind;
+    active_factor_[i] = f.kind == FaultKind::kDegraded ? f.factor : 1.0;
+    any_active_ = true;
+  }
 }
 
 void Plant::set_state(const Vec4& beta, const Vec3& omega) {
@@ -130,6 +238,38 @@ void Plant::set_state(const Vec4& beta, const Vec3& omega) {
 }
 
 void Plant::advance(const Vec8& force, bool enabled) {
+  // A command for this period: the valve driver's clock restarts.
+  have_cmd_ = true;
+  cmd_time_ = t();
+  timed_out_ = false;
+  step_period(force, enabled);
+}
+
+void Plant::receive(const hal::ThrusterOutputs& thrusters) {
+  held_cmd_ = thrusters;
+  have_cmd_ = true;
+  cmd_time_ = t();
+  valve_open_ = thrusters.valve_open;
+}
+
+void Plant::advance() {
+  // The valve driver: no new command for command_timeout_s -> every thruster off.
+  timed_out_ = have_cmd_ && p_.command_timeout_s > 0.0 &&
+               t() - cmd_time_ >= p_.command_timeout_s - 1e-9;
+  if (timed_out_) {
+    ++timeout_periods_;
+    step_period(Vec8::Zero(), false);
+  } else {
+    step_period(channel_forces(held_cmd_), held_cmd_.enabled);
+  }
+}
+
+void Plant::advance(const hal::ThrusterOutputs& thrusters) {
+  receive(thrusters);
+  advance();
+}
+
+void Plant::step_period(const Vec8& force, bool enabled) {
   // Per-channel saturation at the true u_max; zero-order hold over the period.
   clipped_ = false;
   for (int i = 0; i < gnc::kChannels; ++i) {
@@ -153,15 +293,64 @@ void Plant::advance(const Vec8& force, bool enabled) {
     ++disturbance_index_;
   }
 
-  // Eq. (2): B u + d. The study's unit strengths keep the original expression, bit for bit.
-  const Vec3 torque = unit_strengths_
-                          ? Vec3(b_ * applied_ + disturbance_ + p_.disturbance.bias_nm)
-                          : Vec3(thruster_torque(applied_) + disturbance_ + p_.disturbance.bias_nm);
+  if (!faults_.empty() || any_active_) update_active_faults(t0);
+  nominal_last_ = !any_active_ && valve_open_[0] && valve_open_[1] && valve_open_[2] &&
+                  valve_open_[3];
+  double flow_n = 0.0;  // propellant flow as force, N (Eq. 54)
+  if (nominal_last_) {
+    // Eq. (2): B u + d. The study's unit strengths keep the original expression, bit for bit.
+    control_torque_ = unit_strengths_ ? Vec3(b_ * applied_) : thruster_torque(applied_);
+    flow_n = applied_.lpNorm<1>();
+  } else {
+    // Physical thrusters: thruster 2c is channel c's "+", 2c + 1 its "-" (= 4 pod + position).
+    Vec8 delivered;
+    for (int c = 0; c < gnc::kChannels; ++c) {
+      for (int side = 0; side < 2; ++side) {
+        const int i = 2 * c + side;
+        const auto k = static_cast<std::size_t>(i);
+        const double commanded = side == 0 ? std::max(applied_(c), 0.0) : std::max(-applied_(c), 0.0);
+        double fired = commanded;  // what the thruster's valve lets through (propellant flow)
+        double thrust = commanded;
+        if (!valve_open_[static_cast<std::size_t>(hal::thruster_pod(i))]) {
+          fired = thrust = 0.0;  // latch valve closed: no propellant reaches the pod
+        } else {
+          switch (active_[k]) {
+            case FaultKind::kStuckOff: fired = thrust = 0.0; break;
+            case FaultKind::kStuckOn: fired = thrust = p_.rcs.u_max; break;
+            case FaultKind::kDegraded: thrust = active_factor_[k] * commanded; break;
+            case FaultKind::kNone: break;
+          }
+        }
+        thrust_(i) = thrust * p_.thruster_strength(i);
+        flow_n += fired;
+      }
+      delivered(c) = thrust_(2 * c) - thrust_(2 * c + 1);
+    }
+    control_torque_ = b_ * delivered;
+  }
+  const Vec3 torque = control_torque_ + disturbance_ + p_.disturbance.bias_nm;
   const double h = p_.control_period_s / p_.substeps;
   for (int s = 0; s < p_.substeps; ++s) att::rk4_step(j_, j_inv_, torque, h, beta_, omega_);
   // Eq. (54): exact for forces held over the period.
-  fuel_kg_ += applied_.lpNorm<1>() / (p_.isp_s * p_.g0) * p_.control_period_s;
+  fuel_kg_ += flow_n / (p_.isp_s * p_.g0) * p_.control_period_s;
   ++ticks_;
+}
+
+Vec16 Plant::thruster_thrust() const {
+  if (!nominal_last_) return thrust_;
+  Vec16 f = Vec16::Zero();
+  for (int c = 0; c < gnc::kChannels; ++c) {
+    const int i = applied_(c) >= 0.0 ? 2 * c : 2 * c + 1;
+    f(i) = std::fabs(applied_(c)) * p_.thruster_strength(i);
+  }
+  return f;
+}
+
+Vec8 Plant::delivered_force() const {
+  const Vec16 f = thruster_thrust();
+  Vec8 u;
+  for (int c = 0; c < gnc::kChannels; ++c) u(c) = f(2 * c) - f(2 * c + 1);
+  return u;
 }
 
 Vec3 Plant::thruster_torque(const Vec8& f) const {
@@ -171,10 +360,6 @@ Vec3 Plant::thruster_torque(const Vec8& f) const {
     delivered(c) = f(c) * p_.thruster_strength(f(c) >= 0.0 ? 2 * c : 2 * c + 1);
   }
   return b_ * delivered;
-}
-
-void Plant::advance(const hal::ThrusterOutputs& thrusters) {
-  advance(channel_forces(thrusters), thrusters.enabled);
 }
 
 Vec8 Plant::channel_forces(const hal::ThrusterOutputs& thrusters) {

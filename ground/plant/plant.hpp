@@ -12,12 +12,19 @@
 //   as a unit quaternion; a new sample every sensor period T_s, held in between;
 // - a gyro bias (constant + random walk on its own stream) and a strength factor per physical
 //   thruster (16), both off by default (zero, one), in which case the code path is the study's;
+// - thruster faults per physical thruster (stuck off, stuck on, degraded), each from an onset time,
+//   one latch valve per pod (a closed pod's four thrusters produce nothing, a stuck-on one
+//   included), and the valve driver's command timeout (thrusters off when commands stop); none of
+//   them by default, in which case the code path is the study's, bit for bit;
 // - every random stream (gyro, star tracker, disturbance, gyro bias) seeded from the run's seed: a
 //   run is bit-for-bit repeatable.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "gnc/model/mass_properties.hpp"
 #include "gnc/model/rcs.hpp"
@@ -48,6 +55,30 @@ struct SensorParams {
 // Sixteen physical thrusters: thruster 2c is channel c's "+" thruster, 2c+1 its "-" (SPEC §4).
 using Vec16 = Eigen::Matrix<double, 16, 1>;
 
+// A thruster fault (ground truth; the flight software never sees it). Physical thruster index
+// 4 * pod + position (hal/readings.hpp), which is also 2c ("+") and 2c + 1 ("-") of channel c.
+enum class FaultKind : std::uint8_t {
+  kNone = 0,
+  kStuckOff = 1,  // produces nothing whatever is commanded (and uses no propellant)
+  kStuckOn = 2,   // full thrust u_max whatever is commanded, while its pod's latch valve is open
+  kDegraded = 3,  // delivers factor x the commanded thrust, 0 < factor < 1
+};
+const char* to_string(FaultKind k);  // "none", "stuck_off", "stuck_on", "degraded"
+// Parses the names of to_string (not "none"). False for anything else.
+bool parse_fault_kind(const std::string& name, FaultKind& out);
+
+struct ThrusterFault {
+  int thruster{0};                      // 0..15
+  FaultKind kind{FaultKind::kStuckOff};
+  double onset_s{0.0};                  // plant time from which the fault acts, s (>= 0)
+  double factor{1.0};                   // kDegraded: thrust factor in (0, 1); otherwise unused
+};
+// Empty when the fault is valid, else the reason.
+std::string check(const ThrusterFault& f);
+// "thruster 3 stuck_on at 60 s", "thruster 5 degraded x0.5 at 100 s"; a list joined by "; ".
+std::string describe(const ThrusterFault& f);
+std::string describe(const std::vector<ThrusterFault>& faults);  // "none" when empty
+
 struct PlantParams {
   gnc::MassProperties mass{gnc::study_true_mass_properties()};  // true mass properties
   gnc::RcsLayout rcs{gnc::study_rcs_layout(200.0)};              // true geometry and u_max
@@ -60,6 +91,12 @@ struct PlantParams {
   // True strength factor of each physical thruster: the force it delivers is k_i times the
   // commanded one (1 in the study; fuel is counted on the commanded force).
   Vec16 thruster_strength{Vec16::Ones()};
+  // Thruster faults, at most one per thruster (none in the study).
+  std::vector<ThrusterFault> faults{};
+  // The valve driver's command timeout, s of plant time: when no new thruster command has arrived
+  // for this long, every thruster is switched off (latch valves keep their state). 0: off (the
+  // last command is held forever, the study's harness behaviour).
+  double command_timeout_s{0.0};
   Vec4 beta0{0.0, 0.0, 0.0, 1.0};  // initial attitude, unit quaternion of F_B in F_I
   Vec3 omega0{Vec3::Zero()};        // initial body rate, rad/s
   std::uint64_t seed{1};
@@ -74,12 +111,19 @@ class Plant {
   void reset();                          // initial state, time 0, streams re-seeded
   const PlantParams& params() const { return p_; }
 
-  // One control period: clip each channel at u_max (zeros when !enabled), hold the forces
-  // (and the disturbance) for the period, RK4 with `substeps` steps, integrate fuel (Eq. 54).
+  // One control period with a fresh command: clip each channel at u_max (zeros when !enabled), hold
+  // the forces (and the disturbance) for the period, apply the thruster faults and the latch valves
+  // (as last set), RK4 with `substeps` steps, integrate fuel (Eq. 54).
   void advance(const Vec8& force, bool enabled);
 
-  // The same with the 16 physical thrusters as the flight computer fires them (the plant's own
-  // SPEC §4 wiring maps them onto the channels; nothing fires when !thrusters.enabled).
+  // The valve driver: latch a new command (16 physical thrusters and the four latch valves) at the
+  // current plant time. The plant's own SPEC §4 wiring maps the thrusters onto the channels;
+  // nothing fires when !thrusters.enabled. The valves take the commanded state.
+  void receive(const hal::ThrusterOutputs& thrusters);
+  // One control period with the command last received (all off before any): when
+  // command_timeout_s > 0 and no command arrived for that long, every thruster is off.
+  void advance();
+  // receive() then advance(): a fresh command for this period.
   void advance(const hal::ThrusterOutputs& thrusters);
   // That mapping: the signed channel forces of a thruster firing (zeros when disabled).
   static Vec8 channel_forces(const hal::ThrusterOutputs& thrusters);
@@ -112,6 +156,29 @@ class Plant {
   // Test hook: overwrite the state (beta is normalised).
   void set_state(const Vec4& beta, const Vec3& omega);
 
+  // --- Faults and valves -------------------------------------------------------------------------
+  // Adds a fault at run time (PIL fault injection); it replaces any fault of that thruster, and acts
+  // from its onset (at once when the onset has passed). Returns the reason when rejected (empty:
+  // accepted).
+  std::string inject(const ThrusterFault& f);
+  void clear_fault(int thruster);  // removes that thruster's fault (no-op when out of range)
+  void clear_faults();
+  const std::vector<ThrusterFault>& faults() const { return faults_; }
+  // The fault acting on each thruster during the last period (kNone before the onset).
+  const std::array<FaultKind, hal::kThrusters>& active_faults() const { return active_; }
+  // Latch valves, one per pod (open by default); set by receive(), or directly (test hook).
+  const std::array<bool, gnc::kPods>& valves() const { return valve_open_; }
+  void set_valves(const std::array<bool, gnc::kPods>& open) { valve_open_ = open; }
+  // Force delivered by each physical thruster last period, N (after faults, valves, strengths).
+  Vec16 thruster_thrust() const;
+  // Signed channel forces delivered last period (delivered "+" minus delivered "-"), N.
+  Vec8 delivered_force() const;
+  // Body torque the thrusters delivered last period (the true B times the delivered forces), N m.
+  const Vec3& control_torque() const { return control_torque_; }
+  // The valve driver switched everything off last period for want of commands; periods so far.
+  bool command_timed_out() const { return timed_out_; }
+  std::uint64_t timeout_periods() const { return timeout_periods_; }
+
  private:
   PlantParams p_;
   Mat3 j_{Mat3::Identity()};
@@ -126,6 +193,23 @@ class Plant {
   Vec8 applied_{Vec8::Zero()};
   bool clipped_{false};
   std::uint64_t clipped_periods_{0};
+
+  // Faults, valves, valve driver.
+  std::vector<ThrusterFault> faults_{};
+  std::array<FaultKind, hal::kThrusters> active_{};
+  std::array<double, hal::kThrusters> active_factor_{};
+  bool any_active_{false};
+  bool nominal_last_{true};  // last period took the study's code path (no fault, valves open)
+  Vec16 thrust_{Vec16::Zero()};  // delivered per thruster (fault path)
+  Vec3 control_torque_{Vec3::Zero()};
+  std::array<bool, gnc::kPods> valve_open_{true, true, true, true};
+  hal::ThrusterOutputs held_cmd_{};
+  bool have_cmd_{false};
+  double cmd_time_{0.0};
+  bool timed_out_{false};
+  std::uint64_t timeout_periods_{0};
+  void update_active_faults(double t0);
+  void step_period(const Vec8& force, bool enabled);
 
   Vec3 disturbance_{Vec3::Zero()};
   std::int64_t disturbance_index_{-1};  // which hold interval the current draw belongs to

@@ -9,6 +9,11 @@
 //     up to --startup-timeout for the flight software (not counted).
 //   realtime: advance on wall-clock deadlines with the newest command received (zero-order hold).
 // The plant commands nothing itself: mode commands come from the operator, a test or a script.
+// Thruster commands go through the plant's valve driver: when none arrives for --valve-timeout s of
+// plant time (a held period counts), every thruster is switched off. Fault injection (PIL):
+// RS_PLANT_FAULT (plant_fault_cmd_t) on the ground bus adds or clears a thruster fault; each one is
+// answered with an event (accepted, or rejected with the reason) and counted. The case file's
+// `faults:` apply from the start. The flight software never hears any of it.
 // At the end, --summary prints the study's figures of merit (SPEC §7), computed on the true state
 // exactly as the in-process runner does (ground/merit). The plant links no flight software: it speaks
 // device readings (hal/readings.hpp) through the bus library (wire/).
@@ -27,6 +32,7 @@
 #include <exception>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <lcm/lcm.h>
@@ -65,7 +71,14 @@ std::string case_file(const std::string& config_dir, const std::string& arg) {
 }
 
 // Plant events on RS_EVENTS (ids from 1000).
-enum PlantEvent : std::int32_t { kRunStarted = 1000, kEchoTimeout = 1001, kRunFinished = 1002 };
+enum PlantEvent : std::int32_t {
+  kRunStarted = 1000,
+  kEchoTimeout = 1001,
+  kRunFinished = 1002,
+  kFaultAccepted = 1003,    // arg0: thruster, arg1: fault kind (or 0 for a clear)
+  kFaultRejected = 1004,    // arg0: thruster, arg1: op; text: the reason
+  kValveDriverTimeout = 1005,  // the valve driver switched the thrusters off (arg0: frame)
+};
 
 struct Bus {
   lcm_t* lcm{nullptr};
@@ -78,6 +91,9 @@ struct Bus {
   wire::RxCounters rx{};
   std::uint64_t commands{0};
   bool have_tlm{false};
+  rocksteady::plant_fault_cmd_t fault_scratch{};
+  std::vector<rocksteady::plant_fault_cmd_t> fault_queue;  // applied by the loop between periods
+  wire::RxCounters fault_rx{};
   int last_mode{-1};
   double fuel_hat{0.0};
   std::int64_t event_seq{0};
@@ -91,6 +107,13 @@ struct Bus {
     ++b.commands;
     b.latest = b.scratch;
     b.have_cmd = true;
+  }
+  static void on_fault(const lcm_recv_buf_t* rbuf, const char* /*ch*/, void* self) {
+    auto& b = *static_cast<Bus*>(self);
+    if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), b.fault_scratch,
+                          &b.fault_rx)) {
+      b.fault_queue.push_back(b.fault_scratch);
+    }  // else counted, ignored
   }
   static void on_tlm(const lcm_recv_buf_t* rbuf, const char* /*ch*/, void* self) {
     auto& b = *static_cast<Bus*>(self);
@@ -169,11 +192,51 @@ rocksteady::plant_truth_t make_truth(std::int64_t seq, const plant::Plant& p) {
   for (int i = 0; i < 3; ++i) m.omega[i] = p.omega()(i);
   m.omega_norm = p.omega().norm();
   for (int i = 0; i < 8; ++i) m.channel_force[i] = p.applied_force()(i);
-  const plant::Vec3 tc = p.torque_matrix() * p.applied_force();
+  const plant::Vec3 tc = p.control_torque();
   for (int i = 0; i < 3; ++i) m.torque_control[i] = tc(i);
   for (int i = 0; i < 3; ++i) m.torque_disturbance[i] = p.disturbance()(i);
   m.fuel_used_kg = p.fuel_kg();
+  const plant::Vec16 thrust = p.thruster_thrust();
+  for (int i = 0; i < hal::kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    m.fault_kind[i] = static_cast<std::int8_t>(p.active_faults()[k]);
+    m.fault_factor[i] = 1.0;
+    m.fault_onset[i] = -1.0;
+    m.thruster_force[i] = thrust(i);
+  }
+  for (const plant::ThrusterFault& f : p.faults()) {
+    m.fault_onset[f.thruster] = f.onset_s;
+    if (f.kind == plant::FaultKind::kDegraded) m.fault_factor[f.thruster] = f.factor;
+  }
+  for (int k = 0; k < gnc::kPods; ++k) m.valve_open[k] = p.valves()[static_cast<std::size_t>(k)] ? 1 : 0;
+  m.command_timeout = p.command_timed_out() ? 1 : 0;
   return m;
+}
+
+// One RS_PLANT_FAULT command: applied to the plant, or the reason it was not.
+std::string apply_fault_command(const rocksteady::plant_fault_cmd_t& c, plant::Plant& p) {
+  using C = rocksteady::plant_fault_cmd_t;
+  switch (c.op) {
+    case C::OP_INJECT: {
+      plant::ThrusterFault f;
+      f.thruster = c.thruster;
+      switch (c.fault_kind) {
+        case C::FAULT_STUCK_OFF: f.kind = plant::FaultKind::kStuckOff; break;
+        case C::FAULT_STUCK_ON: f.kind = plant::FaultKind::kStuckOn; break;
+        case C::FAULT_DEGRADED: f.kind = plant::FaultKind::kDegraded; break;
+        default: return "unknown fault kind " + std::to_string(c.fault_kind);
+      }
+      f.onset_s = std::max(0.0, c.onset_s);
+      f.factor = f.kind == plant::FaultKind::kDegraded ? c.factor : 1.0;
+      return p.inject(f);
+    }
+    case C::OP_CLEAR:
+      if (c.thruster < 0 || c.thruster >= hal::kThrusters) return "thruster must be in [0, 15]";
+      p.clear_fault(c.thruster);
+      return "";
+    case C::OP_CLEAR_ALL: p.clear_faults(); return "";
+    default: return "unknown op " + std::to_string(c.op);
+  }
 }
 
 std::string fmt_opt(const std::optional<double>& v, const char* unit, int prec) {
@@ -222,6 +285,11 @@ int main(int argc, char** argv) {
   cli.add_option("--out", out_csv, "time series CSV (true state, forces, fuel)");
   cli.add_option("--log-interval", log_interval_s, "CSV row interval, s")->capture_default_str();
   cli.add_flag("-v,--verbose", verbose, "progress once per wall second");
+  double valve_timeout_s = 1.0;
+  cli.add_option("--valve-timeout", valve_timeout_s,
+                 "valve driver: switch every thruster off after this many seconds of plant time "
+                 "without a thruster command (0: hold the last command forever; default: the case "
+                 "file's valve_driver_timeout_s when set, else 1 s)");
   std::string ground_url;
   cli.add_option("--ground-lcm-url", ground_url,
                  "separate ground bus (as rocksteady-fsw's): telemetry in, events and truth out");
@@ -250,6 +318,13 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rocksteady-plant: %s\n", e.what());
     return 2;
+  }
+  if (cli.count("--valve-timeout") > 0 || setup.truth.command_timeout_s == 0.0) {
+    if (!(valve_timeout_s >= 0.0) || !std::isfinite(valve_timeout_s)) {
+      std::fprintf(stderr, "rocksteady-plant: --valve-timeout must be >= 0\n");
+      return 2;
+    }
+    setup.truth.command_timeout_s = valve_timeout_s;
   }
   plant::Plant plant(setup.truth);
   const double dt = setup.truth.control_period_s;
@@ -316,6 +391,9 @@ int main(int argc, char** argv) {
     lcm_subscribe(bus.command_bus(), channels::kThrusterCmd, &Bus::on_cmd, &bus);
   }
   lcm_subscribe(bus.ground_bus(), channels::kGncTelemetry, &Bus::on_tlm, &bus);
+  lcm_subscribe(bus.ground_bus(), channels::kPlantFault, &Bus::on_fault, &bus);
+  bus.fault_queue.reserve(64);
+  std::uint64_t faults_accepted = 0, faults_rejected = 0, driver_timeouts = 0;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
@@ -407,6 +485,7 @@ int main(int argc, char** argv) {
       started = true;
       if (got) {
         thrusters = wire::to_outputs(bus.latest);
+        plant.receive(thrusters);
         const plant::Vec8 from_thrusters = plant::Plant::channel_forces(thrusters);
         for (int i = 0; i < 8; ++i) {
           if (std::fabs(from_thrusters(i) - bus.latest.channel_force[i]) >
@@ -432,6 +511,7 @@ int main(int argc, char** argv) {
         if (bus.have_cmd) {
           bus.have_cmd = false;
           thrusters = wire::to_outputs(bus.latest);
+          plant.receive(thrusters);
           ++applied;
           if (bus.latest.seq == static_cast<std::int64_t>(k)) fresh = true;
         }
@@ -445,7 +525,29 @@ int main(int argc, char** argv) {
     }
     if (g_stop != 0) break;
 
-    plant.advance(thrusters);
+    // Fault injection between periods: the next period has it.
+    for (const rocksteady::plant_fault_cmd_t& c : bus.fault_queue) {
+      const std::string why = apply_fault_command(c, plant);
+      if (why.empty()) {
+        ++faults_accepted;
+        bus.event(rocksteady::event_t::SEV_INFO, kFaultAccepted, c.thruster, c.fault_kind, plant.t(),
+                  "plant fault command seq " + std::to_string(c.seq) + " applied: " +
+                      plant::describe(plant.faults()));
+      } else {
+        ++faults_rejected;
+        bus.event(rocksteady::event_t::SEV_WARNING, kFaultRejected, c.thruster, c.op, plant.t(),
+                  "plant fault command seq " + std::to_string(c.seq) + " rejected: " + why);
+      }
+    }
+    bus.fault_queue.clear();
+
+    const bool was_timed_out = plant.command_timed_out();
+    plant.advance();  // the command last received, through the valve driver
+    if (plant.command_timed_out() && !was_timed_out) {
+      ++driver_timeouts;
+      bus.event(rocksteady::event_t::SEV_WARNING, kValveDriverTimeout, static_cast<std::int32_t>(k), 0,
+                plant.t(), "valve driver: no thruster command, every thruster off");
+    }
     const double w = plant.omega().norm();
     const double t = plant.t();
     omega_conv.add(t, w, plant.fuel_kg());
@@ -493,6 +595,11 @@ int main(int argc, char** argv) {
                 ", rx rejected %" PRIu64 ", thruster/channel mismatches %" PRIu64 "\n",
                 bus.commands, applied, timeouts, resends, holds, stale, bus.rx.rejected(),
                 wiring_mismatch);
+    std::printf("  faults: %s; commands accepted %" PRIu64 ", rejected %" PRIu64
+                ", malformed %" PRIu64 "; valve-driver timeouts %" PRIu64 " (%" PRIu64
+                " periods off)\n",
+                plant::describe(plant.faults()).c_str(), faults_accepted, faults_rejected,
+                bus.fault_rx.rejected(), driver_timeouts, plant.timeout_periods());
     std::printf("summary: case=%d mode=%s periods=%" PRIu64
                 " t_omega=%s fuel_omega=%s t_q=%s "
                 "fuel_q=%s total_fuel=%.17g final_rate=%.17g final_q_error=%.17g flight_mode=%s "

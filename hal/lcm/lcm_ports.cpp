@@ -52,7 +52,12 @@ void LcmThrusterSink::republish() {
 void LcmThrusterSink::all_off(std::int64_t seq, double t) {
   const std::lock_guard<std::mutex> lock(mutex_);
   off_latched_.store(true);
-  const ThrusterOutputs off{};  // disabled, every thruster off, zero force
+  // Disabled, every thruster off, zero force; the latch valves stay as last commanded (reopening a
+  // valve that isolates a failed-on thruster would fire it again).
+  ThrusterOutputs off{};
+  for (int p = 0; p < gnc::kPods; ++p) {
+    off.valve_open[static_cast<std::size_t>(p)] = msg_.valve_closed[p] == 0;
+  }
   msg_ = wire::to_message(off, channel_forces(wiring_, off), seq, t);
   written_ = true;
   publish_locked();

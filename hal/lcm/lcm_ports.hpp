@@ -66,11 +66,17 @@ class LcmThrusterSink final : public ThrusterSink {
   bool written() const { return written_.load(); }
   std::uint64_t publish_errors() const { return publish_errors_.load(); }
 
-  // Commands every thruster off (thruster bank disabled, all 16 off, zero force), echoing `seq`,
-  // and latches: later write() and republish() calls publish nothing (counted in suppressed()).
+  // Commands every thruster off (thruster bank disabled, all 16 off, zero force; the latch valves
+  // keep their last commanded state), echoing `seq`, and latches: later write() and republish()
+  // calls publish nothing (counted in suppressed()).
   // For the watchdog: callable from any thread, also while write() is in progress on another.
   void all_off(std::int64_t seq, double t);
   bool latched_off() const { return off_latched_.load(); }
+  // The message last built (a copy, under the lock).
+  rocksteady::thruster_cmd_t last_message() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return msg_;
+  }
   std::uint64_t suppressed() const { return suppressed_.load(); }
 
  private:

@@ -172,6 +172,34 @@ TEST(ConfigErrors, UnknownKey) {
   expect_error([&] { load_case(g.path()); }, g.path(), "u_maxx", "unknown key");
 }
 
+// The findings: a duplicate key was silently ignored (the first one won), and u_max_n: 1e300 or
+// duration_s: 1e300 were accepted. Both are errors naming file, key and reason now.
+TEST(ConfigErrors, DuplicateKeyIsAnError) {
+  TempFile f("case.yaml", read(case_file(1)) + "u_max_n: 5\n");
+  expect_error([&] { load_case(f.path()); }, f.path(), "u_max_n", "duplicate key");
+  TempFile g("gnc.yaml", replaced(read(kGnc), "  auto_hold: true", "  auto_hold: true\n  auto_hold: false"));
+  expect_error([&] { load_gnc(g.path()); }, g.path(), "modes.auto_hold", "duplicate key");
+}
+
+TEST(ConfigErrors, ValuesOutsideTheirPhysicalRangesAreErrors) {
+  TempFile f("case.yaml", replaced(read(case_file(2)), "u_max_n: 200", "u_max_n: 1e300"));
+  expect_error([&] { load_case(f.path()); }, f.path(), "u_max_n", "physical range");
+  TempFile g("case.yaml", read(case_file(1)));
+  const std::string text = read(case_file(1));
+  const std::size_t at = text.find("duration_s:");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t end = text.find('\n', at);
+  TempFile h("case.yaml", text.substr(0, at) + "duration_s: 1e300" + text.substr(end));
+  expect_error([&] { load_case(h.path()); }, h.path(), "duration_s", "physical range");
+  TempFile k("gnc.yaml", replaced(read(kGnc), "sensor_timeout_s: 1.0", "sensor_timeout_s: 1e30"));
+  try {
+    load_flight_params(kMission, k.path(), case_file(1));
+    ADD_FAILURE() << "sensor_timeout_s: 1e30 accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("mode.sensor_timeout"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ConfigErrors, WrongShape) {
   TempFile f("mission.yaml",
              replaced(read(kMission), "r_so_bcm_m: [-0.0495, -0.0004, 3.5456]", "r_so_bcm_m: [1, 2]"));
@@ -210,7 +238,7 @@ TEST(ConfigErrors, NegativeNoisePower) {
 
 TEST(ConfigErrors, BadValues) {
   TempFile f("gnc.yaml", replaced(read(kGnc), "estimator: auto", "estimator: kalman"));
-  expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough or filter");
+  expect_error([&] { load_gnc(f.path()); }, f.path(), "estimator", "auto, passthrough, filter or mekf");
   TempFile a("gnc.yaml", replaced(read(kGnc), "allocator: pinv", "allocator: simplex"));
   expect_error([&] { load_gnc(a.path()); }, a.path(), "allocator", "pinv or l1");
   TempFile g("gnc.yaml", replaced(read(kGnc), "{K_d: 1.0e4, k_p: 10.0}", "{K_d: -1.0e4, k_p: 10.0}"));
@@ -256,6 +284,67 @@ TEST(PlantTruthExtras, BadValuesNameFileAndKey) {
       "x.yaml", "plant_truth.thruster_strength", ">= 0");
   expect_error([&] { apply_plant_truth(YAML::Load("{gyro_bias: [0, 0, 0]}"), "x.yaml", t); },
                "x.yaml", "plant_truth.gyro_bias", "unknown key");
+}
+
+
+TEST(CaseFaults, AbsentMeansNoFaultAndNoTimeout) {
+  for (int n = 1; n <= 7; ++n) {
+    const RunSetup s = load_run(kMission, kGnc, case_file(n));
+    EXPECT_TRUE(s.truth.faults.empty());
+    EXPECT_EQ(s.truth.command_timeout_s, 0.0);
+  }
+}
+
+TEST(CaseFaults, ListAndTimeoutReachThePlantButNotTheFlightSoftware) {
+  TempFile f("case.yaml", read(case_file(5)) +
+                              "faults:\n"
+                              "  - {thruster: 3, kind: stuck_on, onset_s: 60}\n"
+                              "  - {thruster: 9, kind: degraded, onset_s: 5000, factor: 0.5}\n"
+                              "  - {thruster: 12, kind: stuck_off}\n"
+                              "valve_driver_timeout_s: 1.5\n");
+  const RunSetup s = load_run(kMission, kGnc, f.path());
+  ASSERT_EQ(s.truth.faults.size(), 3u);
+  EXPECT_EQ(s.truth.faults[0].thruster, 3);
+  EXPECT_EQ(s.truth.faults[0].kind, plant::FaultKind::kStuckOn);
+  EXPECT_EQ(s.truth.faults[0].onset_s, 60.0);
+  EXPECT_EQ(s.truth.faults[1].kind, plant::FaultKind::kDegraded);
+  EXPECT_EQ(s.truth.faults[1].factor, 0.5);
+  EXPECT_EQ(s.truth.faults[2].kind, plant::FaultKind::kStuckOff);
+  EXPECT_EQ(s.truth.faults[2].onset_s, 0.0);
+  EXPECT_EQ(s.truth.command_timeout_s, 1.5);
+  // The flight software's loader accepts the file and its parameters are those of the plain case.
+  const gnc::GncParams with = load_flight_params(kMission, kGnc, f.path());
+  const gnc::GncParams without = load_flight_params(kMission, kGnc, case_file(5));
+  EXPECT_EQ(with.rcs.u_max, without.rcs.u_max);
+  EXPECT_EQ(with.mass_hat.j_ast, without.mass_hat.j_ast);
+  EXPECT_EQ(with.estimator.kind, without.estimator.kind);
+}
+
+TEST(CaseFaults, BadEntriesNameFileKeyAndReason) {
+  const std::string base = read(case_file(1));
+  struct Bad {
+    std::string yaml, key, reason;
+  };
+  const Bad bad[] = {
+      {"faults: {thruster: 3}\n", "faults", "list of faults"},
+      {"faults: [3]\n", "faults[0]", "mapping"},
+      {"faults:\n  - {thruster: 16, kind: stuck_on}\n", "faults[0].thruster", "[0, 15]"},
+      {"faults:\n  - {thruster: 2.5, kind: stuck_on}\n", "faults[0].thruster", "integer"},
+      {"faults:\n  - {kind: stuck_on}\n", "faults[0].thruster", "missing required key"},
+      {"faults:\n  - {thruster: 1, kind: stuck}\n", "faults[0].kind", "stuck_off, stuck_on or degraded"},
+      {"faults:\n  - {thruster: 1, kind: degraded}\n", "faults[0].factor", "missing required key"},
+      {"faults:\n  - {thruster: 1, kind: degraded, factor: 1.0}\n", "faults[0].factor", "(0, 1)"},
+      {"faults:\n  - {thruster: 1, kind: stuck_on, factor: 0.5}\n", "faults[0].factor", "only a degraded"},
+      {"faults:\n  - {thruster: 1, kind: stuck_on, onset_s: -2}\n", "faults[0].onset_s", "negative"},
+      {"faults:\n  - {thruster: 1, kind: stuck_on, onsett: 2}\n", "faults[0].onsett", "unknown key"},
+      {"faults:\n  - {thruster: 1, kind: stuck_on}\n  - {thruster: 1, kind: stuck_off}\n",
+       "faults[1].thruster", "already has a fault"},
+      {"valve_driver_timeout_s: -1\n", "valve_driver_timeout_s", "negative"},
+  };
+  for (const Bad& b : bad) {
+    TempFile f("case.yaml", base + b.yaml);
+    expect_error([&] { load_run(kMission, kGnc, f.path()); }, f.path(), b.key, b.reason);
+  }
 }
 
 }  // namespace

@@ -18,11 +18,13 @@ exec unshare -rn bash -c '
   state=$(mktemp -d)
   cd "$RS_SRC"
   rm -f "$RS_OUT"/*.log "$RS_OUT"/*.png   # nothing of an earlier run is read or kept
+  # A command key made for this run: the console signs, the flight verifies.
+  "$RS_BUILD/ground/cli/rocksteady-ground" keygen "$state/key" > /dev/null
   "$RS_BUILD/fsw/main/rocksteady-fsw" --lcm-url "$url" --case 1 --clock realtime \
-      --start-mode DETUMBLE --tlm-every 2 > "$RS_OUT/fsw.log" 2>&1 & fsw=$!
+      --key-file "$state/key" --start-mode DETUMBLE --tlm-every 2 > "$RS_OUT/fsw.log" 2>&1 & fsw=$!
   "$RS_BUILD/ground/plantd/rocksteady-plant" --lcm-url "$url" --case 1 --mode realtime \
       --truth-every 2 > "$RS_OUT/plant.log" 2>&1 & plant=$!
-  "$RS_BUILD/ground/cli/rocksteady-ground" --lcm-url "$url" serve --port 0 --state-dir "$state" \
+  "$RS_BUILD/ground/cli/rocksteady-ground" --lcm-url "$url" --key-file "$state/key" serve --port 0 --state-dir "$state" \
       --stale-after 2 > "$RS_OUT/serve.log" 2>&1 & serve=$!
   trap "kill $fsw $plant $serve 2>/dev/null; rm -rf $state" EXIT
   for i in $(seq 150); do grep -q "^console: http" "$RS_OUT/serve.log" && break; sleep 0.2; done

@@ -184,8 +184,10 @@ TEST(FlightApp, TimeBaseResynchronisesAfterARunOfRejectedFrames) {
   f.loop.truth.t = 0.0;  // the sensor front end restarted its clock
   for (int i = 0; i < 5; ++i) f.ticks(1);
   EXPECT_EQ(f.app->health().frames_rejected, 5u);
-  f.ticks(1);  // the 6th accepted as the new time base
-  EXPECT_EQ(f.app->health().frames_rejected, 5u);
+  f.ticks(2);  // the 6th and 7th: a run of consistent frames, still rejected
+  EXPECT_EQ(f.app->health().frames_rejected, 7u);
+  f.ticks(1);  // the 8th completes the run (frame_resync_run 3) and re-anchors the base
+  EXPECT_EQ(f.app->health().frames_rejected, 7u);
   EXPECT_NEAR(f.out.telemetry.t, f.loop.truth.t - 0.05, 1e-12);
 }
 
@@ -206,13 +208,14 @@ TEST(FlightApp, HousekeepingPublishesHealthAtItsRate) {
 
 TEST(FlightApp, EventQueueDropsAndCountsWhenFull) {
   AppFixture f;
+  test::drain(*f.app);  // the lab-mode announcement (event 0)
   for (int i = 0; i < EventQueue::kCapacity + 10; ++i) f.send(Opcode::kNoop);
   EXPECT_EQ(f.app->pending_events(), EventQueue::kCapacity);
   EXPECT_EQ(f.app->health().events_dropped, 10u);
-  EXPECT_EQ(f.app->health().events_emitted, static_cast<std::uint32_t>(EventQueue::kCapacity + 10));
+  EXPECT_EQ(f.app->health().events_emitted, static_cast<std::uint32_t>(EventQueue::kCapacity + 11));
   Event e;
   ASSERT_TRUE(f.app->pop_event(e));
-  EXPECT_EQ(e.seq, 0u);  // the oldest are kept
+  EXPECT_EQ(e.seq, 1u);  // the oldest are kept
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ class FakePorts final : public hal::SensorSource, public hal::ThrusterSink {
     out.seq = seq_;
     out.t = truth_.t;
     out.gyro = hal::GyroReading{truth_.t, c_bs_.transpose() * truth_.omega, gyro_valid};
+    if (gyro_nan) out.gyro.rate.x() = std::numeric_limits<double>::quiet_NaN();
     out.star = hal::StarTrackerReading{truth_.t, truth_.beta, true};
     return true;
   }
@@ -56,6 +57,7 @@ class FakePorts final : public hal::SensorSource, public hal::ThrusterSink {
   }
 
   bool gyro_valid{true};
+  bool gyro_nan{false};
   hal::ThrusterOutputs last{};
   std::int64_t last_seq{-1};
   double last_t{0.0};
@@ -145,6 +147,38 @@ TEST(FlightComputer, AGyroWithoutValidReadingsTakesItToSafeWithThrustersOff) {
   EXPECT_GT(rig.computer->gyro_rejects(), 0u);
   EXPECT_EQ(rig.computer->mode(), gnc::Mode::kSafe);
   EXPECT_FALSE(rig.ports->last.enabled);
+  // SAFE keeps commanding every thruster off through the HAL, on every GNC tick: each of the 16 is
+  // written off with zero force (a valve driver that loses these commands times out on its own).
+  for (int i = 0; i < 20; ++i) {
+    const int writes = rig.ports->writes;
+    ASSERT_TRUE(rig.tick().gnc_ran);
+    EXPECT_EQ(rig.ports->writes, writes + 1);
+    EXPECT_EQ(rig.computer->mode(), gnc::Mode::kSafe);
+    EXPECT_FALSE(rig.ports->last.enabled);
+    for (int t = 0; t < hal::kThrusters; ++t) {
+      EXPECT_FALSE(rig.ports->last.on[static_cast<std::size_t>(t)]) << t;
+      EXPECT_EQ(rig.ports->last.force[static_cast<std::size_t>(t)], 0.0) << t;
+    }
+    EXPECT_EQ(rig.ports->last.valve_open, (std::array<bool, 4>{true, true, true, true}));
+  }
+}
+
+// A NaN in a sensor value is a rejected sample, counted in the health's sensor_rejects (one per
+// frame), and reset with the other counters.
+TEST(FlightComputer, NanSensorValuesAreCountedInSensorRejects) {
+  Rig rig;
+  rig.truth.omega = V3(0.2, 0.0, 0.0);
+  for (int i = 0; i < 3; ++i) rig.tick();
+  EXPECT_EQ(rig.computer->health().sensor_rejects, 0u);
+  rig.ports->gyro_nan = true;
+  for (int i = 0; i < 7; ++i) rig.tick();
+  EXPECT_EQ(rig.computer->health().sensor_rejects, 7u);
+  rig.ports->gyro_nan = false;
+  for (int i = 0; i < 3; ++i) rig.tick();
+  EXPECT_EQ(rig.computer->health().sensor_rejects, 7u);
+  ASSERT_TRUE(rig.computer->submit(test::command(1, Opcode::kResetCounters)).accepted);
+  rig.tick();
+  EXPECT_EQ(rig.computer->health().sensor_rejects, 0u);
 }
 
 // A harness reaches the devices only through the ports: the flight computer exposes no device,

@@ -64,6 +64,7 @@ inline FlightConfig small_config() {
   c.executive.housekeeping_divider = 20;
   c.executive.slip_event_interval_s = 10.0;
   c.sensor_event_interval_s = 10.0;
+  c.security.lab_mode = true;  // command authentication has its own tests (auth_test.cpp)
   return c;
 }
 

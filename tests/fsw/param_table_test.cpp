@@ -2,10 +2,12 @@
 // activate at a tick boundary.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 #include <string>
 
 #include "fsw/params/param_table.hpp"
+#include "gnc/param_bounds.hpp"
 #include "fsw_harness.hpp"
 
 namespace rocksteady::fsw {
@@ -140,12 +142,13 @@ TEST(ParamTable, InvalidLoadNamesTheFirstBadFieldAndKeepsTheInactiveTable) {
 TEST(ParamTable, CoupledFieldsLoadInAValidOrder) {
   ParamTable t;
   t.reset(test::small_vehicle_params());
-  double eps = 3.0;
-  double sw = 2.0;
-  // omega_switch = 2 first would exceed eps_trans = 1; raising eps_trans first keeps it valid.
-  EXPECT_FALSE(t.load(static_cast<int>(ParamId::kOmegaSwitch), &sw, 1).ok());
-  EXPECT_TRUE(t.load(static_cast<int>(ParamId::kEpsTrans), &eps, 1).ok());
+  double eps = 0.01;
+  double sw = 0.005;
+  // eps_trans = 0.01 first would fall below omega_switch = 0.02; lowering omega_switch first keeps
+  // the table valid (both values inside their physical ranges, gnc/param_bounds.cpp).
+  EXPECT_FALSE(t.load(static_cast<int>(ParamId::kEpsTrans), &eps, 1).ok());
   EXPECT_TRUE(t.load(static_cast<int>(ParamId::kOmegaSwitch), &sw, 1).ok());
+  EXPECT_TRUE(t.load(static_cast<int>(ParamId::kEpsTrans), &eps, 1).ok());
 }
 
 TEST(ParamTableActivation, TakesEffectAtTheNextTickBoundary) {
@@ -260,6 +263,79 @@ TEST(ParamTableActivation, DumpReadsTheActiveTableBack) {
   EXPECT_EQ(d.values[static_cast<int>(ParamId::kDpdKp)][0], 5.0);
   const std::vector<Event> ev = test::drain(*f.app);
   EXPECT_EQ(test::count_events(ev, EventId::kParamsDumped), 1);
+}
+
+// The findings: values that switch protection or control off passed gnc::validate (sign and
+// finiteness only). Each is now refused by the physical-range table (gnc/param_bounds.cpp), naming
+// the parameter, and the table stays as it was; values inside the ranges still load.
+TEST(ParamBounds, ValuesThatSwitchProtectionOrControlOffAreRefused) {
+  AppFixture f;
+  const double timeout = static_cast<double>(static_cast<int>(ParamId::kSensorTimeout));
+  const double ntcl_k = static_cast<double>(static_cast<int>(ParamId::kNtclK));
+  const double lambda = static_cast<double>(static_cast<int>(ParamId::kNtclLambda));
+  const double gyro = static_cast<double>(static_cast<int>(ParamId::kGyroMaxRate));
+  const struct {
+    std::initializer_list<double> args;
+    const char* field;
+  } cases[] = {
+      {{timeout, 1e30}, "mode.sensor_timeout"},
+      {{timeout, 3600.0}, "mode.sensor_timeout"},
+      {{ntcl_k, 1e-300, 1e-300, 1e-300}, "ntcl.K"},
+      {{ntcl_k, 1e30, 1e30, 1e30}, "ntcl.K"},
+      {{lambda, 1e3, 1e3, 1e3}, "ntcl.Lambda"},
+      {{gyro, 1e9}, "estimator.gyro_max_rate"},
+  };
+  for (const auto& c : cases) {
+    const CommandAck a = f.send(Opcode::kParamLoad, c.args);
+    EXPECT_EQ(a.reason, RejectReason::kInvalidTable) << c.field;
+    EXPECT_STREQ(a.text, c.field);
+  }
+  EXPECT_FALSE(f.app->param_table().loaded());
+  EXPECT_TRUE(f.send(Opcode::kParamLoad, {timeout, 2.0}).accepted);
+  EXPECT_TRUE(f.send(Opcode::kParamLoad, {ntcl_k, 8.0, 8.0, 8.0}).accepted);
+}
+
+// Every row of the table: a value inside passes gnc::validate's range check, just outside fails,
+// naming that row (the table itself, checked independently of the code that applies it).
+TEST(ParamBounds, TheTableIsWellFormedAndEveryRowHasAReason) {
+  int n = 0;
+  const gnc::ParamBound* rows = gnc::param_bounds(n);
+  ASSERT_GT(n, 25);
+  for (int i = 0; i < n; ++i) {
+    EXPECT_LT(rows[i].lo, rows[i].hi) << rows[i].name;
+    EXPECT_GT(std::string(rows[i].why).size(), 10u) << rows[i].name;
+    EXPECT_EQ(gnc::find_param_bound(rows[i].name), &rows[i]);
+    if (rows[i].kind == gnc::BoundKind::kScalar) {
+      EXPECT_TRUE(gnc::within_bound(rows[i].name, rows[i].lo));
+      EXPECT_TRUE(gnc::within_bound(rows[i].name, rows[i].hi));
+      EXPECT_FALSE(gnc::within_bound(rows[i].name, rows[i].hi * 1.01 + 1e-12));
+      EXPECT_FALSE(gnc::within_bound(rows[i].name, std::nan("")));
+    }
+  }
+  // The study's and the tests' parameters are inside every range.
+  EXPECT_TRUE(gnc::check_bounds(gnc::study_gnc_params(200.0)).ok)
+      << gnc::check_bounds(gnc::study_gnc_params(200.0)).field;
+  EXPECT_TRUE(gnc::check_bounds(test::small_vehicle_params()).ok)
+      << gnc::check_bounds(test::small_vehicle_params()).field;
+}
+
+// The finding: PARAM_DISCARD was acknowledged while a pending activation still went through.
+TEST(ParamBounds, DiscardIsRefusedWhileAnActivationIsPending) {
+  AppFixture f;
+  f.ticks(1);
+  const double kp = static_cast<double>(static_cast<int>(ParamId::kDpdKp));
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {kp, 4.5}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kParamActivate).accepted);
+  const CommandAck d = f.send(Opcode::kParamDiscard);
+  EXPECT_FALSE(d.accepted);
+  EXPECT_EQ(d.reason, RejectReason::kBusy);
+  f.ticks(1);
+  EXPECT_EQ(f.app->active_params().dpd.k_p, 4.5);  // what the refusal said: it was activated
+  // With nothing pending, a discard drops the load as before.
+  ASSERT_TRUE(f.send(Opcode::kParamLoad, {kp, 7.0}).accepted);
+  EXPECT_TRUE(f.send(Opcode::kParamDiscard).accepted);
+  f.ticks(1);
+  EXPECT_EQ(f.app->active_params().dpd.k_p, 4.5);
 }
 
 }  // namespace

@@ -182,5 +182,51 @@ TEST(TrajectoryUplinkApp, TrackCannotHaveItsTableReplaced) {
   EXPECT_TRUE(f.send(Opcode::kLoadTrajectory, {2.0}).accepted);
 }
 
+// The finding: a table with omega_d_dot = +-1 rad/s^2 and a recomputed CRC loaded, and TRACK drove
+// |omega_r| to 9.9 rad/s. Samples within eps_trans are not enough: the flight follows the cubic
+// Hermite interpolation of omega_d and omega_d_dot, so both are bounded now.
+TEST(TrajectoryUplinkApp, AccelerationsAndTheInterpolationBetweenSamplesAreBounded) {
+  auto load = [](gnc::TrajectoryTable& t, std::int32_t id) {
+    t.checksum = gnc::trajectory_checksum(t);  // the attacker recomputes the CRC
+    AppFixture f;
+    f.ticks(2);
+    for (const TrajectoryChunk& c : test::chunks_of(t, id)) {
+      EXPECT_EQ(f.app->receive_chunk(c), ChunkStatus::kStored);
+    }
+    const CommandAck a = f.send(Opcode::kLoadTrajectory, {static_cast<double>(id)});
+    f.ticks(1);
+    return std::make_pair(a, f.app->trajectory_loaded());
+  };
+  // The small test vehicle: eps_trans 1 rad/s. Every sample inside it, but omega_d_dot alternating
+  // +-1e3 rad/s^2: far above what its thrusters can produce, and the interpolation swings out.
+  Plan wild(70, 20.0);
+  for (int i = 0; i + 1 < wild.table->count; ++i) {
+    wild.table->samples[i].omega_d_dot = V3((i % 2 == 0 ? 1e3 : -1e3), 0.0, 0.0);
+  }
+  auto [a, loaded] = load(*wild.table, 5);
+  EXPECT_FALSE(a.accepted);
+  EXPECT_EQ(a.reason, RejectReason::kTrajectoryRejected);
+  EXPECT_FALSE(loaded);
+  // Plausible accelerations, but an interpolation that leaves eps_trans between two samples
+  // (slopes of opposite sign at samples on the bound): refused too.
+  Plan edge(70, 20.0);
+  for (int i = 0; i < edge.table->count; ++i) {
+    edge.table->samples[i].omega_d = V3(i + 1 < edge.table->count ? 0.999 : 0.0, 0.0, 0.0);
+    edge.table->samples[i].omega_d_dot = V3(i % 2 == 0 ? 0.5 : -0.5, 0.0, 0.0);
+  }
+  edge.table->samples[edge.table->count - 1].omega_d_dot.setZero();
+  const double mid = gnc::interpolate(*edge.table, 0.5 * (edge.table->samples[0].t +
+                                                         edge.table->samples[1].t)).omega_d.norm();
+  ASSERT_GT(mid, 1.01);  // independent check that this table really leaves the bound
+  auto [b, loaded_b] = load(*edge.table, 6);
+  EXPECT_EQ(b.reason, RejectReason::kTrajectoryRejected) << b.text;
+  EXPECT_FALSE(loaded_b);
+  // The ordinary despin plan still loads.
+  Plan ok(70, 20.0);
+  auto [c, loaded_c] = load(*ok.table, 7);
+  EXPECT_TRUE(c.accepted) << c.text;
+  EXPECT_TRUE(loaded_c);
+}
+
 }  // namespace
 }  // namespace rocksteady::fsw

@@ -2,7 +2,8 @@
 // message next: the sensor layer, the thruster bank, the flight application's command validator and
 // trajectory uplink. One source, one target per build (ROCKSTEADY_FUZZ_TARGET):
 //   1 sensor_frame_t   2 thruster_cmd_t   3 ground_cmd_t   4 trajectory_chunk_t
-//   5 the ground side's inbound types (event_t, cmd_ack_t, gnc_telemetry_t, plant_truth_t)
+//   5 the ground side's inbound types (event_t, cmd_ack_t, gnc_telemetry_t, plant_truth_t,
+//     plant_fault_cmd_t)
 // Each input is tried as a whole message and, so the fuzzer explores the body without having to find
 // the 8-byte fingerprint, once more behind the right fingerprint. Invariant: a message the decoder
 // accepts re-encodes to exactly the same bytes. Any violation traps.
@@ -233,6 +234,9 @@ void write_seeds(const std::filesystem::path& dir) {
   b = encoded(wire::make<rs::plant_truth_t>());
   b.insert(b.begin(), 3);
   write_seed(dir, b);
+  b = encoded(wire::make<rs::plant_fault_cmd_t>());
+  b.insert(b.begin(), 4);
+  write_seed(dir, b);
 #endif
 }
 
@@ -259,11 +263,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 #else
   // First byte selects the type.
   if (size < 1) return 0;
-  switch (data[0] % 4) {
+  switch (data[0] % 5) {
     case 0: fuzz_type<rs::event_t>(data + 1, size - 1, nothing<rs::event_t>); break;
     case 1: fuzz_type<rs::cmd_ack_t>(data + 1, size - 1, nothing<rs::cmd_ack_t>); break;
     case 2: fuzz_type<rs::gnc_telemetry_t>(data + 1, size - 1, nothing<rs::gnc_telemetry_t>); break;
-    default: fuzz_type<rs::plant_truth_t>(data + 1, size - 1, nothing<rs::plant_truth_t>); break;
+    case 3: fuzz_type<rs::plant_truth_t>(data + 1, size - 1, nothing<rs::plant_truth_t>); break;
+    default: fuzz_type<rs::plant_fault_cmd_t>(data + 1, size - 1, nothing<rs::plant_fault_cmd_t>); break;
   }
 #endif
   return 0;

@@ -37,7 +37,8 @@ TEST(ZeroAllocation, CountingHookSeesAnAllocation) {
 TEST(ZeroAllocation, NoHeapInAnyTickOfAnyLawAndMode) {
   const LawId laws[] = {LawId::kNtcl,     LawId::kNtclEl, LawId::kIntegral,   LawId::kAdaptive,
                         LawId::kSo3,      LawId::kDpd,    LawId::kFeedforward};
-  for (EstimatorKind est : {EstimatorKind::kPassThrough, EstimatorKind::kFilter}) {
+  for (EstimatorKind est :
+       {EstimatorKind::kPassThrough, EstimatorKind::kFilter, EstimatorKind::kMekf}) {
     for (LawId law : laws) {
       GncParams p = test::small_vehicle_params();
       p.law = law;
@@ -75,6 +76,60 @@ TEST(ZeroAllocation, NoHeapInAnyTickOfAnyLawAndMode) {
       delete loop;
     }
   }
+}
+
+// Every module on (MEKF, identification with automatic adoption, fault detection, L1): the tick,
+// the identifier's whole window cycle, a model adoption, a declared fault with its bias torque
+// and a closed valve allocate nothing.
+TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
+  GncParams truth = test::small_vehicle_params();
+  auto* loop = new test::SmallLoop(truth);
+  GncParams p = truth;
+  p.mass_hat.j_ast(0, 0) *= 1.3;  // a wrong table, so a model gets adopted
+  p.mass_hat.r_so_bcm += Vec3(0.05, -0.04, 0.045);
+  p.law = LawId::kNtcl;
+  p.allocator = AllocatorKind::kL1;
+  p.estimator.kind = EstimatorKind::kMekf;
+  p.mekf.gyro_arw = 1e-6;
+  p.mekf.star_sigma = 1e-5;
+  IdentificationParams& id = p.identification;
+  id.enabled = true;
+  id.adopt = ModelAdoption::kAuto;
+  id.adopt_interval_s = 5.0;
+  id.config.window_s = 2.0;
+  id.config.j_prior_sigma = 5.0;
+  id.config.r_prior_sigma = 0.5;
+  id.config.k_prior_sigma = 0.01;
+  id.config.disturbance_sigma = 1e-4;
+  id.config.torque_floor = 1e-4;
+  id.config.min_torque_impulse = 0.05;
+  id.config.min_force_impulse = 0.02;
+  id.config.min_thruster_impulse = 0.005;
+  p.fdi.enabled = true;  // and fault detection, with a ground declaration and a valve closure
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  long counted = -1;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    loop->tick(c);
+    for (int i = 0; i < 1200; ++i) loop->tick();
+    GncCommands o;
+    o.has_fault_declaration = true;
+    o.fault_thruster = 2;
+    o.fault_kind = FaultKind::kStuckOn;
+    o.has_valve = true;
+    o.valve_pod = 3;
+    o.valve_open = false;
+    loop->tick(o);
+    for (int i = 0; i < 1200; ++i) loop->tick();
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(loop->gnc.model_adoptions(), 1u);  // the adoption happened under the counter
+  EXPECT_GT(loop->gnc.identifier().counters().windows, 50u);
+  delete loop;
 }
 
 TEST(ZeroAllocation, NoHeapWhenATrajectoryIsStagedAndSwitchedAtATickBoundary) {

@@ -120,9 +120,11 @@ std::vector<Case> cases() {
       {"activate-gains", {}, false, M::kHold, O::kParamActivate, {}},
       {"discard-gains", {}, false, M::kHold, O::kParamDiscard, {}},
       {"dump-params", {}, false, M::kTrack, O::kParamDump, {}},
+      {"load-identified", {}, false, M::kDetumble, O::kParamLoadIdentified, {}},
       {"reset-counters", {}, false, M::kSafe, O::kResetCounters, {}},
       {"load-trajectory", {"7"}, false, M::kHold, O::kLoadTrajectory, {7}},
       {"abort-uplink", {"2147483647"}, false, M::kTrack, O::kAbortUplink, {2147483647.0}},
+      {"key-rotate", {"2"}, false, M::kTrack, O::kKeyRotate, {2}},
   };
 }
 
@@ -304,6 +306,15 @@ TEST(GroundDictionary, OpcodeNumbersAreTheFlightOpcodes) {
   EXPECT_EQ(G::OP_PARAM_DISCARD, static_cast<int>(fsw::Opcode::kParamDiscard));
   EXPECT_EQ(G::OP_LOAD_TRAJECTORY, static_cast<int>(fsw::Opcode::kLoadTrajectory));
   EXPECT_EQ(G::OP_ABORT_UPLINK, static_cast<int>(fsw::Opcode::kAbortUplink));
+}
+
+// The ground refuses what the flight would refuse, with the same table and reason.
+TEST(GroundCommands, SetGainChecksThePhysicalRangesBeforeSending) {
+  const Encoded e = encode_command("set-gain", {"mode.sensor_timeout", "1e30"});
+  EXPECT_FALSE(e.ok);
+  EXPECT_NE(e.error.find("outside its physical range"), std::string::npos) << e.error;
+  EXPECT_NE(e.error.find("mode.sensor_timeout"), std::string::npos) << e.error;
+  EXPECT_TRUE(encode_command("set-gain", {"mode.sensor_timeout", "2"}).ok);
 }
 
 }  // namespace

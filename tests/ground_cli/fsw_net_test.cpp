@@ -28,12 +28,16 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
   planner::write_trajectory_file(file, problem, plan);
 
   const std::string url = test::lcm_url(17620);
-  const std::string g = test::quote(ROCKSTEADY_GROUND_EXE) + " --lcm-url " + test::quote(url) + " ";
+  const std::string key = dir.file("key");
+  const std::string g = test::quote(ROCKSTEADY_GROUND_EXE) + " --lcm-url " + test::quote(url) +
+                        " --key-file " + test::quote(key) + " ";
   const std::string state = " --state-dir " + test::quote(dir.file("state"));
   std::string s;
+  // A test key made by the test (authenticated commanding end to end).
+  s += test::quote(ROCKSTEADY_GROUND_EXE) + " keygen " + test::quote(key) + " >/dev/null\n";
   s += test::quote(ROCKSTEADY_FSW_EXE) + " --config-dir " + test::quote(ROCKSTEADY_CONFIG_DIR) +
-       " --case 1 --clock realtime --exit-after 20 --lcm-url " + test::quote(url) + " >" +
-       test::quote(dir.file("fsw.txt")) + " 2>&1 &\n";
+       " --case 1 --clock realtime --exit-after 20 --key-file " + test::quote(key) +
+       " --lcm-url " + test::quote(url) + " >" + test::quote(dir.file("fsw.txt")) + " 2>&1 &\n";
   s += "fpid=$!\n";
   // Link check: noops until the flight answers (it may not be subscribed yet).
   s += "i=0; until " + g + "send noop --timeout 0.25" + state +
@@ -77,6 +81,58 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
             std::string::npos)
       << said;
   EXPECT_NE(o.find("23  mode.sensor_timeout            s                1\n"), std::string::npos)
+      << said;
+}
+
+// The replay state survives a restart of the flight process: a command accepted before the restart
+// (the very same counter and authenticator) is refused after it; a new one is accepted; a wrong
+// key file is refused at the ground's and the flight's start.
+TEST(GroundCliWithFlight, CapturedCommandIsRefusedAfterAFlightRestart) {
+  test::TempDir dir;
+  const std::string url = test::lcm_url(17621);
+  const std::string key = dir.file("key");
+  const std::string g = test::quote(ROCKSTEADY_GROUND_EXE) + " --lcm-url " + test::quote(url) +
+                        " --key-file " + test::quote(key) + " ";
+  const std::string state = " --state-dir " + test::quote(dir.file("state"));
+  const std::string fsw = test::quote(ROCKSTEADY_FSW_EXE) + " --config-dir " +
+                          test::quote(ROCKSTEADY_CONFIG_DIR) +
+                          " --case 1 --clock realtime --exit-after 20 --key-file " +
+                          test::quote(key) + " --lcm-url " + test::quote(url);
+  const std::string link = "i=0; until " + g + "send noop --timeout 0.25" + state +
+                           " >/dev/null 2>&1; do\n"
+                           "  i=$((i+1)); [ $i -ge 40 ] && { echo LINK DOWN; exit 3; }\n"
+                           "done\n";
+  const std::string captured = "send noop --seq 9000000000000000 --timeout 5" + state;
+  std::string s;
+  s += test::quote(ROCKSTEADY_GROUND_EXE) + " keygen " + test::quote(key) + " >/dev/null\n";
+  s += "chmod 644 " + test::quote(key) + "\n";
+  s += fsw + " >" + test::quote(dir.file("fsw0.txt")) + " 2>&1; echo fsw_open_key=$?\n";
+  s += g + "send noop --timeout 1" + state + "; echo ground_open_key=$?\n";
+  s += "chmod 600 " + test::quote(key) + "\n";
+  s += fsw + " >" + test::quote(dir.file("fsw1.txt")) + " 2>&1 &\nfpid=$!\n" + link;
+  s += g + captured + "; echo rc=$?\n";
+  s += "kill -INT $fpid; wait $fpid\n";
+  s += fsw + " >" + test::quote(dir.file("fsw2.txt")) + " 2>&1 &\nfpid=$!\n" + link;
+  s += "echo RESTARTED\n";
+  s += g + captured + "; echo rc=$?\n";
+  s += g + "send noop --timeout 5" + state + "; echo rc=$?\n";
+  s += "kill -INT $fpid; wait $fpid\n";
+  const test::Run r = test::run_in_namespace(s, dir, 90);
+  const std::string said = "--- stdout\n" + r.out + "--- stderr\n" + r.err + "--- fsw\n" +
+                           test::read_file(dir.file("fsw0.txt")) +
+                           test::read_file(dir.file("fsw1.txt")) +
+                           test::read_file(dir.file("fsw2.txt"));
+  EXPECT_NE(r.out.find("fsw_open_key=2"), std::string::npos) << said;
+  EXPECT_NE(r.out.find("ground_open_key=2"), std::string::npos) << said;
+  EXPECT_NE(test::read_file(dir.file("fsw0.txt")).find("too open"), std::string::npos) << said;
+  const std::size_t restart = r.out.find("RESTARTED");
+  ASSERT_NE(restart, std::string::npos) << said;
+  EXPECT_NE(r.out.find("ACCEPTED\nrc=0\n"), std::string::npos) << said;
+  EXPECT_EQ(r.out.substr(restart),
+            "RESTARTED\nREJECTED: stale or repeated sequence number: replayed or too old counter\n"
+            "rc=1\nACCEPTED\nrc=0\n")
+      << said;
+  EXPECT_NE(test::read_file(dir.file("fsw2.txt")).find("replay state restored"), std::string::npos)
       << said;
 }
 

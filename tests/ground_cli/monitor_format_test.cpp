@@ -174,5 +174,30 @@ TEST(MonitorFormat, AckVerdictNamesReasonDetailAndText) {
   EXPECT_EQ(format_ack_verdict(a), "REJECTED: stale or repeated sequence number");
 }
 
+// Event and acknowledgement text from the bus reaches the terminal without a single control
+// character: ESC sequences (clear screen, cursor moves, OSC title), C1 CSI, DEL, bare CR/BS and
+// broken UTF-8 are shown as \xNN; printable text and valid UTF-8 pass unchanged.
+TEST(MonitorFormat, BusTextIsSanitisedBeforeTheTerminal) {
+  rocksteady::event_t e{};
+  e.kind = rocksteady::event_t::KIND;
+  e.version = rocksteady::event_t::VERSION;
+  e.text = "ok \x1b[2J\x1b[H\x1b]0;owned\x07 \r\b\x7f \xc2\x9b" "31m \xff\xfe caf\xc3\xa9 \xe2\x86\x92";
+  const std::string s = format_event(e);
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    EXPECT_FALSE(u < 0x20 || u == 0x7f) << static_cast<int>(u);
+  }
+  EXPECT_NE(s.find("ok \\x1b[2J\\x1b[H\\x1b]0;owned\\x07 \\x0d\\x08\\x7f \\xc2\\x9b31m \\xff\\xfe"),
+            std::string::npos)
+      << s;
+  EXPECT_NE(s.find("caf\xc3\xa9 \xe2\x86\x92"), std::string::npos) << s;  // valid UTF-8 kept
+  rocksteady::cmd_ack_t a{};
+  a.accepted = 0;
+  a.reason = 4;
+  a.text = "bad\x1b[31m";
+  EXPECT_EQ(format_ack_verdict(a).find('\x1b'), std::string::npos);
+  EXPECT_EQ(sanitize_text("plain text, 100%"), "plain text, 100%");
+}
+
 }  // namespace
 }  // namespace rocksteady::ground::cli

@@ -66,6 +66,29 @@ TEST(GroundCliNet, SendNoopPrintsAcceptedAndExitsZero) {
   EXPECT_EQ(SequenceStore(sequence_file(state, 1)).last(), 1);
 }
 
+// No flight software, only a forger that answers every command with an unauthenticated "accepted"
+// acknowledgement (the responder does not sign): a ground with the key reports it as forged and
+// exits 1; never ACCEPTED.
+TEST(GroundCliNet, ForgedAcknowledgementIsReportedAsForged) {
+  test::TempDir dir;
+  const int port = 17611;
+  const std::string key = dir.file("key");
+  const std::string state = test::quote(dir.file("state"));
+  const test::Run r = in_namespace(
+      dir, "--url " + test::quote(url(port)) + " --commands 2 --seconds 20",
+      test::quote(kGround) + " keygen " + test::quote(key) + " >/dev/null && " +
+          ground(port, "--key-file " + test::quote(key) + " send set-mode SAFE --timeout 2 "
+                       "--state-dir " + state) +
+          "; echo rc=$?; " +
+          ground(port, "--key-file " + test::quote(key) + " send noop --timeout 2 --state-dir " +
+                           state) +
+          "; echo rc=$?");
+  EXPECT_EQ(r.out.find("ACCEPTED"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.out.find("FORGED: 1 acknowledgement(s) of seq "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rc=1\n"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("rc=0"), std::string::npos) << r.out;
+}
+
 TEST(GroundCliNet, SequenceNumbersKeepIncreasingAndAStaleOneIsRejected) {
   test::TempDir dir;
   const int port = 17602;

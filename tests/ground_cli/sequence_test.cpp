@@ -127,7 +127,7 @@ TEST(SequenceWithFlight, CompletesAbortsOnRejectionAndTimeoutAndSendsNothingWhen
   const std::string state = " --state-dir " + test::quote(dir.file("state"));
   const std::string cfg = " --config-dir " + test::quote(ROCKSTEADY_CONFIG_DIR) + " --case 1 ";
   std::string s;
-  s += test::quote(ROCKSTEADY_FSW_EXE) + cfg + "--clock realtime --exit-after 40 --lcm-url " +
+  s += test::quote(ROCKSTEADY_FSW_EXE) + cfg + "--lab-mode --clock realtime --exit-after 40 --lcm-url " +
        test::quote(url) + " >" + test::quote(dir.file("fsw.txt")) + " 2>&1 &\nfpid=$!\n";
   s += test::quote(ROCKSTEADY_PLANT_EXE) + cfg + "--mode realtime --duration 300 --lcm-url " +
        test::quote(url) + " >" + test::quote(dir.file("plant.txt")) + " 2>&1 &\nppid=$!\n";

@@ -78,7 +78,10 @@ inline std::string quote(const std::string& s) {
 inline Run run_in_namespace(const std::string& script, const TempDir& dir, int timeout_s = 60) {
   const std::string s =
       "ip link set lo up && ip link set lo multicast on && ip route add 239.255.76.67 dev lo || "
-      "exit 90\n" +
+      "exit 90\n"
+      // The stand-in flight (test_responder) does not authenticate: the ground is in lab mode
+      // unless a script gives --key-file (fsw_net_test.cpp does, against the real flight).
+      "export ROCKSTEADY_LAB_MODE=1\n" +
       script;
   return run("timeout " + std::to_string(timeout_s) + " unshare -rn sh -c " + quote(s), dir);
 }

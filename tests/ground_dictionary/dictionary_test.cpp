@@ -64,7 +64,7 @@ TEST(Dictionary, EveryElementOfEveryBusTypeIsAPointInLcmOrder) {
       {"RS_CMD_ACK", "cmd_ack_t"},           {"RS_GROUND_CMD", "ground_cmd_t"},
       {"RS_PLANT_TRUTH", "plant_truth_t"},   {"RS_SENSORS", "sensor_frame_t"},
       {"RS_THRUSTER_CMD", "thruster_cmd_t"}, {"RS_TRAJ_UPLINK", "trajectory_chunk_t"},
-      {"RS_PARAMS", "param_table_t"}};
+      {"RS_PARAMS", "param_table_t"},       {"RS_PLANT_FAULT", "plant_fault_cmd_t"}};
   EXPECT_EQ(channels().size(), types.size());
   for (const auto& [channel, type] : types) {
     const Channel* c = find_channel(channel);

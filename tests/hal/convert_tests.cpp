@@ -1,6 +1,7 @@
 // LCM back end conversions: sensor frames and thruster commands through the wire and back.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <vector>
 
 #include "gnc/model/rcs.hpp"
@@ -13,6 +14,8 @@ namespace {
 
 using hal::GyroReading;
 using hal::LcmSensorSource;
+using hal::LcmThrusterSink;
+using hal::kThrusters;
 using hal::RawSensors;
 using hal::StarTrackerReading;
 using hal::ThrusterBank;
@@ -68,6 +71,49 @@ TEST(Convert, ThrusterCommandRoundTripsThroughTheWire) {
   EXPECT_EQ(back.on, outputs.on);
   EXPECT_EQ(back.force, outputs.force);
   EXPECT_EQ(bank.channel_forces(back), cmd.force);
+}
+
+TEST(Convert, LatchValvesRoundTripAndAFreshMessageMeansOpen) {
+  for (int mask = 0; mask < 16; ++mask) {
+    ThrusterOutputs o;
+    o.enabled = mask % 3 == 0;
+    for (int p = 0; p < 4; ++p) o.valve_open[static_cast<std::size_t>(p)] = ((mask >> p) & 1) == 0;
+    const auto b = bytes(to_message(o, gnc::Vec8::Zero(), mask, 0.1 * mask));
+    rocksteady::thruster_cmd_t m{};
+    ASSERT_TRUE(safe_decode(b.data(), static_cast<int>(b.size()), m));
+    for (int p = 0; p < 4; ++p) EXPECT_EQ(m.valve_closed[p], (mask >> p) & 1);
+    EXPECT_EQ(to_outputs(m).valve_open, o.valve_open) << "mask " << mask;
+  }
+  // A message whose valve fields were never set (all zero) keeps every valve open.
+  EXPECT_EQ(to_outputs(make<rocksteady::thruster_cmd_t>()).valve_open,
+            (std::array<bool, 4>{true, true, true, true}));
+  // A valve flag other than 0/1 is out of range.
+  auto m = make<rocksteady::thruster_cmd_t>();
+  m.valve_closed[2] = 3;
+  const auto b = bytes(m);
+  rocksteady::thruster_cmd_t back{};
+  EXPECT_EQ(decode(b.data(), static_cast<int>(b.size()), back), DecodeStatus::kOutOfRange);
+}
+
+TEST(LcmThrusterSinkAllOff, SwitchesEveryThrusterOffButKeepsTheLatchValvesAsCommanded) {
+  LcmThrusterSink sink(default_thruster_bank_config(200.0));  // no bus: publishes are counted errors
+  ThrusterOutputs o;
+  o.enabled = true;
+  o.on[5] = true;
+  o.force[5] = 120.0;
+  o.valve_open = {true, false, true, false};
+  sink.write(o, 41, 4.1);
+  EXPECT_EQ(sink.last_message().valve_closed[1], 1);
+  sink.all_off(42, 4.2);
+  const rocksteady::thruster_cmd_t m = sink.last_message();
+  EXPECT_EQ(m.enabled, 0);
+  EXPECT_EQ(m.seq, 42);
+  for (int i = 0; i < kThrusters; ++i) {
+    EXPECT_EQ(m.thruster_on[i], 0) << i;
+    EXPECT_EQ(m.thruster_force[i], 0.0) << i;
+  }
+  EXPECT_EQ(to_outputs(m).valve_open, (std::array<bool, 4>{true, false, true, false}));
+  EXPECT_TRUE(sink.latched_off());
 }
 
 TEST(Convert, DisabledCommandDecodesToAllOff) {

@@ -107,6 +107,27 @@ TEST(ThrusterBank, DisabledCommandInhibitsEveryThruster) {
   }
 }
 
+TEST(ThrusterBank, LatchValveCommandsPassThroughEnabledOrNot) {
+  const ThrusterBank bank = default_bank();
+  gnc::ThrusterCommand cmd;
+  EXPECT_EQ(cmd.valve_open, (std::array<bool, 4>{true, true, true, true}));  // default: all open
+  for (int mask = 0; mask < 16; ++mask) {
+    for (const bool enabled : {true, false}) {
+      cmd.enabled = enabled;
+      cmd.force.setConstant(50.0);
+      for (int p = 0; p < 4; ++p) cmd.valve_open[static_cast<std::size_t>(p)] = ((mask >> p) & 1) == 0;
+      ThrusterOutputs out;
+      bank.command(cmd, out);
+      EXPECT_EQ(out.valve_open, cmd.valve_open) << "mask " << mask;
+      // The bank does not second-guess the valves: thrusters follow the channels alone (the valve
+      // stops the propellant downstream).
+      for (int t = 0; t < kThrusters; ++t) {
+        EXPECT_EQ(out.on[static_cast<std::size_t>(t)], enabled && t % 2 == 0) << t;
+      }
+    }
+  }
+}
+
 TEST(ThrusterBank, UnconfiguredBankFiresNothing) {
   const ThrusterBank bank;
   gnc::ThrusterCommand cmd;

@@ -18,6 +18,7 @@
 #include "rocksteady/event_t.hpp"
 #include "rocksteady/gnc_telemetry_t.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
+#include "rocksteady/plant_fault_cmd_t.hpp"
 #include "rocksteady/plant_truth_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
 #include "rocksteady/thruster_cmd_t.hpp"
@@ -48,6 +49,7 @@ std::map<std::string, TypeInfo> cpp_types() {
       {"rocksteady.plant_truth_t", info<rocksteady::plant_truth_t>()},
       {"rocksteady.trajectory_chunk_t", info<rocksteady::trajectory_chunk_t>()},
       {"rocksteady.param_table_t", info<rocksteady::param_table_t>()},
+      {"rocksteady.plant_fault_cmd_t", info<rocksteady::plant_fault_cmd_t>()},
   };
 }
 

@@ -50,7 +50,7 @@ unshare -rn bash -c '
         fx=(--actuator-lcm-url "$act" --ground-lcm-url "$gnd"); px=(--actuator-lcm-url "$act" --ground-lcm-url "$gnd")
       fi
       if [[ $layout == direct ]]; then fx+=(--direct-rx); px+=(--direct-rx); fi
-      "$B_FSW" --lcm-url "$url" --case 1 --start-mode DETUMBLE --tlm-every $tlm -v "${fx[@]}" \
+      "$B_FSW" --lcm-url "$url" --lab-mode --case 1 --start-mode DETUMBLE --tlm-every $tlm -v "${fx[@]}" \
           > "$B_OUT/fsw.log" & f=$!
       "$B_PLANT" --lcm-url "$url" --case 1 --duration "$B_SIM" --summary --truth-every $tlm "${px[@]}" \
           > "$B_OUT/plant.log"
@@ -71,7 +71,7 @@ unshare -rn bash -c '
   if [[ $B_JITTER == 1 ]]; then
     for rate in 10 100; do
       "$B_PLANT" --lcm-url "$url" --case 1 --mode realtime --duration $((B_SECS + 5)) > /dev/null & p=$!
-      "$B_FSW" --lcm-url "$url" --case 1 --clock realtime --rate $rate --start-mode DETUMBLE \
+      "$B_FSW" --lcm-url "$url" --lab-mode --case 1 --clock realtime --rate $rate --start-mode DETUMBLE \
           --exit-after "$B_SECS" --jitter | grep "jitter" >> "$B_OUT/jitter"
       kill $p; wait $p 2>/dev/null || true
     done

@@ -24,6 +24,7 @@
 #include "wire/codec.hpp"
 #include "lcmtypes/channels.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
+#include "rocksteady/plant_fault_cmd_t.hpp"
 #include "rocksteady/sensor_frame_t.hpp"
 #include "rocksteady/thruster_cmd_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
@@ -72,8 +73,10 @@ std::vector<std::string> plant_args(const std::string& url, const std::string& m
 std::vector<std::string> fsw_args(const std::string& url, const std::string& mission,
                                   const std::string& gnc, const std::string& case_file,
                                   std::vector<std::string> extra) {
-  std::vector<std::string> a = {fsw_exe(), "--lcm-url", url,    "--mission", mission,
-                                "--gnc",   gnc,         "--case", case_file, "-v"};
+  // Lab mode: these tests command through the harness's unsigned messages (authentication over the
+  // bus is tested in auth_pil_test below and in tests/ground_cli/fsw_net_test.cpp).
+  std::vector<std::string> a = {fsw_exe(), "--lcm-url", url,       "--mission", mission, "--gnc",
+                                gnc,       "--case",    case_file, "-v",        "--lab-mode"};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
 }
@@ -525,6 +528,65 @@ TEST(PilProtection, KillingThePlantSendsTheFlightSoftwareToSafeAndARestartRecove
 }
 
 // ---------------------------------------------------------------------------------------------
+
+// The plant's fault injection over the bus (RS_PLANT_FAULT, answered with events) and its valve
+// driver: when the flight software dies, the plant (holding after one short echo wait per period)
+// switches every thruster off once 1 s of plant time has passed without a command.
+TEST(PilPlantFaults, BusInjectionIsAnsweredAndTheValveDriverSwitchesOffWhenTheFlightSoftwareDies) {
+  constexpr int kEvFaultAccepted = 1003, kEvFaultRejected = 1004, kEvValveDriverTimeout = 1005;
+  const std::string dir = scratch_dir("plant_faults");
+  const std::string url = lcm_url(7851);
+  const std::string mission = config_dir() + "/mission.yaml", gnc = config_dir() + "/gnc.yaml",
+                    case_file = config_dir() + "/cases/case1.yaml";
+  TestBus bus(url);
+  Process fsw(fsw_args(url, mission, gnc, case_file, {"--start-mode", "DETUMBLE"}), dir + "/fsw.log");
+  Process plant({plant_exe(), "--lcm-url", url, "--mission", mission, "--gnc", gnc, "--case",
+                 case_file, "--summary", "--retries", "0", "--timeout-ms", "20",
+                 "--valve-timeout", "1.0"},
+                dir + "/plant.log");
+  auto logs = [&] { return read_file(dir + "/fsw.log") + "--- plant:\n" + read_file(dir + "/plant.log"); };
+  ASSERT_TRUE(bus.spin_until([&] {
+    return bus.have_tlm && bus.tlm.mode == kDetumble && bus.tlm.thrusters_enabled;
+  }, 20.0)) << logs();
+
+  using F = rocksteady::plant_fault_cmd_t;
+  auto inject = wire::make<F>();
+  inject.seq = 1;
+  inject.op = F::OP_INJECT;
+  inject.thruster = 6;
+  inject.fault_kind = F::FAULT_STUCK_ON;
+  bus.publish_raw(channels::kPlantFault, encode(inject));
+  ASSERT_TRUE(bus.spin_until([&] { return bus.has_event(kEvFaultAccepted); }, 5.0)) << logs();
+  auto bad = inject;
+  bad.seq = 2;
+  bad.thruster = 20;
+  bus.publish_raw(channels::kPlantFault, encode(bad));
+  ASSERT_TRUE(bus.spin_until([&] { return bus.has_event(kEvFaultRejected); }, 5.0)) << logs();
+  for (const auto& e : bus.events) {
+    if (e.id == kEvFaultRejected) {
+      EXPECT_NE(e.text.find("[0, 15]"), std::string::npos) << e.text;
+    }
+    if (e.id == kEvFaultAccepted) {
+      EXPECT_NE(e.text.find("thruster 6 stuck_on"), std::string::npos) << e.text;
+    }
+  }
+  auto malformed = inject;
+  malformed.onset_s = std::nan("");
+  bus.publish_raw(channels::kPlantFault, encode(malformed));
+  bus.spin_for(0.2);
+  EXPECT_FALSE(bus.has_event(kEvValveDriverTimeout));  // commands are flowing
+
+  fsw.signal(SIGKILL);
+  ASSERT_TRUE(fsw.wait(5.0));
+  ASSERT_TRUE(bus.spin_until([&] { return bus.has_event(kEvValveDriverTimeout); }, 10.0)) << logs();
+  plant.signal(SIGINT);
+  ASSERT_TRUE(plant.wait(10.0));
+  const std::string text = read_file(dir + "/plant.log");
+  EXPECT_NE(text.find("faults: thruster 6 stuck_on at 0 s; commands accepted 1, rejected 1, "
+                      "malformed 1; valve-driver timeouts 1"),
+            std::string::npos)
+      << text;
+}
 
 TEST(PilRealtime, WallClockRunClosesTheLoop) {
   const std::string dir = scratch_dir("realtime");

@@ -28,7 +28,7 @@ constexpr int kEvWatchdog = 203;
 
 std::vector<std::string> fsw_realtime(const std::string& url, std::vector<std::string> extra) {
   std::vector<std::string> a = {fsw_exe(),    "--lcm-url", url,       "--config-dir",
-                                config_dir(), "--clock",   "realtime"};
+                                config_dir(), "--clock",   "realtime", "--lab-mode"};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
 }

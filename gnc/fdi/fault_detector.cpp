@@ -1,0 +1,247 @@
+#include "gnc/fdi/fault_detector.hpp"
+
+#include <cmath>
+
+#include <Eigen/LU>
+
+namespace rocksteady::gnc {
+
+Check validate(const FaultDetectorParams& p) {
+  auto bad = [](const char* field, const char* reason) { return Check{false, field, reason}; };
+  if (p.window_ticks < 4 || p.window_ticks > 1000) {
+    return bad("fdi.window_ticks", "must be in [4, 1000]");
+  }
+  if (!finite_non_negative(p.gyro_sigma)) return bad("fdi.gyro_sigma", "must be >= 0 and finite");
+  if (!finite_non_negative(p.disturbance_sigma)) {
+    return bad("fdi.disturbance_sigma", "must be >= 0 and finite");
+  }
+  if (!finite_non_negative(p.model_rel_floor)) {
+    return bad("fdi.model_rel_floor", "must be >= 0 and finite");
+  }
+  if (!finite_positive(p.confirm_llr)) return bad("fdi.confirm_llr", "must be positive");
+  if (!finite_non_negative(p.margin_llr)) return bad("fdi.margin_llr", "must be >= 0");
+  if (!finite_positive(p.suspect_chi2)) return bad("fdi.suspect_chi2", "must be positive");
+  return Check{};
+}
+
+void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs, double u_max,
+                              double dt) {
+  p_ = p;
+  u_max_ = u_max;
+  dt_ = dt;
+  for (int c = 0; c < kChannels; ++c) {
+    for (int s = 0; s < 2; ++s) {
+      const auto i = static_cast<std::size_t>(2 * c + s);
+      pos_[i] = rcs.pod_position[rcs.channel_pod[c]];
+      dir_[i] = s == 0 ? rcs.channel_direction[c] : Vec3(-rcs.channel_direction[c]);
+      pod_[i] = rcs.channel_pod[c];
+    }
+  }
+  st_ = FaultDetectorStatus{};
+  FaultModel m;
+  m.j = Mat3::Identity();
+  set_model(m);
+  reset();
+}
+
+void FaultDetector::reset() {
+  have_start_ = false;
+  n_ = 0;
+  score_.fill(0.0);
+  const std::uint16_t on = st_.confirmed_on;
+  const std::uint16_t off = st_.confirmed_off;
+  st_ = FaultDetectorStatus{};
+  st_.confirmed_on = on;
+  st_.confirmed_off = off;
+}
+
+void FaultDetector::set_model(const FaultModel& m) {
+  m_ = m;
+  j_inv_ = m.j.inverse();
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    // (F1): the rate change per newton-second of thruster i.
+    b_[k] = j_inv_ * (m.k(i) * (pos_[k] + m.r).cross(dir_[k]));
+  }
+}
+
+void FaultDetector::declare(int thruster, FaultKind kind) {
+  if (thruster < 0 || thruster >= kThrusters) return;
+  const auto bit = static_cast<std::uint16_t>(1u << thruster);
+  st_.confirmed_on = static_cast<std::uint16_t>(st_.confirmed_on & ~bit);
+  st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
+  if (kind == FaultKind::kStuckOn) st_.confirmed_on |= bit;
+  if (kind == FaultKind::kStuckOff) st_.confirmed_off |= bit;
+  score_.fill(0.0);
+}
+
+void FaultDetector::clear(int thruster) {
+  if (thruster < 0) {
+    st_.confirmed_on = 0;
+    st_.confirmed_off = 0;
+  } else if (thruster < kThrusters) {
+    const auto bit = static_cast<std::uint16_t>(1u << thruster);
+    st_.confirmed_on = static_cast<std::uint16_t>(st_.confirmed_on & ~bit);
+    st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
+  }
+  score_.fill(0.0);
+}
+
+FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
+  pending_ = FaultEvents{};
+  if (!p_.enabled) return pending_;
+  if (!in.omega_valid || !in.thrust_valid || !in.omega.allFinite() || !in.thrust.allFinite()) {
+    have_start_ = false;  // a gap breaks the window; the next valid sample starts a new one
+    return pending_;
+  }
+  if (!have_start_) {
+    start_window(in.omega);
+    return pending_;
+  }
+  // (F2): the interval ending now, with the thrust commanded over it and the mid-interval rate.
+  const Vec3 w = 0.5 * (omega_prev_ + in.omega);
+  const Vec3 gyro = j_inv_ * w.cross(m_.j * w);
+  Vec3 thrust_rate = Vec3::Zero();
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const bool open = in.valve_open[static_cast<std::size_t>(pod_[k])];
+    if (!open) continue;
+    const bool latched_on = ((st_.confirmed_on >> i) & 1u) != 0;
+    const bool latched_off = ((st_.confirmed_off >> i) & 1u) != 0;
+    // A confirmed fault is part of the model: stuck-on fires at u_max until its valve closes,
+    // stuck-off produces nothing whatever is commanded.
+    const double f = latched_on ? u_max_ : latched_off ? 0.0 : in.thrust(i);
+    thrust_rate += b_[k] * f;
+  }
+  predicted_ += (thrust_rate - gyro) * dt_;
+  motion_ += (thrust_rate.norm() + gyro.norm()) * dt_;
+  thrust_motion_ += thrust_rate.norm() * dt_;
+  force_impulse_ += in.thrust.sum() * dt_;
+  ++n_;
+  const double t = static_cast<double>(n_);
+  const Vec3 r = in.omega - omega_start_ - predicted_;  // (F3) residual of sample j
+  sum_r_ += r;
+  sum_rr_ += r.squaredNorm();
+  sum_t_ += t;
+  sum_tt_ += t * t;
+  sum_tr_ += t * r;
+  // (F4) signatures: stuck-on adds (u_max - f) of its thrust, stuck-off removes f; both only
+  // while the pod's valve is open (a closed pod produces nothing under any hypothesis).
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const bool open = in.valve_open[static_cast<std::size_t>(pod_[k])];
+    if (open) {
+      const double f = in.thrust(i);
+      sig_[k] += b_[k] * ((u_max_ - f) * dt_);
+      sig_[k + kThrusters] -= b_[k] * (f * dt_);
+    }
+    for (std::size_t h : {k, k + static_cast<std::size_t>(kThrusters)}) {
+      sum_s_[h] += sig_[h];
+      sum_sr_[h] += sig_[h].dot(r);
+      sum_ss_[h] += sig_[h].squaredNorm();
+    }
+  }
+  omega_prev_ = in.omega;
+  if (n_ >= p_.window_ticks) {
+    close_window();
+    start_window(in.omega);  // the window's last sample starts the next one
+  }
+  return pending_;
+}
+
+void FaultDetector::start_window(const Vec3& omega) {
+  have_start_ = true;
+  n_ = 0;
+  omega_start_ = omega;
+  omega_prev_ = omega;
+  predicted_.setZero();
+  motion_ = 0.0;
+  force_impulse_ = 0.0;
+  thrust_motion_ = 0.0;
+  sum_r_.setZero();
+  sum_rr_ = 0.0;
+  sum_t_ = sum_tt_ = 0.0;
+  sum_tr_.setZero();
+  for (std::size_t h = 0; h < static_cast<std::size_t>(kHypotheses); ++h) {
+    sig_[h].setZero();
+    sum_s_[h].setZero();
+    sum_sr_[h] = 0.0;
+    sum_ss_[h] = 0.0;
+  }
+}
+
+void FaultDetector::close_window() {
+  const double n = static_cast<double>(n_);
+  // (F5) noise of a residual sample: the gyro (start and sample), the disturbance over the window,
+  // and the model's relative uncertainty times the motion it predicts.
+  const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
+  const double dist = p_.disturbance_sigma * j_inv_.norm() * n * dt_;
+  const double model = rel * motion_;
+  // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
+  // r_sigma times the jets' force, and k_sigma times their torque.
+  const double offset = m_.r_sigma * j_inv_.norm() * force_impulse_;
+  const double strength = m_.k_sigma * thrust_motion_;
+  const double var = 2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model +
+                     offset * offset + strength * strength + 1e-30;
+  st_.noise_sigma = std::sqrt(var);
+  // The unknown offset (the start sample's own noise) is removed: mean-centred sums.
+  const Vec3 r_mean = sum_r_ / n;
+  // Slope test (no fault): least-squares rate of change of the residual, chi-square with 3 dof.
+  const double stt = sum_tt_ - sum_t_ * sum_t_ / n;
+  const Vec3 str = sum_tr_ - sum_t_ * r_mean;
+  const Vec3 slope = stt > 0.0 ? Vec3(str / stt) : Vec3::Zero();
+  st_.residual = slope * n;  // rate change over the window that the model does not explain
+  st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
+  ++st_.windows;
+  // (F6) sequential log-likelihood ratios, CUSUM with exoneration at zero.
+  int best = -1;
+  double best_s = 0.0;
+  double second = 0.0;
+  for (int h = 0; h < kHypotheses; ++h) {
+    const auto k = static_cast<std::size_t>(h);
+    const int thruster = h % kThrusters;
+    const bool latched = (((st_.confirmed_on | st_.confirmed_off) >> thruster) & 1u) != 0;
+    if (latched) {
+      score_[k] = 0.0;
+      continue;
+    }
+    const double sr = sum_sr_[k] - sum_s_[k].dot(r_mean);
+    const double ss = sum_ss_[k] - sum_s_[k].squaredNorm() / n;
+    const double llr = (sr - 0.5 * ss) / var;
+    score_[k] = std::fmax(0.0, score_[k] + llr);
+    if (score_[k] > best_s) {
+      second = best_s;
+      best_s = score_[k];
+      best = h;
+    } else if (score_[k] > second) {
+      second = score_[k];
+    }
+  }
+  st_.best = best;
+  st_.best_llr = best_s;
+  st_.runner_up_llr = second;
+  st_.suspected_on = 0;
+  st_.suspected_off = 0;
+  if (best >= 0 && best_s > 0.5 * p_.confirm_llr) {
+    const auto bit = static_cast<std::uint16_t>(1u << (best % kThrusters));
+    if (best < kThrusters) {
+      st_.suspected_on = bit;
+    } else {
+      st_.suspected_off = bit;
+    }
+  }
+  if (st_.chi2 > p_.suspect_chi2) {
+    ++st_.suspicions;
+    pending_.suspected = true;
+  }
+  if (best >= 0 && best_s > p_.confirm_llr && best_s - second > p_.margin_llr) {
+    const int thruster = best % kThrusters;
+    const FaultKind kind = best < kThrusters ? FaultKind::kStuckOn : FaultKind::kStuckOff;
+    declare(thruster, kind);
+    pending_.confirmed = true;
+    pending_.thruster = thruster;
+    pending_.kind = kind;
+  }
+}
+
+}  // namespace rocksteady::gnc

@@ -1,0 +1,154 @@
+// Thruster fault detection and isolation: a hypothesis bank scored on the residual between the
+// measured change of the body rate and the change predicted from the identified model and the
+// thrust actually commanded (Wilson, Lages & Mah 2002: predict the motion for "no fault" and for
+// each fault hypothesis; a hypothesis gathers evidence only when its signature is non-zero; the
+// most likely one is confirmed when it is clearly ahead of every other). Design note with the
+// equations (F1)... and the detection limit: README.md beside this file.
+//
+// Hypotheses: no fault, 16 x stuck-on (the thruster fires at u_max whatever is commanded, while its
+// pod's latch valve is open), 16 x stuck-off (it produces nothing when commanded). A degraded
+// thruster is the identifier's business (its strength k_i). A confirmed fault latches until the
+// ground clears it; a latched stuck-on asks for its pod's latch valve to close.
+//
+// Flight code: fixed-size Eigen, no heap, no exceptions, no I/O.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "gnc/check.hpp"
+#include "gnc/io.hpp"  // FaultKind
+#include "gnc/model/rcs.hpp"
+#include "gnc/types.hpp"
+
+namespace rocksteady::gnc {
+
+
+struct FaultDetectorParams {
+  bool enabled{false};
+  // Residual window: the rate change over this many ticks is compared with the prediction (F2).
+  int window_ticks{5};
+  // Noise model of the residual (F4): gyro white noise per sample (rad/s), external disturbance
+  // torque per axis (N m), and a floor on the relative model uncertainty (the identifier's J 1
+  // sigma relative to ||J_hat|| is used when larger).
+  double gyro_sigma{1e-6};
+  double disturbance_sigma{0.57735026918962576};
+  double model_rel_floor{0.002};
+  // Sequential test (F6): a hypothesis is confirmed when its cumulative log-likelihood ratio
+  // exceeds confirm_llr and leads the runner-up by margin_llr; a window whose no-fault chi-square
+  // (3 dof) exceeds suspect_chi2 raises a suspicion. Calibrated on healthy runs (README §F.4).
+  double confirm_llr{25.0};
+  double margin_llr{10.0};
+  double suspect_chi2{16.27};  // chi-square(3) at 0.999
+  // A hypothesis whose LLR falls this far below zero is exonerated (its score resets).
+  double forget_llr{-5.0};
+  // true: a confirmed stuck-on closes its pod's latch valve (automatic isolation).
+  bool auto_isolate{true};
+};
+
+Check validate(const FaultDetectorParams& p);
+
+// What the detector reads each tick.
+struct FaultDetectorInput {
+  Vec3 omega{Vec3::Zero()};  // measured body rate at this tick (gyro, bias-corrected), rad/s
+  bool omega_valid{false};
+  // Force commanded on each physical thruster over the previous tick (N, >= 0; index 2c "+",
+  // 2c+1 "-" of channel c) and the pods' latch valves over that tick.
+  Vec16 thrust{Vec16::Zero()};
+  std::array<bool, kPods> valve_open{{true, true, true, true}};
+  bool thrust_valid{true};
+};
+
+// The identified model the predictions use (refreshed when the identifier reports).
+struct FaultModel {
+  Mat3 j{Mat3::Identity()};
+  Vec3 r{Vec3::Zero()};
+  Vec16 k{Vec16::Ones()};
+  double j_rel_sigma{1.0};  // largest 1 sigma of J relative to ||J|| (the identifier's)
+  double r_sigma{1.0};      // m, largest 1 sigma of r: a torque error of r_sigma x the net force
+  double k_sigma{0.05};     // largest 1 sigma of the strengths: k_sigma x each jet's torque
+};
+
+struct FaultDetectorStatus {
+  Vec3 residual{Vec3::Zero()};  // last window: measured minus predicted rate change, rad/s
+  double chi2{0.0};             // its no-fault chi-square (3 dof)
+  double noise_sigma{0.0};      // per-axis residual 1 sigma of the last window
+  std::uint16_t suspected_on{0};   // bit i: thruster i stuck-on is the leading hypothesis
+  std::uint16_t suspected_off{0};
+  std::uint16_t confirmed_on{0};   // latched
+  std::uint16_t confirmed_off{0};
+  int best{-1};                 // leading hypothesis: 0..15 stuck-on, 16..31 stuck-off, -1 none
+  double best_llr{0.0};
+  double runner_up_llr{0.0};
+  std::uint32_t windows{0};
+  std::uint32_t suspicions{0};  // windows whose chi-square exceeded suspect_chi2
+};
+
+// Raised by update(); the caller turns them into events.
+struct FaultEvents {
+  bool suspected{false};       // a window crossed suspect_chi2 with no fault confirmed yet
+  bool confirmed{false};       // a fault was confirmed this tick
+  int thruster{-1};
+  FaultKind kind{FaultKind::kNone};
+};
+
+class FaultDetector {
+ public:
+  void configure(const FaultDetectorParams& p, const RcsLayout& rcs, double u_max, double dt);
+  void reset();  // scores and windows; latched faults are kept (clear() removes them)
+  void set_model(const FaultModel& m);
+  FaultEvents update(const FaultDetectorInput& in);
+
+  // Ground overrides and what the flight does after isolation.
+  void declare(int thruster, FaultKind kind);  // latches it (as if confirmed)
+  void clear(int thruster);                    // -1: every thruster
+  const FaultDetectorStatus& status() const { return st_; }
+  std::uint16_t confirmed_on() const { return st_.confirmed_on; }
+  std::uint16_t confirmed_off() const { return st_.confirmed_off; }
+  const FaultDetectorParams& params() const { return p_; }
+
+  // Rate change signature of hypothesis h over the last window (exposed for tests): 0..15
+  // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
+  const Vec3& signature(int h) const { return sig_[static_cast<std::size_t>(h)]; }
+  static constexpr int kHypotheses = 2 * kThrusters;
+
+ private:
+  void close_window();
+  void start_window(const Vec3& omega);
+
+  FaultDetectorParams p_{};
+  double u_max_{200.0};
+  double dt_{0.1};
+  std::array<Vec3, kThrusters> arm_x_e_{};  // (p_i + r) x e_i with the model's r (recomputed)
+  std::array<Vec3, kThrusters> pos_{};
+  std::array<Vec3, kThrusters> dir_{};
+  std::array<int, kThrusters> pod_{};
+  FaultModel m_{};
+  Mat3 j_inv_{Mat3::Identity()};
+
+  // Window accumulation (F2)-(F5): samples j = 1..n after the window's first sample.
+  int n_{0};
+  bool have_start_{false};
+  Vec3 omega_start_{Vec3::Zero()};  // rate at the window's first sample
+  Vec3 omega_prev_{Vec3::Zero()};
+  Vec3 predicted_{Vec3::Zero()};    // cumulative predicted rate change since the start
+  double motion_{0.0};              // cumulative |predicted terms| * dt (model-uncertainty scale)
+  double force_impulse_{0.0};       // cumulative sum of thrust * dt over the jets, N s
+  double thrust_motion_{0.0};       // cumulative |thrust rate change| * dt
+  Vec3 sum_r_{Vec3::Zero()};        // sum of residuals r_j
+  double sum_rr_{0.0};
+  double sum_t_{0.0};               // sum of j (sample index), for the slope test
+  double sum_tt_{0.0};
+  Vec3 sum_tr_{Vec3::Zero()};
+  std::array<Vec3, kHypotheses> sig_{};     // cumulative signature S_h(j)
+  std::array<Vec3, kHypotheses> sum_s_{};   // sum over j of S_h(j)
+  std::array<double, kHypotheses> sum_sr_{};
+  std::array<double, kHypotheses> sum_ss_{};
+  std::array<Vec3, kThrusters> b_{};  // J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i
+
+  std::array<double, kHypotheses> score_{};
+  FaultDetectorStatus st_{};
+  FaultEvents pending_{};
+};
+
+}  // namespace rocksteady::gnc

@@ -1,0 +1,93 @@
+#include "ground/campaign/estimation_report.hpp"
+
+namespace rocksteady::campaign {
+
+nlohmann::json estimation_json(const EstimationReport& e) {
+  nlohmann::json marks = nlohmann::json::array();
+  for (const IdentificationMark& m : e.marks) {
+    marks.push_back({{"t_s", m.t_s},
+                     {"reached", m.reached},
+                     {"j_rel", m.j_rel},
+                     {"r_err_m", m.r_err_m},
+                     {"k_max_err", m.k_max_err},
+                     {"j_nees", m.j_nees},
+                     {"r_nees", m.r_nees},
+                     {"inertia_confident", m.inertia_confident},
+                     {"offset_confident", m.offset_confident},
+                     {"offset_unobservable", m.offset_unobservable}});
+  }
+  return {{"estimator", e.estimator},
+          {"attitude_rms_rad", e.attitude_rms_rad},
+          {"attitude_max_rad", e.attitude_max_rad},
+          {"rate_rms_rad_s", e.rate_rms_rad_s},
+          {"rate_max_rad_s", e.rate_max_rad_s},
+          {"identifying", e.identifying},
+          {"model_adoptions", e.model_adoptions},
+          {"identification", marks}};
+}
+
+namespace {
+nlohmann::json opt(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+std::optional<double> to_opt(const nlohmann::json& j) {
+  if (j.is_null()) return std::nullopt;
+  return j.get<double>();
+}
+}  // namespace
+
+nlohmann::json fdi_json(const FdiReport& f) {
+  return {{"enabled", f.enabled},
+          {"first_suspicion_s", opt(f.first_suspicion_s)},
+          {"first_confirmation_s", opt(f.first_confirmation_s)},
+          {"thruster", f.thruster},
+          {"kind", f.kind},
+          {"confirmations", f.confirmations},
+          {"confirmed_on", f.confirmed_on},
+          {"confirmed_off", f.confirmed_off},
+          {"valve_closed_s", opt(f.valve_closed_s)},
+          {"suspicions", f.suspicions}};
+}
+
+FdiReport fdi_from_json(const nlohmann::json& j) {
+  FdiReport f;
+  f.enabled = j.at("enabled").get<bool>();
+  f.first_suspicion_s = to_opt(j.at("first_suspicion_s"));
+  f.first_confirmation_s = to_opt(j.at("first_confirmation_s"));
+  f.thruster = j.at("thruster").get<int>();
+  f.kind = j.at("kind").get<std::string>();
+  f.confirmations = j.at("confirmations").get<int>();
+  f.confirmed_on = j.at("confirmed_on").get<std::uint16_t>();
+  f.confirmed_off = j.at("confirmed_off").get<std::uint16_t>();
+  f.valve_closed_s = to_opt(j.at("valve_closed_s"));
+  f.suspicions = j.at("suspicions").get<std::uint32_t>();
+  return f;
+}
+
+EstimationReport estimation_from_json(const nlohmann::json& j) {
+  EstimationReport e;
+  e.estimator = j.at("estimator").get<std::string>();
+  e.attitude_rms_rad = j.at("attitude_rms_rad").get<double>();
+  e.attitude_max_rad = j.at("attitude_max_rad").get<double>();
+  e.rate_rms_rad_s = j.at("rate_rms_rad_s").get<double>();
+  e.rate_max_rad_s = j.at("rate_max_rad_s").get<double>();
+  e.identifying = j.at("identifying").get<bool>();
+  e.model_adoptions = j.at("model_adoptions").get<std::uint32_t>();
+  for (const nlohmann::json& m : j.at("identification")) {
+    IdentificationMark x;
+    x.t_s = m.at("t_s").get<double>();
+    x.reached = m.at("reached").get<bool>();
+    x.j_rel = m.at("j_rel").get<double>();
+    x.r_err_m = m.at("r_err_m").get<double>();
+    x.k_max_err = m.at("k_max_err").get<double>();
+    x.j_nees = m.at("j_nees").get<double>();
+    x.r_nees = m.at("r_nees").get<double>();
+    x.inertia_confident = m.at("inertia_confident").get<bool>();
+    x.offset_confident = m.at("offset_confident").get<bool>();
+    x.offset_unobservable = m.at("offset_unobservable").get<int>();
+    e.marks.push_back(x);
+  }
+  return e;
+}
+
+}  // namespace rocksteady::campaign

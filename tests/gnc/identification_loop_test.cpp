@@ -1,0 +1,220 @@
+// The identifier and the MEKF in the flight core's tick (Gnc::step): a wrong table is corrected by
+// the identified model at a tick boundary with an event (automatic policy), never without
+// confidence, never with a model that fails table validation; the ground path (policy off) leaves
+// the table alone and offers the candidate. Truth: tests/common's rigid body driven by the true B.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gnc/gnc.hpp"
+#include "gnc/math/rotation.hpp"
+#include "gnc_harness.hpp"
+
+namespace rocksteady::gnc {
+namespace {
+
+// The small vehicle's identification, tuned to its scale (torques ~1 N m, forces ~2 N).
+GncParams identifying_params(ModelAdoption adopt) {
+  GncParams p = test::small_vehicle_params();
+  p.law = LawId::kNtcl;
+  IdentificationParams& id = p.identification;
+  id.enabled = true;
+  id.adopt = adopt;
+  id.adopt_interval_s = 5.0;
+  IdentifierConfig& c = id.config;
+  c.window_s = 2.0;  // 40 ticks at 20 Hz
+  c.j_prior_sigma = 5.0;
+  c.r_prior_sigma = 0.5;
+  c.k_prior_sigma = 0.01;
+  c.disturbance_sigma = 1e-4;
+  c.torque_floor = 1e-4;
+  c.min_torque_impulse = 0.05;
+  c.min_force_impulse = 0.02;
+  c.min_thruster_impulse = 0.005;
+  c.r_max_offset = 1.0;
+  return p;
+}
+
+// The table believes J_ast 30 % larger about x and r_SO/BCM 8 cm off; the truth is the harness's.
+GncParams wrong_table(const GncParams& truth) {
+  GncParams p = truth;
+  p.mass_hat.j_ast(0, 0) *= 1.3;
+  p.mass_hat.r_so_bcm += Vec3(0.05, -0.04, 0.045);
+  return p;
+}
+
+int count_events(const GncOutput& out, EventId id) {
+  int n = 0;
+  for (int i = 0; i < out.events.count; ++i) n += out.events.items[i].id == id ? 1 : 0;
+  return n;
+}
+
+TEST(WithModel, RebuildsTheTableAroundAGivenTotalInertiaAndOffset) {
+  const GncParams p = test::small_vehicle_params();
+  Mat3 j;
+  j << 14.0, 0.8, 0.4, 0.8, 15.5, -0.2, 0.4, -0.2, 17.0;
+  const Vec3 r(0.03, 0.01, 0.35);
+  Vec16 k = Vec16::Ones();
+  k(5) = 0.93;
+  const GncParams q = with_model(p, j, r, k);
+  // Eq. (1) evaluated on the result gives back exactly the requested J_tot.
+  EXPECT_LT((total_inertia(q.mass_hat) - j).norm(), 1e-12 * j.norm());
+  EXPECT_EQ(q.mass_hat.r_so_bcm, r);
+  EXPECT_EQ(q.rcs.strength, k);
+  EXPECT_EQ(q.mass_hat.j_sc, p.mass_hat.j_sc);  // the spacecraft's own part is kept
+  EXPECT_TRUE(validate(q).ok);
+  // A J_tot smaller than the spacecraft's part alone leaves no positive-definite asteroid.
+  const GncParams bad = with_model(p, 0.1 * Mat3::Identity(), r, k);
+  const ParamCheck c = validate(bad);
+  EXPECT_FALSE(c.ok);
+  EXPECT_STREQ(c.field, "mass_hat.j_ast");
+}
+
+TEST(GncIdentification, AutomaticPolicyAdoptsTheIdentifiedModelAtABoundaryWithAnEvent) {
+  const GncParams truth = identifying_params(ModelAdoption::kAuto);
+  test::SmallLoop loop(truth);  // the body flies the truth's J_tot and B
+  const GncParams table = wrong_table(truth);
+  ASSERT_TRUE(loop.gnc.init(table).ok);
+  const Mat3 j_true = total_inertia(truth.mass_hat);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  loop.tick(c);
+  int adopted_events = 0;
+  int adopted_at = -1;
+  for (int k = 0; k < 1200 && adopted_at < 0; ++k) {
+    const Mat3 j_before = total_inertia(loop.gnc.params().mass_hat);
+    IdentifiedModel model;
+    const ModelCandidate offered = loop.gnc.identified_model(model);
+    loop.tick();
+    const int n = count_events(loop.out, EventId::kModelAdopted);
+    adopted_events += n;
+    if (n > 0) {
+      adopted_at = k;
+      // Only a confident candidate that differs from the table is adopted.
+      EXPECT_EQ(offered, ModelCandidate::kOk);
+      EXPECT_GT((j_before - j_true).norm(), 0.01 * j_true.norm());
+    } else {
+      // Until the event, the table is the one loaded.
+      EXPECT_EQ(total_inertia(loop.gnc.params().mass_hat), total_inertia(table.mass_hat));
+    }
+  }
+  ASSERT_GE(adopted_at, 0) << "no model adopted in 60 s";
+  EXPECT_EQ(adopted_events, 1);
+  EXPECT_EQ(loop.gnc.model_adoptions(), 1u);
+  EXPECT_EQ(loop.out.telemetry.est.adoptions, 1u);
+  // The adopted table is the truth to within the confidence bounds.
+  const GncParams& now = loop.gnc.params();
+  EXPECT_LT((total_inertia(now.mass_hat) - j_true).norm(), 0.01 * j_true.norm());
+  EXPECT_LT((now.mass_hat.r_so_bcm - truth.mass_hat.r_so_bcm).norm(), 0.02);
+  EXPECT_TRUE(validate(now).ok);
+  EXPECT_EQ(now.law, truth.law);  // the law stays the commanded one
+  // Adopting the identifier's own model does not reset what it has learned.
+  EXPECT_TRUE(loop.gnc.identifier().estimate().inertia_confident);
+  // Nothing more to adopt while the model stands (the interval has long passed).
+  for (int k = 0; k < 400; ++k) loop.tick();
+  EXPECT_EQ(loop.gnc.model_adoptions(), 1u);
+  EXPECT_EQ(loop.out.telemetry.est.candidate, ModelCandidate::kUnchanged);
+}
+
+TEST(GncIdentification, PolicyOffOnlyOffersTheCandidate) {
+  const GncParams truth = identifying_params(ModelAdoption::kOff);
+  test::SmallLoop loop(truth);
+  const GncParams table = wrong_table(truth);
+  ASSERT_TRUE(loop.gnc.init(table).ok);
+  GncParams candidate;
+  EXPECT_EQ(loop.gnc.model_candidate(candidate), ModelCandidate::kNotConfident);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  loop.tick(c);
+  for (int k = 0; k < 1200; ++k) {
+    loop.tick();
+    EXPECT_EQ(count_events(loop.out, EventId::kModelAdopted), 0);
+  }
+  EXPECT_EQ(total_inertia(loop.gnc.params().mass_hat), total_inertia(table.mass_hat));
+  EXPECT_EQ(loop.gnc.model_adoptions(), 0u);
+  ASSERT_EQ(loop.gnc.model_candidate(candidate), ModelCandidate::kOk);
+  const Mat3 j_true = total_inertia(truth.mass_hat);
+  EXPECT_LT((total_inertia(candidate.mass_hat) - j_true).norm(), 0.01 * j_true.norm());
+  EXPECT_TRUE(validate(candidate).ok);
+  EXPECT_EQ(loop.out.telemetry.est.candidate, ModelCandidate::kOk);
+  EXPECT_TRUE(loop.out.telemetry.est.identifying);
+  EXPECT_TRUE(loop.out.telemetry.est.inertia_confident);
+  // The activation path (what PARAM_ACTIVATE does at a boundary) installs it.
+  ASSERT_TRUE(loop.gnc.set_params(candidate).ok);
+  EXPECT_EQ(loop.gnc.model_candidate(candidate), ModelCandidate::kUnchanged);
+  EXPECT_TRUE(loop.gnc.identifier().estimate().inertia_confident);  // its own model: no re-inflation
+}
+
+TEST(GncIdentification, AModelThatFailsValidationIsRefusedWithAnEvent) {
+  GncParams truth = identifying_params(ModelAdoption::kAuto);
+  test::SmallLoop loop(truth);
+  // The true body is lighter than the table's spacecraft alone: J_ast = J_tot - J_sc part < 0.
+  loop.body.j = 0.5 * total_inertia(truth.mass_hat);
+  GncParams table = truth;
+  table.mass_hat.j_sc = Vec3(9.0, 9.0, 9.0).asDiagonal();  // most of the believed inertia
+  MassProperties sc = table.mass_hat;
+  sc.j_ast.setZero();
+  table.mass_hat.j_ast = total_inertia(truth.mass_hat) - total_inertia(sc);
+  ASSERT_TRUE(validate(table).ok);
+  ASSERT_TRUE(loop.gnc.init(table).ok);
+  const Mat3 j_table = total_inertia(table.mass_hat);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  loop.tick(c);
+  int refused = 0;
+  for (int k = 0; k < 1200; ++k) {
+    loop.tick();
+    refused += count_events(loop.out, EventId::kModelRefused);
+    EXPECT_EQ(count_events(loop.out, EventId::kModelAdopted), 0);
+  }
+  EXPECT_GE(refused, 1);
+  EXPECT_EQ(loop.gnc.model_adoptions(), 0u);
+  EXPECT_EQ(total_inertia(loop.gnc.params().mass_hat), j_table);
+  GncParams candidate;
+  EXPECT_EQ(loop.gnc.model_candidate(candidate), ModelCandidate::kInvalid);
+}
+
+TEST(GncIdentification, OffByDefaultAndTelemetryZero) {
+  const GncParams p = test::small_vehicle_params();
+  test::SmallLoop loop(p);
+  ASSERT_TRUE(loop.gnc.init(p).ok);
+  loop.tick();
+  EXPECT_FALSE(loop.out.telemetry.est.identifying);
+  EXPECT_FALSE(loop.out.telemetry.est.mekf);
+  EXPECT_EQ(loop.out.telemetry.est.candidate, ModelCandidate::kDisabled);
+  IdentifiedModel m;
+  EXPECT_EQ(loop.gnc.identified_model(m), ModelCandidate::kDisabled);
+}
+
+TEST(GncMekf, SelectedEstimatorFliesTheLoopToHold) {
+  GncParams p = test::small_vehicle_params();
+  p.estimator.kind = EstimatorKind::kMekf;
+  p.mekf.gyro_arw = 1e-6;
+  p.mekf.star_sigma = 1e-5;
+  ASSERT_TRUE(validate(p).ok);
+  test::SmallLoop loop(p);
+  ASSERT_TRUE(loop.gnc.init(p).ok);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  loop.tick(c);
+  EXPECT_TRUE(loop.gnc.mekf().initialised());
+  for (int k = 0; k < 4000 && loop.gnc.mode() != Mode::kHold; ++k) loop.tick();
+  EXPECT_EQ(loop.gnc.mode(), Mode::kHold);
+  for (int k = 0; k < 2000; ++k) loop.tick();
+  EXPECT_TRUE(loop.out.telemetry.est.mekf);
+  // Perfect sensors: the estimate is the truth at the sample (the body has since moved one tick).
+  const Vec3 omega_at_sample = loop.body.omega;
+  const Vec4 beta_at_sample = loop.body.beta;
+  loop.tick();
+  EXPECT_LT((loop.out.telemetry.omega_hat - omega_at_sample).norm(), 1e-6);
+  EXPECT_LT((loop.out.telemetry.q_hat - mrp::from_quaternion(beta_at_sample)).norm(), 1e-6);
+  EXPECT_LT(loop.gnc.mekf().bias().norm(), 1e-6);
+  EXPECT_GT(loop.gnc.mekf().counters().updates, 100u);
+}
+
+}  // namespace
+}  // namespace rocksteady::gnc
