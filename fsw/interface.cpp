@@ -172,6 +172,10 @@ const char* to_string(EventId id) {
       return "fault_override";
     case EventId::kReducedAuthority:
       return "reduced_authority";
+    case EventId::kTrajectorySwitched:
+      return "trajectory_switched";
+    case EventId::kTrajectoryStale:
+      return "trajectory_stale";
   }
   return "?";
 }

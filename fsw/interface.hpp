@@ -166,6 +166,8 @@ enum class EventId : std::int32_t {
   kValveClosed = 134,      // arg0 = pod, arg1 = the stuck-on thruster it isolates
   kFaultOverride = 135,    // arg0 = thruster / pod / -1, arg1 = kind / 10 open / 11 close / 20, 21 inhibit
   kReducedAuthority = 136, // arg0 = rank, arg1 = usable channels
+  kTrajectorySwitched = 137,  // the staged trajectory became active at the tick boundary
+  kTrajectoryStale = 138,     // the staged trajectory was stale: refused, the active one kept
 };
 const char* to_string(EventId id);
 

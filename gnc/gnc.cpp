@@ -41,7 +41,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   refresh_fault_model();
   modes_.reset(params.mode.initial);
   laws_.reset_state();
-  trajectory_valid_ = false;
+  trajectories_.clear();
   fuel_kg_ = 0.0;
   tick_ = 0;
   sensor_rejects_ = 0;
@@ -234,7 +234,7 @@ AllocatorLimits Gnc::allocation_limits() const {
 }
 
 TransitionCheck Gnc::check_mode_request(Mode to) const {
-  const TransitionContext ctx{estimate_ready(), trajectory_valid_, params_.law};
+  const TransitionContext ctx{estimate_ready(), trajectories_.valid(), params_.law};
   return check_transition(modes_.mode(), to, ctx);
 }
 
@@ -296,12 +296,7 @@ void Gnc::adopt_model(double t, ModeEvents& events) {
 }
 
 TrajectoryError Gnc::load_trajectory(const TrajectoryTable& table) {
-  const TrajectoryError e = validate_trajectory(table, params_.guidance.eps_trans);
-  if (e != TrajectoryError::kOk) return e;
-  if (modes_.mode() == Mode::kTrack) return TrajectoryError::kBusyTracking;
-  trajectory_ = table;
-  trajectory_valid_ = true;
-  return e;
+  return trajectories_.load(table, params_.guidance.eps_trans, modes_.mode() == Mode::kTrack);
 }
 
 void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutput& out) {
@@ -389,7 +384,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   if (commands.has_target && commands.target_mrp.allFinite()) {
     refs_.set_target(commands.target_mrp);
   }
-  const TransitionContext ctx{estimate_ready(), trajectory_valid_, params_.law};
+  const TransitionContext ctx{estimate_ready(), trajectories_.valid(), params_.law};
   const bool finite = omega_hat.allFinite() && q_hat.allFinite();
   modes_.update(ModeInputs{commands.has_mode_request, commands.mode_request, ctx, omega_hat.norm(),
                            t - last_good_t_, finite},
@@ -397,9 +392,19 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   const Mode mode = modes_.mode();
   if (actuating(mode) && !actuating(before)) laws_.reset_state();
 
-  // 3. Reference.
+  // 3. Reference. A staged trajectory becomes active here, at the tick boundary, and TRACK
+  // re-synchronises to the estimate on it.
+  const SwitchOutcome sw = trajectories_.switch_at_boundary(omega_hat, stale_tolerance(omega_hat));
+  if (sw != SwitchOutcome::kNone) {
+    const bool switched = sw == SwitchOutcome::kSwitched;
+    out.events.push(ModeEvent{switched ? EventId::kTrajectorySwitched : EventId::kTrajectoryStale,
+                              mode, mode, TransitionCheck::kOk});
+    if (switched && mode == Mode::kTrack && !modes_.entered()) {
+      refs_.reset_track(t, q_hat, omega_hat, trajectories_.active());
+    }
+  }
   const ReferenceSample ref =
-      refs_.update(mode, modes_.entered(), t, q_hat, omega_hat, trajectory_);
+      refs_.update(mode, modes_.entered(), t, q_hat, omega_hat, trajectories_.active());
 
   // 4. Control law.
   RateReference rr;
@@ -461,7 +466,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   tl.alloc = status;
   tl.fuel_kg = fuel_kg_;
   tl.sensor_rejects = sensor_rejects_;
-  tl.trajectory_loaded = trajectory_valid_;
+  tl.trajectory_loaded = trajectories_.valid();
   tl.a_hat = laws_.a_hat();
   tl.integral = laws_.integral();
   fill_estimation_telemetry(tl);

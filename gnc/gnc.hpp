@@ -13,6 +13,7 @@
 #include "gnc/fdi/fault_detector.hpp"
 #include "gnc/guidance/references.hpp"
 #include "gnc/guidance/trajectory.hpp"
+#include "gnc/guidance/trajectory_buffers.hpp"
 #include "gnc/io.hpp"  // SensorSample, GncCommands, GncOutput: what step() takes and gives
 #include "gnc/mode/mode_manager.hpp"
 #include "gnc/params.hpp"
@@ -36,8 +37,12 @@ class Gnc {
 
   // Would a request for `to` be accepted now? (the ground-command validator asks before acking)
   TransitionCheck check_mode_request(Mode to) const;
-  // Load (copy) a validated trajectory for TRACK. Rejected while TRACK is active.
+  // Load (copy) a validated trajectory for TRACK. While TRACK is active the table is staged in the
+  // standby buffer and becomes active at the next tick boundary (event kTrajectorySwitched, the
+  // reference re-synchronised to the estimate), or is refused there if stale (kTrajectoryStale);
+  // a second load while one is staged is refused (kBusyTracking).
   TrajectoryError load_trajectory(const TrajectoryTable& table);
+  const TrajectoryBuffers& trajectories() const { return trajectories_; }
 
   void step(const SensorSample& sample, const GncCommands& commands, GncOutput& out);
 
@@ -82,8 +87,7 @@ class Gnc {
   References refs_{};
   ControlLaws laws_{};
   Allocator alloc_{};
-  TrajectoryTable trajectory_{};
-  bool trajectory_valid_{false};
+  TrajectoryBuffers trajectories_{};  // double buffer: active + standby (switch at a tick boundary)
   double fuel_kg_{0.0};
   std::uint32_t tick_{0};
   std::uint32_t sensor_rejects_{0};

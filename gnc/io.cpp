@@ -58,6 +58,8 @@ const char* to_string(EventId e) {
     case EventId::kNonFiniteState: return "non_finite_state";
     case EventId::kRequestRejected: return "request_rejected";
     case EventId::kSensorRejected: return "sensor_rejected";
+    case EventId::kTrajectorySwitched: return "trajectory_switched";
+    case EventId::kTrajectoryStale: return "trajectory_stale";
     case EventId::kModelAdopted: return "model_adopted";
     case EventId::kModelRefused: return "model_refused";
     case EventId::kFaultSuspected: return "fault_suspected";

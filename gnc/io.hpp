@@ -58,6 +58,8 @@ enum class EventId : std::uint8_t {
   kNonFiniteState,   // -> SAFE: the estimate or command went non-finite
   kRequestRejected,  // a mode request that failed the check at the tick boundary
   kSensorRejected,   // a sample failed validity / range checks
+  kTrajectorySwitched,  // a staged trajectory became active at this tick boundary (TRACK re-synced)
+  kTrajectoryStale,     // a staged trajectory was refused at the boundary; the active one kept
   kModelAdopted,     // the identified model became the active table (automatic policy)
   kModelRefused,     // a confident identified model failed table validation (kept the old one)
   kFaultSuspected,   // a residual window failed the no-fault test (arg0 = leading thruster or -1)

@@ -25,7 +25,7 @@ struct Row {
   const char* text;  // printf with %s: from, to, detail (in that order; each may be unused)
 };
 
-constexpr std::array<Row, 13> kRows{{
+constexpr std::array<Row, 15> kRows{{
     {gnc::EventId::kModeChanged, EventId::kModeChanged, Severity::kInfo, Args::kFromTo,
      Detail::kCause, "mode %s -> %s (%s)"},
     {gnc::EventId::kAutoHold, EventId::kAutoHold, Severity::kInfo, Args::kFromTo, Detail::kNone,
@@ -53,6 +53,12 @@ constexpr std::array<Row, 13> kRows{{
      Detail::kArgs, "fault management override applied in %.0s%s (%s)"},
     {gnc::EventId::kReducedAuthority, EventId::kReducedAuthority, Severity::kWarning, Args::kData,
      Detail::kArgs, "reduced control authority in %.0s%s: some torque directions unreachable (%s)"},
+    {gnc::EventId::kTrajectorySwitched, EventId::kTrajectorySwitched, Severity::kInfo,
+     Args::kFromTo, Detail::kNone,
+     "trajectory switched at the tick boundary (mode %s%.0s): reference re-synchronised%s"},
+    {gnc::EventId::kTrajectoryStale, EventId::kTrajectoryStale, Severity::kWarning,
+     Args::kFromTo, Detail::kNone,
+     "staged trajectory refused at the tick boundary (mode %s%.0s): stale, active one kept%s"},
 }};
 
 const Row* find_row(gnc::EventId id) {

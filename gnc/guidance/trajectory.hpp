@@ -9,7 +9,10 @@
 
 namespace rocksteady::gnc {
 
-// [Rocksteady choice] fixed capacity: enough for a 10^5 s plan at the planner's default grid.
+// [Rocksteady choice] fixed capacity per table (the flight core holds two: trajectory_buffers.hpp).
+// 1024 samples = 512 Hermite-Simpson nodes: a plan of up to ~12 800 s at the planner's uniform grid
+// (a node every 25 s, what the open-loop check needs while the body turns in ~170 s). Each table is
+// 57 352 bytes; the wire format (trajectory_chunk_t.MAX_TABLE_SAMPLES) carries the same limit.
 inline constexpr int kMaxTrajectorySamples = 1024;
 
 struct TrajectorySample {

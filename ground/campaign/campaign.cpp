@@ -317,28 +317,40 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
     std::string note;
     double wall_s{0.0};
   };
-  std::vector<Plan> plans(setups.size());
+  // plans[c * kPlanHorizons + h]: case c, horizon h (only the horizons some strategy uses).
+  std::vector<Plan> plans(setups.size() * kPlanHorizons);
+  bool horizon_used[kPlanHorizons] = {false, false};
+  for (const Strategy& s : spec.strategies) {
+    if (s.needs_trajectory()) horizon_used[static_cast<int>(s.horizon)] = true;
+  }
+  const auto plan_of = [&](std::size_t c, const Strategy& s) -> Plan& {
+    return plans[c * kPlanHorizons + static_cast<std::size_t>(s.horizon)];
+  };
   const bool any_fuel_optimal =
       std::any_of(spec.strategies.begin(), spec.strategies.end(),
                   [](const Strategy& s) { return s.needs_trajectory(); });
   const auto plan0 = Clock::now();
   if (any_fuel_optimal) {
     for (std::size_t c = 0; c < setups.size(); ++c) {
+     for (int h = 0; h < kPlanHorizons; ++h) {
+      if (!horizon_used[h]) continue;
       PlanRequest req;
+      req.study_horizon = h == static_cast<int>(PlanHorizon::kStudy);
       req.setup = &setups[c];
       req.model = setups[c].flight;
       plant::Plant probe(setups[c].truth);  // the flight software's first measurement
       req.omega_init = probe.read_sensors().gyro.rate;
       if (spec.progress != ProgressMode::kOff) {
         log << "planning " << (c + 1) << "/" << setups.size() << ": " << setups[c].case_name
-            << " ..." << std::flush;
+            << (req.study_horizon ? " (study horizon)" : "") << " ..." << std::flush;
       }
       const PlanOutcome o = source.plan(req);
-      plans[c] = Plan{o.table, o.note, o.wall_s};
+      plans[c * kPlanHorizons + h] = Plan{o.table, o.note, o.wall_s};
       if (spec.progress != ProgressMode::kOff) {
         log << " " << (o.table ? "done" : "no plan") << " (" << fmt(o.wall_s, 1) << " s"
             << (o.note.empty() ? "" : ": " + o.note) << ")\n";
       }
+     }
     }
   }
   rep.plan_wall_s = seconds_since(plan0);
@@ -361,7 +373,7 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
   std::uint64_t total_ticks = 0;
   for (const Job& j : jobs) {
     const Strategy& st = spec.strategies[j.s];
-    if (st.needs_trajectory() && !plans[j.c].table) continue;
+    if (st.needs_trajectory() && !plan_of(j.c, st).table) continue;
     const double d = spec.duration_s >= 0 ? spec.duration_s : setups[j.c].duration_s;
     total_ticks += static_cast<std::uint64_t>(std::llround(d / setups[j.c].truth.control_period_s));
   }
@@ -395,11 +407,12 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
         GncFlightSide core_only;
         FswFlightSide app;
         FlightSide& flight = spec.use_flight_app ? static_cast<FlightSide&>(app) : core_only;
-        const gnc::TrajectoryTable* traj = st.needs_trajectory() ? plans[j.c].table.get() : nullptr;
-        r = run_closed_loop(setup, st, flight, traj, opt, plans[j.c].note);
+        const Plan& pl = plan_of(j.c, st);
+        const gnc::TrajectoryTable* traj = st.needs_trajectory() ? pl.table.get() : nullptr;
+        r = run_closed_loop(setup, st, flight, traj, opt, pl.note);
         if (st.needs_trajectory()) {
-          r.plan_wall_s = plans[j.c].wall_s;
-          if (traj != nullptr && r.note.empty()) r.note = plans[j.c].note;
+          r.plan_wall_s = pl.wall_s;
+          if (traj != nullptr && r.note.empty()) r.note = pl.note;
         }
       } catch (const std::exception& e) {
         r.case_name = setup.case_name;

@@ -82,7 +82,7 @@ std::vector<Strategy> strategies(const std::string& spec) {
       std::string known;
       for (const std::string& k : campaign::all_strategy_names()) known += " " + k;
       throw CLI::ValidationError("--strategy", "unknown strategy '" + n + "' (known:" + known +
-                                                   ", or <law>+dpd_ref|fuel_optimal)");
+                                                   ", or <law>+dpd_ref|fuel_optimal|fuel_optimal_study)");
     }
     out.push_back(*s);
   }
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
 
   CLI::App* run = app.add_subcommand("run", "one case with one strategy");
   run->add_option("--case", case_arg, "case number or case file")->capture_default_str();
-  run->add_option("--strategy", strategy_arg, "e.g. ntcl+dpd_ref, dpd, ntcl+fuel_optimal")
+  run->add_option("--strategy", strategy_arg, "e.g. ntcl+dpd_ref, dpd, ntcl+fuel_optimal, ntcl+fuel_optimal_study (study-horizon plan)")
       ->capture_default_str();
   CLI::App* camp = app.add_subcommand("campaign", "cases x strategies, in parallel");
   camp->add_option("--cases", cases_arg, "case numbers, ranges or files: 1-7, 1,4, x.yaml")

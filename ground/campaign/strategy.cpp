@@ -16,6 +16,9 @@ std::optional<Strategy> parse_base(const std::string& name) {
     s.reference = ReferenceKind::kDpdRef;
   } else if (ref == "fuel_optimal") {
     s.reference = ReferenceKind::kFuelOptimal;
+  } else if (ref == "fuel_optimal_study") {
+    s.reference = ReferenceKind::kFuelOptimal;
+    s.horizon = PlanHorizon::kStudy;
   } else {
     return std::nullopt;
   }

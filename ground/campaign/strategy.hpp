@@ -12,10 +12,16 @@ namespace rocksteady::campaign {
 
 enum class ReferenceKind { kDpdRef, kFuelOptimal };
 
+// The fuel-optimal plan's final time: the planner's default (8x the shortest despin), or the study's
+// (ground/planner kStudyHorizon, the option "study-horizon": reference name fuel_optimal_study).
+enum class PlanHorizon { kDefault = 0, kStudy = 1 };
+inline constexpr int kPlanHorizons = 2;
+
 struct Strategy {
   std::string name;
   gnc::LawId law{gnc::LawId::kNtcl};
   ReferenceKind reference{ReferenceKind::kDpdRef};
+  PlanHorizon horizon{PlanHorizon::kDefault};
   // Modifiers beyond the study (name suffixes): ":mekf" flies the MEKF instead of the case's
   // estimator; ":id" runs the on-line identification with automatic model adoption.
   bool mekf{false};
@@ -24,8 +30,9 @@ struct Strategy {
   bool needs_trajectory() const { return reference == ReferenceKind::kFuelOptimal; }
 };
 
-// Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal;
-// optional suffixes ":mekf", ":id" and ":fdi" in any order ("ntcl+dpd_ref:mekf:id", "dpd:id:fdi").
+// Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal,
+// fuel_optimal_study (the fuel-optimal plan with the study's horizon); optional suffixes ":mekf",
+// ":id" and ":fdi" in any order ("ntcl+dpd_ref:mekf:id", "dpd:id:fdi").
 std::optional<Strategy> parse_strategy(const std::string& name);
 // The six columns of the study's results table, in its order.
 const std::vector<std::string>& study_strategy_names();

@@ -31,6 +31,7 @@ class PlannerSource final : public TrajectorySource {
     problem.model.u_max = r.model.rcs.u_max;
     problem.model.eps_trans = r.model.guidance.eps_trans;
     problem.model.omega_init = r.omega_init;
+    if (r.study_horizon) problem.settings.t_final_max = pl::kStudyHorizon;
     try {
       if (!cache_dir_.empty()) {
         // Plan once per model and case: the cache file is keyed by the problem's hash, and it is

@@ -17,6 +17,7 @@ struct PlanRequest {
   const config::RunSetup* setup{nullptr};  // the case
   gnc::GncParams model{};                   // the flight software's model: J_hat, B_hat, u_max
   gnc::Vec3 omega_init{gnc::Vec3::Zero()};  // the flight software's first rate measurement
+  bool study_horizon{false};  // plan with the study's final time (ground/planner kStudyHorizon)
 };
 
 struct PlanOutcome {

@@ -198,21 +198,29 @@ DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfi
   }
   r.eps_trans_rad_s = setup.flight.guidance.eps_trans;
 
-  // One plan per draw (the draw's estimated model and first rate measurement), shared.
-  std::shared_ptr<const gnc::TrajectoryTable> plan;
-  for (const campaign::Strategy& st : spec.strategies)
-    r.planned = r.planned || st.needs_trajectory();
-  if (r.planned) {
+  // One plan per draw and horizon (the draw's estimated model and first rate measurement), shared.
+  std::shared_ptr<const gnc::TrajectoryTable> plans[campaign::kPlanHorizons];
+  std::string notes[campaign::kPlanHorizons];
+  bool used[campaign::kPlanHorizons] = {false, false};
+  for (const campaign::Strategy& st : spec.strategies) {
+    if (st.needs_trajectory()) used[static_cast<int>(st.horizon)] = true;
+  }
+  for (int h = 0; h < campaign::kPlanHorizons; ++h) {
+    if (!used[h]) continue;
+    r.planned = true;
     campaign::PlanRequest req;
     req.setup = &setup;
     req.model = setup.flight;
+    req.study_horizon = h == static_cast<int>(campaign::PlanHorizon::kStudy);
     plant::Plant probe(setup.truth);
     req.omega_init = probe.read_sensors().gyro.rate;
     const campaign::PlanOutcome o = planner.plan(req);
-    plan = o.table;
-    r.have_plan = plan != nullptr;
-    r.plan_note = o.note;
-    r.plan_wall_s = o.wall_s;
+    plans[h] = o.table;
+    notes[h] = o.note;
+    const bool first = h == 0 || !used[0];  // the first horizon planned
+    r.have_plan = (first || r.have_plan) && plans[h] != nullptr;
+    if (r.plan_note.empty() || plans[h] == nullptr) r.plan_note = o.note;
+    r.plan_wall_s += o.wall_s;
   }
 
   for (const campaign::Strategy& st : spec.strategies) {
@@ -228,8 +236,9 @@ DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfi
         seen = read_back(p, flight.computer().app().active_params());
         have = true;
       };
-      const gnc::TrajectoryTable* traj = st.needs_trajectory() ? plan.get() : nullptr;
-      run = campaign::run_closed_loop(setup, st, flight, traj, opt, r.plan_note);
+      const int h = static_cast<int>(st.horizon);
+      const gnc::TrajectoryTable* traj = st.needs_trajectory() ? plans[h].get() : nullptr;
+      run = campaign::run_closed_loop(setup, st, flight, traj, opt, notes[h]);
       if (have && !r.flown) r.flown = seen;
     } catch (const std::exception& e) {
       run.strategy = st.name;
@@ -238,7 +247,7 @@ DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfi
     }
     StrategyOutcome o = outcome_of(run, r.eps_trans_rad_s);
     if (st.needs_trajectory() && run.status == campaign::RunStatus::kOk && o.note.empty()) {
-      o.note = r.plan_note;
+      o.note = notes[static_cast<int>(st.horizon)];
     }
     r.runs.push_back(o);
     if (options.full_runs != nullptr) options.full_runs->push_back(std::move(run));

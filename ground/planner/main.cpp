@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   std::string case_file;
   std::string config_dir;
   bool no_refinement = false;
+  bool tumble_grid = false;
   bool verbose = false;
   planner::PlanSettings settings;
   app.add_option("--u-max", u_max, "per-channel force limit u_max (N), SPEC Table 3")
@@ -68,11 +69,28 @@ int main(int argc, char** argv) {
   app.add_option("--delta-r", delta_r, "||dr_SO/BCM||_2 (m): r_hat = r - dr [1,1,1]/sqrt(3)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--case-name", case_name, "case name recorded in the file");
-  app.add_option("--nodes", settings.nodes, "grid nodes N (2N-1 samples)")
-      ->check(CLI::Range(3, 512));
+  app.add_flag("--tumble-grid", tumble_grid,
+               "tumble-following grid with mesh refinement instead of the uniform one");
+  app.add_option("--intervals-per-turn", settings.intervals_per_turn,
+                 "tumble grid: intervals per turn of the body")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--nodes", settings.nodes, "grid nodes N (2N-1 samples; 0 = automatic)")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            try {
+              const int n = std::stoi(v);
+              if (n == 0 || (n >= 3 && n <= 512)) return "";
+            } catch (const std::exception&) {
+            }
+            return "must be 0 (automatic) or in [3, 512]";
+          },
+          "0|3..512"));
   app.add_option("--t-final-max", settings.t_final_max,
                  "final time (fixed) or its upper bound (free), s; default 8x the shortest despin");
   app.add_option("--t-final-min", settings.t_final_min, "lower bound of a free final time, s");
+  bool study_horizon = false;
+  app.add_flag("--study-horizon", study_horizon,
+               "final time like the study's fuel-optimal trackers (44000 s)");
   app.add_flag("--free-final-time", settings.free_final_time, "let t_f float in [min, max]");
   app.add_option("--tolerance", settings.tolerance, "IPOPT convergence tolerance (scaled NLP)")
       ->check(CLI::PositiveNumber);
@@ -105,6 +123,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   settings.verify_refinement = !no_refinement;
+  settings.tumble_grid = tumble_grid;
+  if (study_horizon) {
+    if (settings.t_final_max > 0.0) {
+      std::fprintf(stderr, "error: --study-horizon and --t-final-max both set the final time\n");
+      return 2;
+    }
+    settings.t_final_max = planner::kStudyHorizon;
+  }
   if (verbose) settings.print_level = 5;
 
   planner::PlanProblem problem;

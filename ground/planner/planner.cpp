@@ -175,11 +175,11 @@ std::vector<double> momentum_ramp_guess(const HermiteSimpsonNlp& nlp, const Plan
     return e.cross(omega);
   };
   const int p = nlp.num_points();
-  const double dt_point = t_f / (p - 1);
   constexpr int kSubsteps = 16;
   Vec3 e = h0 / h0_norm;
   for (int j = 0; j < p; ++j) {
-    const double t = j * dt_point;
+    const double t = t_f * nlp.point_fraction(j);
+    const double dt_point = j + 1 < p ? t_f * nlp.point_fraction(j + 1) - t : 0.0;
     const Vec3 omega = h0_norm * (1.0 - t / t_f) * (j_inv * e);
     const Vec8 u = (b_pinv * (-h0_norm / t_f * e)).cwiseMax(-model.u_max).cwiseMin(model.u_max);
     nlp.set_point(x.data(), j, j == 0 ? model.omega_init : omega, u);
@@ -200,23 +200,43 @@ std::vector<double> momentum_ramp_guess(const HermiteSimpsonNlp& nlp, const Plan
 std::vector<double> guess_from_samples(const HermiteSimpsonNlp& nlp,
                                        const std::vector<PlanSample>& samples) {
   std::vector<double> x(nlp.num_variables(), 0.0);
-  const double t_f = samples.back().t;
+  // The warm plan's final time when it lies in this problem's range; else this problem's (a shorter
+  // plan is extended by rest, a longer one cut).
+  double t_f = samples.back().t;
+  if (t_f < nlp.model().t_final_min || t_f > nlp.model().t_final_max) t_f = nlp.t_scale();
   nlp.set_t_final(x.data(), t_f);
   const int p = nlp.num_points();
   std::size_t k = 0;
   for (int j = 0; j < p; ++j) {
-    const double t = t_f * j / (p - 1);
+    const double t = t_f * nlp.point_fraction(j);
     while (k + 2 < samples.size() && samples[k + 1].t < t) ++k;
     const PlanSample& a = samples[k];
     const PlanSample& b = samples[k + 1];
+    if (t > samples.back().t) {  // after the warm plan: at rest
+      nlp.set_point(x.data(), j, Vec3::Zero(), Vec8::Zero());
+      continue;
+    }
     const double s = std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0);
     nlp.set_point(x.data(), j, (1 - s) * a.omega_d + s * b.omega_d, (1 - s) * a.u_d + s * b.u_d);
   }
   return x;
 }
 
-SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, int nodes, double t_min,
-                   double t_max, const std::vector<PlanSample>* warm) {
+struct SolveSpec {
+  int nodes{0};
+  std::vector<double> grid;  // empty: uniform
+  double t_min{0.0};
+  double t_max{0.0};
+  const std::vector<PlanSample>* warm{nullptr};
+  double warm_mu{0.0};  // > 0: warm-start the barrier at this mu (needs warm)
+};
+
+SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
+                        const SolveSpec& spec) {
+  const int nodes = spec.nodes;
+  const double t_min = spec.t_min;
+  const double t_max = spec.t_max;
+  const std::vector<PlanSample>* warm = spec.warm;
   SolveOutcome out;
   TranscriptionModel tm;
   tm.j_hat = model.j_hat;
@@ -225,6 +245,7 @@ SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, int nod
   tm.eps_trans = model.eps_trans;
   tm.omega_init = model.omega_init;
   tm.nodes = nodes;
+  tm.grid = spec.grid;
   tm.t_final_min = t_min;
   tm.t_final_max = t_max;
   const HermiteSimpsonNlp nlp(tm);
@@ -241,6 +262,19 @@ SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, int nod
   app->Options()->SetIntegerValue("max_iter", settings.max_iterations);
   app->Options()->SetNumericValue("bound_relax_factor", 0.0);  // bounds hold exactly
   app->Options()->SetStringValue("mu_strategy", "adaptive");
+  if (warm != nullptr && spec.warm_mu > 0.0) {
+    // Warm start [Rocksteady choice]: the guess is a converged plan of a nearby problem (another
+    // grid, a shorter horizon, an earlier state), so the barrier starts small and the bounds are
+    // barely pushed; measured on case 1 at 5600 s the refinement re-solve takes 59 instead of 292
+    // iterations.
+    app->Options()->SetStringValue("mu_strategy", "monotone");
+    app->Options()->SetNumericValue("mu_init", spec.warm_mu);
+    // A warm start that has not converged by then is not near its answer: solve() starts over cold.
+    app->Options()->SetIntegerValue("max_iter", std::min(settings.max_iterations, kWarmMaxIterations));
+    app->Options()->SetNumericValue("bound_push", 1e-6);
+    app->Options()->SetNumericValue("bound_frac", 1e-6);
+    app->Options()->SetStringValue("bound_mult_init_method", "mu-based");
+  }
   app->Options()->SetStringValue("hessian_approximation", "exact");
   if (app->Initialize() != Ipopt::Solve_Succeeded) {
     out.error = "IPOPT failed to initialise";
@@ -266,7 +300,7 @@ SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, int nod
   out.samples.resize(p);
   for (int j = 0; j < p; ++j) {
     PlanSample& s = out.samples[j];
-    s.t = out.t_final * j / (p - 1);
+    s.t = out.t_final * nlp.point_fraction(j);
     s.omega_d = nlp.omega(x.data(), j);
     s.u_d = nlp.control(x.data(), j);
   }
@@ -276,6 +310,19 @@ SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, int nod
   for (PlanSample& s : out.samples) s.omega_d_dot = dynamics(model, j_inv, s.omega_d, s.u_d);
   out.ok = true;
   return out;
+}
+
+// A warm-started solve that does not converge is repeated from the same guess with the default
+// (adaptive) barrier strategy; iterations and time add up.
+SolveOutcome solve(const PlanModel& model, const PlanSettings& settings, const SolveSpec& spec) {
+  SolveOutcome out = solve_once(model, settings, spec);
+  if (out.ok || spec.warm_mu <= 0.0) return out;
+  SolveSpec cold = spec;
+  cold.warm_mu = 0.0;
+  SolveOutcome again = solve_once(model, settings, cold);
+  again.iterations += out.iterations;
+  again.seconds += out.seconds;
+  return again;
 }
 
 void check_model(const PlanModel& m, int nodes) {
@@ -306,6 +353,144 @@ void check_model(const PlanModel& m, int nodes) {
         << "] (2N-1 samples fit the on-board table)";
     throw std::invalid_argument(msg.str());
   }
+}
+
+
+int max_nodes() { return (gnc::kMaxTrajectorySamples + 1) / 2; }
+
+// Automatic uniform grid: one node every kUniformStep seconds, at least kDefaultNodes, at most what
+// the on-board table holds.
+int automatic_uniform_nodes(double t_f) {
+  const double n = std::ceil(t_f / kUniformStep) + 1.0;
+  return static_cast<int>(std::clamp(n, static_cast<double>(kDefaultNodes),
+                                     static_cast<double>(max_nodes())));
+}
+
+std::vector<double> uniform_grid(int nodes) {
+  const int n = std::max(nodes, 2);
+  std::vector<double> g(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) g[k] = static_cast<double>(k) / (n - 1);
+  g[static_cast<std::size_t>(n - 1)] = 1.0;
+  return g;
+}
+
+std::vector<double> bisected(const std::vector<double>& grid) {
+  std::vector<double> g;
+  g.reserve(2 * grid.size() - 1);
+  for (std::size_t k = 0; k + 1 < grid.size(); ++k) {
+    g.push_back(grid[k]);
+    g.push_back(0.5 * (grid[k] + grid[k + 1]));
+  }
+  g.push_back(1.0);
+  return g;
+}
+
+// Tumble-following grid [Rocksteady choice]: node spacing inversely proportional to the body rate,
+// so every interval covers about the same rotation angle (2 pi / intervals_per_turn), whatever the
+// horizon. The rate is floored at kTumbleFloor |omega(0)| so that slow stretches keep some nodes.
+// nodes > 0 fixes the node count; else it follows from the total angle.
+template <typename Rate>
+std::vector<double> tumble_grid(const Rate& rate, double t_f, double intervals_per_turn, int nodes,
+                                int max) {
+  constexpr int kFine = 20000;  // quadrature of the angle
+  const double floor = kTumbleFloor * rate(0.0);
+  std::vector<double> angle(kFine + 1, 0.0);
+  for (int i = 0; i < kFine; ++i) {
+    const double ta = t_f * i / kFine;
+    const double tb = t_f * (i + 1) / kFine;
+    angle[i + 1] = angle[i] + 0.5 * (tb - ta) *
+                                  (std::max(rate(ta), floor) + std::max(rate(tb), floor));
+  }
+  const double total = angle.back();
+  if (nodes <= 0) {
+    const double turns = total / (2.0 * 3.14159265358979323846);
+    nodes = static_cast<int>(std::ceil(turns * intervals_per_turn)) + 1;
+  }
+  nodes = std::clamp(nodes, kMinTumbleNodes, max);
+  std::vector<double> g(nodes, 0.0);
+  int i = 0;
+  for (int k = 1; k + 1 < nodes; ++k) {
+    const double target = total * k / (nodes - 1);
+    while (i < kFine && angle[i + 1] < target) ++i;
+    const double f = (target - angle[i]) / (angle[i + 1] - angle[i]);
+    g[k] = (i + f) / kFine;
+  }
+  g.back() = 1.0;
+  return g;
+}
+
+
+// Local open-loop error of each interval: RK4 (32 steps) from the interval's first node under the
+// quadratic control interpolant, compared with the plan's next node (the per-interval part of the
+// verification's propagation check).
+std::vector<double> interval_errors(const PlanModel& model, const std::vector<PlanSample>& samples) {
+  const Mat3 j_inv = model.j_hat.inverse();
+  std::vector<double> e;
+  constexpr int kSteps = 32;
+  for (std::size_t a = 0; a + 2 < samples.size(); a += 2) {
+    const double ta = samples[a].t;
+    const double h = samples[a + 2].t - ta;
+    const Vec8& ua = samples[a].u_d;
+    const Vec8& um = samples[a + 1].u_d;
+    const Vec8& ub = samples[a + 2].u_d;
+    const auto u_at = [&](double t) -> Vec8 {
+      const double s = (t - ta) / h;
+      return (2 * s - 1) * (s - 1) * ua + 4 * s * (1 - s) * um + s * (2 * s - 1) * ub;
+    };
+    Vec3 omega = samples[a].omega_d;
+    const double dt = h / kSteps;
+    for (int k = 0; k < kSteps; ++k) {
+      const double t = ta + k * dt;
+      const Vec3 k1 = dynamics(model, j_inv, omega, u_at(t));
+      const Vec3 k2 = dynamics(model, j_inv, omega + 0.5 * dt * k1, u_at(t + 0.5 * dt));
+      const Vec3 k3 = dynamics(model, j_inv, omega + 0.5 * dt * k2, u_at(t + 0.5 * dt));
+      const Vec3 k4 = dynamics(model, j_inv, omega + dt * k3, u_at(t + dt));
+      omega += dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+    }
+    e.push_back((omega - samples[a + 2].omega_d).norm());
+  }
+  return e;
+}
+
+// Error-equidistributing grid [Rocksteady choice] (mesh refinement after a first solve). Hermite-
+// Simpson's local error on an interval of length h is C h^5; with C_k = e_k / h_k^5 from the first
+// plan, intervals of length h(t) = (e / C(t))^(1/5) all make the same error e. Choosing e =
+// limit / N (so that N such errors add up to `limit`, the caller's fraction of the verification's
+// limit) gives N = (I^5 / limit)^(1/4), I = int C^(1/5) dt. The density is floored by `turns_floor`
+// intervals per turn of the body (the plan's own rate), so that no stretch goes unresolved.
+std::vector<double> error_grid(const std::vector<PlanSample>& samples, const std::vector<double>& err,
+                               double limit, double turns_floor, int max) {
+  const double t_f = samples.back().t;
+  const std::size_t k_count = err.size();
+  std::vector<double> density(k_count);  // intervals per second on each old interval
+  double integral = 0.0;
+  for (std::size_t k = 0; k < k_count; ++k) {
+    const double h = samples[2 * k + 2].t - samples[2 * k].t;
+    density[k] = std::pow(std::max(err[k], 1e-300), 0.2) / h;  // C^(1/5)
+    integral += density[k] * h;
+  }
+  const double n_err = std::pow(std::pow(integral, 5.0) / limit, 0.25);
+  const double scale = n_err / std::max(integral, 1e-300);  // density in intervals per second
+  std::vector<double> cumulative(k_count + 1, 0.0);
+  for (std::size_t k = 0; k < k_count; ++k) {
+    const double h = samples[2 * k + 2].t - samples[2 * k].t;
+    const double w = 0.5 * (samples[2 * k].omega_d.norm() + samples[2 * k + 2].omega_d.norm());
+    const double floor = turns_floor * w / (2.0 * 3.14159265358979323846);
+    cumulative[k + 1] = cumulative[k] + h * std::max(scale * density[k], floor);
+  }
+  const int nodes = std::clamp(static_cast<int>(std::ceil(cumulative.back())) + 1, kMinTumbleNodes, max);
+  std::vector<double> g(nodes, 0.0);
+  std::size_t k = 0;
+  for (int i = 1; i + 1 < nodes; ++i) {
+    const double target = cumulative.back() * i / (nodes - 1);
+    while (k + 1 < k_count && cumulative[k + 1] < target) ++k;
+    const double f = (target - cumulative[k]) / (cumulative[k + 1] - cumulative[k]);
+    g[i] = (samples[2 * k].t + f * (samples[2 * k + 2].t - samples[2 * k].t)) / t_f;
+  }
+  g.back() = 1.0;
+  for (int i = 1; i < nodes; ++i) g[i] = std::max(g[i], g[i - 1] + 1e-9);
+  g.back() = 1.0;
+  return g;
 }
 
 }  // namespace
@@ -423,7 +608,7 @@ PlanResult plan(const PlanProblem& problem) {
   const PlanModel& model = problem.model;
   const PlanSettings& settings = problem.settings;
   try {
-    check_model(model, settings.nodes);
+    check_model(model, settings.nodes > 0 ? settings.nodes : kDefaultNodes);
   } catch (const std::invalid_argument& e) {
     r.error = std::string("invalid problem: ") + e.what();
     return r;
@@ -433,11 +618,83 @@ PlanResult plan(const PlanProblem& problem) {
     r.error = "invalid problem: t_final_max < t_final_min";
     return r;
   }
-  r.nodes = settings.nodes;
-  SolveOutcome main =
-      solve(model, settings, settings.nodes, r.t_final_min, r.t_final_max, nullptr);
+  SolveSpec spec;
+  spec.t_min = r.t_final_min;
+  spec.t_max = r.t_final_max;
+  if (problem.warm_start != nullptr && problem.warm_start->size() >= 3) {
+    spec.warm = problem.warm_start;
+    spec.warm_mu = kWarmMu;
+  }
+  if (settings.tumble_grid) {
+    // Pass 1: a grid that follows an a-priori tumble (the momentum-ramp guess's rate).
+    const double w0 = model.omega_init.norm();
+    const double t_f = 0.5 * (r.t_final_min + r.t_final_max);
+    spec.grid = tumble_grid(
+        [&](double t) { return w0 * std::max(1.0 - t / t_f, kTumbleFloor); }, t_f,
+        settings.intervals_per_turn, settings.nodes, max_nodes());
+  } else {
+    if (settings.nodes <= 0 && std::ceil(r.t_final_max / kUniformStep) + 1.0 > max_nodes()) {
+      // Refused before solving: at the grid's resolution the plan would not fit the on-board
+      // table, and a coarser grid fails the open-loop check (after minutes of solving).
+      std::ostringstream msg;
+      msg << "invalid problem: a " << r.t_final_max << " s horizon needs "
+          << std::ceil(r.t_final_max / kUniformStep) + 1.0 << " nodes at one per " << kUniformStep
+          << " s; the on-board table holds " << max_nodes()
+          << " (at most " << kUniformStep * (max_nodes() - 1)
+          << " s on the uniform grid; try the tumble-following grid)";
+      r.error = msg.str();
+      return r;
+    }
+    spec.grid = uniform_grid(settings.nodes > 0 ? settings.nodes
+                                                : automatic_uniform_nodes(r.t_final_max));
+  }
+  spec.nodes = static_cast<int>(spec.grid.size());
+  SolveOutcome main = solve(model, settings, spec);
   r.iterations = main.iterations;
   r.solve_seconds = main.seconds;
+  // Mesh refinement (automatic grid): re-grid on the plan's own interval errors and re-solve,
+  // warm-started, until the open-loop check holds (at most kMaxRegrids times). The error target
+  // tightens each round, since the global error is not just the sum of the local ones.
+  const double limit = settings.propagation_limit * model.omega_init.norm();
+  double safety = kRegridSafety;
+  for (int round = 0; main.ok && settings.tumble_grid && settings.nodes <= 0 && round < kMaxRegrids;
+       ++round) {
+    const std::vector<double> err = interval_errors(model, main.samples);
+    if (round > 0 && verify_samples(model, main.samples, settings.propagation_limit).passed) break;
+    const std::vector<PlanSample> previous = main.samples;
+    SolveSpec again = spec;
+    again.grid = error_grid(previous, err, safety * limit, kFloorIntervalsPerTurn, max_nodes());
+    again.nodes = static_cast<int>(again.grid.size());
+    again.warm = &previous;
+    again.warm_mu = kWarmMu;
+    SolveOutcome next = solve(model, settings, again);
+    r.iterations += next.iterations;
+    r.solve_seconds += next.seconds;
+    main = std::move(next);
+    spec = again;
+    spec.warm = nullptr;
+    safety *= 0.25;
+  }
+  // Automatic uniform grid: when the open-loop check fails (faster dynamics than case 1's, e.g. a
+  // larger u_max), 1.5x the nodes, warm-started, while the table holds them.
+  for (int round = 0; main.ok && !settings.tumble_grid && settings.nodes <= 0 &&
+                      spec.nodes < max_nodes() && round < kMaxRegrids;
+       ++round) {
+    if (verify_samples(model, main.samples, settings.propagation_limit).passed) break;
+    const std::vector<PlanSample> previous = main.samples;
+    SolveSpec again = spec;
+    again.grid = uniform_grid(std::min(max_nodes(), (3 * spec.nodes) / 2));
+    again.nodes = static_cast<int>(again.grid.size());
+    again.warm = &previous;
+    again.warm_mu = kWarmMu;
+    SolveOutcome next = solve(model, settings, again);
+    r.iterations += next.iterations;
+    r.solve_seconds += next.seconds;
+    main = std::move(next);
+    spec = again;
+    spec.warm = nullptr;
+  }
+  r.nodes = spec.nodes;
   if (!main.ok) {
     r.error = main.error;
     return r;
@@ -452,8 +709,12 @@ PlanResult plan(const PlanProblem& problem) {
     return r;
   }
   if (settings.verify_refinement) {
-    const SolveOutcome fine = solve(model, settings, 2 * settings.nodes - 1, r.t_final_min,
-                                    r.t_final_max, &r.samples);
+    SolveSpec fine_spec = spec;
+    fine_spec.grid = bisected(spec.grid);  // every interval halved: 2N-1 nodes
+    fine_spec.nodes = static_cast<int>(fine_spec.grid.size());
+    fine_spec.warm = &r.samples;
+    fine_spec.warm_mu = kWarmMu;
+    const SolveOutcome fine = solve(model, settings, fine_spec);
     if (!fine.ok) {
       r.verification.refined_iterations = fine.iterations;
       r.error = "verification failed: refined grid: " + fine.error;
@@ -467,7 +728,7 @@ PlanResult plan(const PlanProblem& problem) {
         std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
     if (!(r.verification.refinement_change < settings.refinement_limit)) {
       std::ostringstream msg;
-      msg << "grid refinement (" << settings.nodes << " -> " << 2 * settings.nodes - 1
+      msg << "grid refinement (" << r.nodes << " -> " << fine_spec.nodes
           << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
           << " % (limit " << 100.0 * settings.refinement_limit << " %)";
       r.verification.passed = false;
@@ -494,6 +755,51 @@ gnc::TrajectoryTable to_table(const std::vector<PlanSample>& samples) {
   if (table.count > 0) table.samples[table.count - 1].omega_d = Vec3::Zero();
   table.checksum = gnc::trajectory_checksum(table);
   return table;
+}
+
+std::vector<PlanSample> remaining_plan(const std::vector<PlanSample>& samples, double t_now) {
+  std::vector<PlanSample> out;
+  if (samples.size() < 3 || !(t_now < samples.back().t)) return out;
+  // First node at or after t_now; the point at t_now interpolated in front of it.
+  std::size_t k = 0;
+  while (k < samples.size() && samples[k].t < t_now) k += 2;
+  if (k >= samples.size()) return out;
+  PlanSample first;
+  if (k == 0) {
+    first = samples[0];
+  } else {
+    const PlanSample& a = samples[k - 2];
+    const PlanSample& b = samples[k];
+    const double s = (t_now - a.t) / (b.t - a.t);
+    first.omega_d = (1 - s) * a.omega_d + s * b.omega_d;
+    first.omega_d_dot = (1 - s) * a.omega_d_dot + s * b.omega_d_dot;
+    first.u_d = (1 - s) * a.u_d + s * b.u_d;
+  }
+  first.t = t_now;
+  out.push_back(first);
+  if (k > 0 && samples[k].t > t_now) {  // a midpoint between t_now and node k
+    PlanSample m;
+    m.t = 0.5 * (t_now + samples[k].t);
+    m.omega_d = 0.5 * (first.omega_d + samples[k].omega_d);
+    m.omega_d_dot = 0.5 * (first.omega_d_dot + samples[k].omega_d_dot);
+    m.u_d = 0.5 * (first.u_d + samples[k].u_d);
+    out.push_back(m);
+  }
+  for (std::size_t i = k == 0 ? 1 : k; i < samples.size(); ++i) out.push_back(samples[i]);
+  if (out.size() % 2 == 0) out.erase(out.begin() + 1);  // first and node k coincide
+  for (PlanSample& p : out) p.t -= t_now;
+  out.front().t = 0.0;
+  return out;
+}
+
+PlanModel replan_model(const gnc::GncParams& active, const Vec3& omega_hat) {
+  PlanModel m;
+  m.j_hat = gnc::total_inertia(active.mass_hat);
+  m.b_hat = gnc::torque_matrix(active.rcs, active.mass_hat.r_so_bcm);
+  m.u_max = active.rcs.u_max;
+  m.eps_trans = active.guidance.eps_trans;
+  m.omega_init = omega_hat;
+  return m;
 }
 
 PlanModel study_case_model(double u_max, double delta_j_norm, double delta_r_norm) {
@@ -538,8 +844,9 @@ std::uint64_t problem_hash(const PlanProblem& problem) {
   hash_double(h, s.tolerance);
   hash_double(h, s.refinement_limit);
   hash_double(h, s.propagation_limit);
-  const std::int64_t flags =
-      (s.verify_refinement ? 1 : 0) + (s.free_final_time ? 2 : 0) + 4 * std::int64_t{s.max_iterations};
+  const std::int64_t flags = (s.verify_refinement ? 1 : 0) + (s.free_final_time ? 2 : 0) +
+                             (s.tumble_grid ? 8 : 0) + 16 * std::int64_t{s.max_iterations};
+  hash_double(h, s.intervals_per_turn);
   hash_bytes(h, &flags, sizeof flags);
   return h;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gnc/guidance/trajectory.hpp"
+#include "gnc/params.hpp"
 #include "gnc/types.hpp"
 
 namespace rocksteady::ground::planner {
@@ -27,6 +28,9 @@ inline constexpr double kG0 = 9.8;     // m/s^2
 inline constexpr int kDefaultNodes = 101;
 // [Rocksteady choice] default horizon: kHorizonFactor times the shortest possible despin time.
 inline constexpr double kHorizonFactor = 8.0;
+// The study's horizon ("study-horizon"): its fuel-optimal trackers despin over about 44 000 s (their
+// reference decays over hours, which exposes them to the gyroscopic model error, SPEC §8 C2-C3).
+inline constexpr double kStudyHorizon = 44000.0;
 
 // The model the plan is for: the flight software's estimate (hatted quantities, SPEC Eq. 6).
 struct PlanModel {
@@ -37,8 +41,35 @@ struct PlanModel {
   Vec3 omega_init{Vec3::Zero()};  // initial body rate (rad/s)
 };
 
+// [Rocksteady choice] automatic uniform grid: a node every kUniformStep seconds (measured on case 1:
+// 28 s and 27.5 s spacing pass the open-loop check at 5600 s and 11 000 s with little margin).
+inline constexpr double kUniformStep = 25.0;
+// [Rocksteady choice] tumble-following grid (README.md, "Long horizons"): intervals per turn of the
+// body, the floor of the rate the grid follows (fraction of |omega_init|), the fewest nodes.
+inline constexpr double kIntervalsPerTurn = 8.0;
+inline constexpr double kTumbleFloor = 0.15;
+inline constexpr int kMinTumbleNodes = 41;
+// Second pass: the error-equidistributing grid keeps at least this many intervals per turn.
+inline constexpr double kFloorIntervalsPerTurn = 4.0;
+// Mesh refinement: first error target (fraction of the open-loop limit), rounds at most.
+inline constexpr double kRegridSafety = 0.25;
+inline constexpr int kMaxRegrids = 3;
+// Barrier parameter a warm-started solve starts from.
+inline constexpr double kWarmMu = 1e-7;
+// Iterations a warm-started solve gets before it is repeated cold (case 3 at 1390 s: a warm
+// refinement that wanders for 1000 iterations made the plan 3x slower than the cold one).
+inline constexpr int kWarmMaxIterations = 150;
+
 struct PlanSettings {
-  int nodes{kDefaultNodes};
+  // Grid nodes N (2N-1 samples). 0 = automatic: with the uniform grid, one node every kUniformStep
+  // seconds (at least kDefaultNodes); with the tumble grid, from the total rotation angle
+  // (intervals_per_turn per turn), then mesh refinement on the plan's own interval errors.
+  int nodes{0};
+  // false (default): the uniform grid. true: node spacing follows the tumble (about the same
+  // rotation angle per interval), refined where the open-loop error is largest. ground/planner/
+  // README.md, "Long horizons", has the measurements behind the default.
+  bool tumble_grid{false};
+  double intervals_per_turn{kIntervalsPerTurn};
   // Final time [Rocksteady choice]: fixed by default. Without a time cost the minimum fuel is a
   // non-increasing function of the horizon (a plan that reaches rest at T extends to any T' > T by
   // resting), so a free final time ends at its upper bound anyway (or anywhere on a flat stretch);
@@ -57,10 +88,16 @@ struct PlanSettings {
   double propagation_limit{1e-3};    // allowed open-loop error, relative to |omega_init|
 };
 
+struct PlanSample;
+
 struct PlanProblem {
   std::string case_name{"custom"};
   PlanModel model;
   PlanSettings settings;
+  // Optional warm start (not part of the problem's hash): a plan of a nearby problem, e.g. the
+  // remaining part of the plan being flown (remaining_plan). Its final time is used when it lies in
+  // the final-time range; a shorter plan is extended by rest.
+  const std::vector<PlanSample>* warm_start{nullptr};
 };
 
 struct PlanSample {
@@ -126,6 +163,16 @@ gnc::TrajectoryTable to_table(const std::vector<PlanSample>& samples);
 // The estimated model of a study case (SPEC §5, Table 3): J_ast_hat = J_ast - dJ diag(-1, 1, 0.5),
 // r_hat = r - dr [1 1 1]/sqrt(3); study RCS layout; omega_init of Table 2.
 PlanModel study_case_model(double u_max, double delta_j_norm, double delta_r_norm);
+
+// The part of a plan after `t_now`, time-shifted to start at 0 (interpolated first sample; the
+// sample count kept odd, node-midpoint structure kept): the warm start of a re-plan from the state
+// reached at t_now.
+std::vector<PlanSample> remaining_plan(const std::vector<PlanSample>& samples, double t_now);
+
+// The model a re-plan from the flight's current state is for. Today: the flight's active parameter
+// table (J_hat from mass_hat, B_hat from the RCS layout and r_hat). The identified model (J, r,
+// thruster strengths k) replaces the table here, and only here, once the flight reports it.
+PlanModel replan_model(const gnc::GncParams& active, const Vec3& omega_hat);
 
 // 64-bit FNV-1a hash of the model and the settings (the cache key; also stored in the file).
 std::uint64_t problem_hash(const PlanProblem& problem);

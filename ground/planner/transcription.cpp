@@ -25,7 +25,31 @@ HermiteSimpsonNlp::HermiteSimpsonNlp(const TranscriptionModel& model)
   // middle of the final-time range, controls in units of u_max (p, n in [0, 1]).
   omega_scale_ = model.eps_trans;
   t_scale_ = 0.5 * (model.t_final_min + model.t_final_max);
-  c_ = t_scale_ / (nodes_ - 1);
+  if (model.grid.empty()) {
+    s_.resize(nodes_);
+    for (int k = 0; k < nodes_; ++k) s_[k] = static_cast<double>(k) / (nodes_ - 1);
+    s_.back() = 1.0;
+  } else {
+    if (static_cast<int>(model.grid.size()) != nodes_ || model.grid.front() != 0.0 ||
+        model.grid.back() != 1.0) {
+      throw std::invalid_argument("grid must hold N positions from 0 to 1");
+    }
+    for (int k = 0; k + 1 < nodes_; ++k) {
+      if (!(model.grid[k + 1] > model.grid[k])) {
+        throw std::invalid_argument("grid positions must increase strictly");
+      }
+    }
+    s_ = model.grid;
+  }
+  c_.resize(nodes_ - 1);
+  weights_.assign(points_, 0.0);
+  for (int k = 0; k + 1 < nodes_; ++k) {
+    const double ds = s_[k + 1] - s_[k];
+    c_[k] = t_scale_ * ds;
+    weights_[2 * k] += ds / 6.0;  // Simpson on interval k
+    weights_[2 * k + 1] += 4.0 * ds / 6.0;
+    weights_[2 * k + 2] += ds / 6.0;
+  }
   j_inv_ = model.j_hat.inverse();
   a_ = model.u_max * j_inv_ * model.b_hat / omega_scale_;
 
@@ -116,10 +140,9 @@ Vec3 HermiteSimpsonNlp::rhs(const double* x, int j) const {
   return g_scaled(w) + a_ * (p - n);
 }
 
-double HermiteSimpsonNlp::weight(int j) const {
-  if (j % 2 == 1) return 4.0 / 6.0;
-  if (j == 0 || j == points_ - 1) return 1.0 / 6.0;
-  return 2.0 / 6.0;
+double HermiteSimpsonNlp::point_fraction(int j) const {
+  if (j % 2 == 0) return s_[j / 2];
+  return 0.5 * (s_[j / 2] + s_[j / 2 + 1]);
 }
 
 void HermiteSimpsonNlp::bounds(std::vector<double>& x_lo, std::vector<double>& x_hi,
@@ -161,7 +184,7 @@ double HermiteSimpsonNlp::objective(const double* x) const {
     for (int c = 0; c < 16; ++c) l1 += x[p_index(j) + c];
     sum += weight(j) * l1;
   }
-  return x[tau_index()] * sum / (nodes_ - 1);
+  return x[tau_index()] * sum;
 }
 
 void HermiteSimpsonNlp::objective_gradient(const double* x, double* grad) const {
@@ -172,18 +195,18 @@ void HermiteSimpsonNlp::objective_gradient(const double* x, double* grad) const 
     double l1 = 0.0;
     for (int c = 0; c < 16; ++c) {
       l1 += x[p_index(j) + c];
-      grad[p_index(j) + c] = tau * weight(j) / (nodes_ - 1);
+      grad[p_index(j) + c] = tau * weight(j);
     }
     sum += weight(j) * l1;
   }
-  grad[tau_index()] = sum / (nodes_ - 1);
+  grad[tau_index()] = sum;
 }
 
 void HermiteSimpsonNlp::constraints(const double* x, double* g) const {
-  const double h = c_ * x[tau_index()];
   std::vector<Vec3> f(points_);
   for (int j = 0; j < points_; ++j) f[j] = rhs(x, j);
   for (std::size_t d = 0; d < defects_.size(); ++d) {
+    const double h = c_[d / 2] * x[tau_index()];  // defects 2k, 2k+1 belong to interval k
     Vec3 v = Vec3::Zero();
     for (const DefectTerm& term : defects_[d]) {
       v += term.alpha * Eigen::Map<const Vec3>(x + w_index(term.point)) + h * term.beta * f[term.point];
@@ -198,11 +221,13 @@ void HermiteSimpsonNlp::constraints(const double* x, double* g) const {
 
 void HermiteSimpsonNlp::jacobian_values(const double* x, double* values) const {
   const double tau = x[tau_index()];
-  const double h = c_ * tau;
   std::vector<Vec3> f(points_);
   for (int j = 0; j < points_; ++j) f[j] = rhs(x, j);
   std::size_t k = 0;
-  for (const auto& defect : defects_) {
+  for (std::size_t d = 0; d < defects_.size(); ++d) {
+    const auto& defect = defects_[d];
+    const double ck = c_[d / 2];
+    const double h = ck * tau;
     Vec3 dtau = Vec3::Zero();
     for (const DefectTerm& term : defect) {
       const Eigen::Map<const Vec3> w(x + w_index(term.point));
@@ -210,7 +235,7 @@ void HermiteSimpsonNlp::jacobian_values(const double* x, double* values) const {
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) values[k++] = dw(r, c);
       }
-      dtau += c_ * term.beta * f[term.point];
+      dtau += ck * term.beta * f[term.point];
       if (term.beta == 0.0) continue;
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 8; ++c) values[k++] = h * term.beta * a_(r, c);
@@ -227,7 +252,6 @@ void HermiteSimpsonNlp::jacobian_values(const double* x, double* values) const {
 void HermiteSimpsonNlp::hessian_values(const double* x, double sigma, const double* lambda,
                                        double* values) const {
   const double tau = x[tau_index()];
-  const double h = c_ * tau;
   std::vector<Mat3> hw(points_, Mat3::Zero());
   std::vector<Vec3> tw(points_, Vec3::Zero());
   std::vector<Vec8> tp(points_, Vec8::Zero());
@@ -235,13 +259,15 @@ void HermiteSimpsonNlp::hessian_values(const double* x, double sigma, const doub
     const Vec3 lam(lambda[3 * d], lambda[3 * d + 1], lambda[3 * d + 2]);
     const Mat3 hg = g_scaled_hessian(lam);
     const Vec8 at_lam = a_.transpose() * lam;
+    const double ck = c_[d / 2];
+    const double h = ck * tau;
     for (const DefectTerm& term : defects_[d]) {
       if (term.beta == 0.0) continue;
       const int j = term.point;
       const Eigen::Map<const Vec3> w(x + w_index(j));
       hw[j] += h * term.beta * hg;
-      tw[j] += c_ * term.beta * g_scaled_jacobian(w).transpose() * lam;
-      tp[j] += c_ * term.beta * at_lam;
+      tw[j] += ck * term.beta * g_scaled_jacobian(w).transpose() * lam;
+      tp[j] += ck * term.beta * at_lam;
     }
   }
   const int path0 = 3 * static_cast<int>(defects_.size());
@@ -253,7 +279,7 @@ void HermiteSimpsonNlp::hessian_values(const double* x, double sigma, const doub
       for (int c = 0; c <= r; ++c) values[k++] = hw[j](r, c);
     }
     for (int c = 0; c < 3; ++c) values[k++] = tw[j][c];
-    const double obj = sigma * weight(j) / (nodes_ - 1);
+    const double obj = sigma * weight(j);
     for (int c = 0; c < 8; ++c) values[k++] = tp[j][c] + obj;   // (tau, p_j)
     for (int c = 0; c < 8; ++c) values[k++] = -tp[j][c] + obj;  // (tau, n_j)
   }

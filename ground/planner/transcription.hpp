@@ -3,7 +3,8 @@
 // The NLP is written here without any reference to the solver, so its derivatives can be checked
 // against finite differences (tests/planner) and the IPOPT adapter (planner.cpp) stays a thin shell.
 //
-// Grid: N nodes, uniform in time over [0, t_f], t_f = t_scale * tau free in [tau_min, tau_max].
+// Grid: N nodes over [0, t_f] at normalised positions s_0 = 0 < s_1 < ... < s_{N-1} = 1 (node k at
+// t = s_k t_f; uniform unless given), t_f = t_scale * tau free in [tau_min, tau_max].
 // Collocation points j = 0..P-1, P = 2N-1: even j are nodes, odd j the interval midpoints.
 // At every point: scaled rate w_j = omega_j / omega_scale, and the split control
 // u_j = u_max (p_j - n_j), p_j, n_j in [0, 1]^8 (the L1 cost becomes linear: |u| = u_max (p + n)
@@ -12,13 +13,13 @@
 // Scaled dynamics, Eq. (41):  dw/dt = F(w, p, n) = g(w) + A (p - n),
 //   g(w) = omega_scale J^-1 ((J w) x w),   A = u_max J^-1 B / omega_scale.
 // Separated Hermite-Simpson defects on interval k (points a = 2k, m = 2k+1, b = 2k+2, h = c tau,
-// c = t_scale / (N-1)):
+// c_k = t_scale (s_{k+1} - s_k)):
 //   D1_k = w_m - (w_a + w_b)/2 - h/8 (F_a - F_b)           = 0
 //   D2_k = w_b - w_a - h/6 (F_a + 4 F_m + F_b)             = 0
 // Path constraint, Eq. (43): |w_j|^2 <= (eps_trans / omega_scale)^2 at the interior points.
 // Boundary conditions, Eq. (43): w_0 = omega_init / omega_scale and w_{P-1} = 0 as fixed bounds.
-// Cost (Simpson): J = tau/(N-1) sum_j q_j sum_i (p_ji + n_ji), q = 1/6, 4/6, 1/6 per interval;
-// the physical cost int |u|_1 dt = u_max t_scale J.
+// Cost (Simpson): J = tau sum_k (s_{k+1} - s_k) (L_a + 4 L_m + L_b)/6, L_j = sum_i (p_ji + n_ji),
+// i.e. J = tau sum_j W_j L_j; the physical cost int |u|_1 dt = u_max t_scale J.
 #pragma once
 
 #include <vector>
@@ -39,6 +40,9 @@ struct TranscriptionModel {
   double eps_trans{0.05236};
   Vec3 omega_init{Vec3::Zero()};
   int nodes{101};            // N >= 2
+  // Normalised node positions s_k (size N, s_0 = 0, s_{N-1} = 1, strictly increasing); empty means
+  // uniform. A non-uniform grid lets the intervals follow the tumble (ground/planner/README.md).
+  std::vector<double> grid;
   double t_final_min{1.0};   // s
   double t_final_max{2.0};   // s (equal to t_final_min: fixed final time)
 };
@@ -66,6 +70,8 @@ class HermiteSimpsonNlp {
 
   double omega_scale() const { return omega_scale_; }
   double t_scale() const { return t_scale_; }
+  // Normalised time of collocation point j (nodes at s_k, midpoints halfway).
+  double point_fraction(int j) const;
   double cost_scale() const { return model_.u_max * t_scale_; }  // N s per unit of objective
   const TranscriptionModel& model() const { return model_; }
 
@@ -102,14 +108,16 @@ class HermiteSimpsonNlp {
   };
   int interior_points() const { return points_ - 2; }
   Vec3 rhs(const double* x, int j) const;  // F at point j (scaled)
-  double weight(int j) const;              // Simpson weight q_j
+  double weight(int j) const { return weights_[j]; }  // Simpson weight W_j (see header)
 
   TranscriptionModel model_;
   int nodes_;
   int points_;
   double omega_scale_;
   double t_scale_;
-  double c_;  // t_scale / (N-1)
+  std::vector<double> s_;        // node positions s_k
+  std::vector<double> c_;        // per interval: t_scale (s_{k+1} - s_k)
+  std::vector<double> weights_;  // per point: W_j
   Mat3 j_inv_;
   Eigen::Matrix<double, 3, 8> a_;  // u_max J^-1 B / omega_scale
   // Defect d (rows 3d..3d+2) is sum_terms alpha w + c tau beta F.

@@ -132,5 +132,49 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
   delete loop;
 }
 
+TEST(ZeroAllocation, NoHeapWhenATrajectoryIsStagedAndSwitchedAtATickBoundary) {
+  const GncParams p = test::small_vehicle_params();
+  auto* loop = new test::SmallLoop(p);
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  auto* first = new TrajectoryTable();
+  auto* replan = new TrajectoryTable();
+  auto* stale = new TrajectoryTable();
+  test::linear_despin_table(loop->body.omega, 30.0, *first);
+  test::linear_despin_table(Vec3(-0.3, 0.2, -0.25), 30.0, *stale);
+  ASSERT_EQ(loop->gnc.load_trajectory(*first), TrajectoryError::kOk);
+  int switched = 0;
+  int refused = 0;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kTrack;
+    loop->tick(c);
+    for (int i = 0; i < 50; ++i) loop->tick();
+    test::linear_despin_table(loop->body.omega, 20.0, *replan);  // fills caller-owned memory
+    // The hand-over (a copy into the standby table) and the switch inside the next tick.
+    EXPECT_EQ(loop->gnc.load_trajectory(*replan), TrajectoryError::kOk);
+    for (int i = 0; i < 50; ++i) {
+      loop->tick();
+      for (int k = 0; k < loop->out.events.count; ++k) {
+        switched += loop->out.events.items[k].id == EventId::kTrajectorySwitched ? 1 : 0;
+      }
+    }
+    EXPECT_EQ(loop->gnc.load_trajectory(*stale), TrajectoryError::kOk);
+    loop->tick();
+    for (int k = 0; k < loop->out.events.count; ++k) {
+      refused += loop->out.events.items[k].id == EventId::kTrajectoryStale ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(rocksteady::test::heap_allocations(), 0);
+  EXPECT_EQ(switched, 1);
+  EXPECT_EQ(refused, 1);
+  EXPECT_EQ(loop->gnc.mode(), Mode::kTrack);
+  delete stale;
+  delete replan;
+  delete first;
+  delete loop;
+}
+
 }  // namespace
 }  // namespace rocksteady::gnc

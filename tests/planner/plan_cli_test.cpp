@@ -91,3 +91,14 @@ TEST_F(PlanCli, UsageErrorsExitTwoAndHelpStatesTheConvention) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(PlanCli, StudyHorizonAndAnExplicitFinalTimeTogetherAreAUsageError) {
+  const Outcome r = plan("--study-horizon --t-final-max 2000 -o x.yaml");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--study-horizon and --t-final-max"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
+}
+
+}  // namespace
