@@ -59,16 +59,16 @@ BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
 // priors, 20 s windows, automatic adoption), fault detection, L1 allocation under limits, NTCL in DETUMBLE. The rate
 // changes every tick so the identifier cycles through its windows. Reports the mean per tick and,
 // as counters, the median, 99.9th percentile and maximum single tick over the run.
-void BM_GncTickAllModules(benchmark::State& state) {
+void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc) {
   GncParams p = study_gnc_params(200.0);
   p.law = LawId::kNtcl;
-  p.allocator = AllocatorKind::kL1;
+  p.allocator = alloc;
   p.estimator.kind = EstimatorKind::kMekf;
   p.mekf.gyro_arw = 1e-6;
   p.mekf.star_sigma = 4e-4;
   p.identification.enabled = true;
   p.identification.adopt = ModelAdoption::kAuto;
-  p.fdi.enabled = true;
+  p.fdi.enabled = fdi;
   p.mode.auto_hold = false;
   Gnc gnc;
   if (!gnc.init(p).ok) {
@@ -108,7 +108,10 @@ void BM_GncTickAllModules(benchmark::State& state) {
   state.counters["id_windows"] = gnc.identifier().counters().windows;
   state.SetLabel(to_string(gnc.mode()));
 }
-BENCHMARK(BM_GncTickAllModules)->Iterations(200000);
+BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_fdi_l1, true, AllocatorKind::kL1)->Iterations(200000);
+BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_fdi_pinv, true, AllocatorKind::kPseudoInverse)
+    ->Iterations(200000);
+BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_l1, false, AllocatorKind::kL1)->Iterations(200000);
 
 void BM_LawAlone(benchmark::State& state, LawId law) {
   const GncParams p = study_gnc_params(200.0);

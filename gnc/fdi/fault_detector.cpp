@@ -129,17 +129,18 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   // while the pod's valve is open (a closed pod produces nothing under any hypothesis).
   for (int i = 0; i < kThrusters; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const bool open = in.valve_open[static_cast<std::size_t>(pod_[k])];
-    if (open) {
+    const auto h = k + static_cast<std::size_t>(kThrusters);
+    if (in.valve_open[static_cast<std::size_t>(pod_[k])]) {
       const double f = in.thrust(i);
-      sig_[k] += b_[k] * ((u_max_ - f) * dt_);
-      sig_[k + kThrusters] -= b_[k] * (f * dt_);
+      c_[k] += (u_max_ - f) * dt_;
+      c_[h] -= f * dt_;
     }
-    for (std::size_t h : {k, k + static_cast<std::size_t>(kThrusters)}) {
-      sum_s_[h] += sig_[h];
-      sum_sr_[h] += sig_[h].dot(r);
-      sum_ss_[h] += sig_[h].squaredNorm();
-    }
+    sum_c_[k] += c_[k];
+    sum_c_[h] += c_[h];
+    sum_cc_[k] += c_[k] * c_[k];
+    sum_cc_[h] += c_[h] * c_[h];
+    sum_cr_[k] += c_[k] * r;
+    sum_cr_[h] += c_[h] * r;
   }
   omega_prev_ = in.omega;
   if (n_ >= p_.window_ticks) {
@@ -162,12 +163,10 @@ void FaultDetector::start_window(const Vec3& omega) {
   sum_rr_ = 0.0;
   sum_t_ = sum_tt_ = 0.0;
   sum_tr_.setZero();
-  for (std::size_t h = 0; h < static_cast<std::size_t>(kHypotheses); ++h) {
-    sig_[h].setZero();
-    sum_s_[h].setZero();
-    sum_sr_[h] = 0.0;
-    sum_ss_[h] = 0.0;
-  }
+  c_.fill(0.0);
+  sum_c_.fill(0.0);
+  sum_cc_.fill(0.0);
+  for (Vec3& v : sum_cr_) v.setZero();
 }
 
 void FaultDetector::close_window() {
@@ -205,8 +204,12 @@ void FaultDetector::close_window() {
       score_[k] = 0.0;
       continue;
     }
-    const double sr = sum_sr_[k] - sum_s_[k].dot(r_mean);
-    const double ss = sum_ss_[k] - sum_s_[k].squaredNorm() / n;
+    const Vec3& b = b_[k % static_cast<std::size_t>(kThrusters)];
+    sig_[k] = b * c_[k];
+    // Mean-centred sums: sum S~ r~ = b.(sum c r) - (b.r_mean) sum c; sum |S~|^2 = |b|^2 (sum c^2 -
+    // (sum c)^2 / n).
+    const double sr = b.dot(sum_cr_[k]) - b.dot(r_mean) * sum_c_[k];
+    const double ss = b.squaredNorm() * (sum_cc_[k] - sum_c_[k] * sum_c_[k] / n);
     const double llr = (sr - 0.5 * ss) / var;
     score_[k] = std::fmax(0.0, score_[k] + llr);
     if (score_[k] > best_s) {

@@ -140,10 +140,14 @@ class FaultDetector {
   double sum_t_{0.0};               // sum of j (sample index), for the slope test
   double sum_tt_{0.0};
   Vec3 sum_tr_{Vec3::Zero()};
-  std::array<Vec3, kHypotheses> sig_{};     // cumulative signature S_h(j)
-  std::array<Vec3, kHypotheses> sum_s_{};   // sum over j of S_h(j)
-  std::array<double, kHypotheses> sum_sr_{};
-  std::array<double, kHypotheses> sum_ss_{};
+  // The signature of hypothesis h is S_h(j) = b_i c_h(j) with the scalar c_h(j) = sum of the
+  // extra (stuck-on: u_max - f) or missing (stuck-off: -f) thrust times dt up to sample j, so
+  // the window's sums need only scalars and one vector per hypothesis (F5).
+  std::array<double, kHypotheses> c_{};
+  std::array<double, kHypotheses> sum_c_{};
+  std::array<double, kHypotheses> sum_cc_{};
+  std::array<Vec3, kHypotheses> sum_cr_{};
+  std::array<Vec3, kHypotheses> sig_{};  // b c of the last window, for signature()
   std::array<Vec3, kThrusters> b_{};  // J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i
 
   std::array<double, kHypotheses> score_{};
