@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 namespace rocksteady::gnc {
@@ -58,6 +59,12 @@ void FaultDetector::reset() {
 void FaultDetector::set_model(const FaultModel& m) {
   m_ = m;
   j_inv_ = m.j.inverse();
+  // Spectral norms of J and J^-1 from J's eigenvalues (symmetric 3x3, fixed size: no heap).
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (m.j + m.j.transpose()), Eigen::EigenvaluesOnly);
+  const double lo = eig.eigenvalues().minCoeff();
+  const double hi = eig.eigenvalues().maxCoeff();
+  j_norm_ = hi;
+  j_inv_norm_ = lo > 0.0 ? 1.0 / lo : j_inv_.norm();
   for (int i = 0; i < kThrusters; ++i) {
     const auto k = static_cast<std::size_t>(i);
     // (F1): the rate change per newton-second of thruster i.
@@ -114,7 +121,11 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
     thrust_rate += b_[k] * f;
   }
   predicted_ += (thrust_rate - gyro) * dt_;
-  motion_ += (thrust_rate.norm() + gyro.norm()) * dt_;
+  // Model-uncertainty scale (F5): the thrust term, and the gyroscopic term's sensitivity to J,
+  // |J^-1 (w x dJ w)| + |dJ^-1 (w x J w)| <= 2 ||J^-1|| ||dJ|| |w|^2 (not |J^-1 (w x J w)|, which
+  // vanishes near a principal axis while its error does not).
+  motion_ += (thrust_rate.norm() + 2.0 * j_inv_norm_ * j_norm_ * w.squaredNorm()) * dt_;
+  // (the relative 1 sigma multiplies this: ||dJ||_2 = rel ||J||_2)
   thrust_motion_ += thrust_rate.norm() * dt_;
   force_impulse_ += in.thrust.sum() * dt_;
   ++n_;

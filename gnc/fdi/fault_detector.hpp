@@ -33,7 +33,7 @@ struct FaultDetectorParams {
   // sigma relative to ||J_hat|| is used when larger).
   double gyro_sigma{1e-6};
   double disturbance_sigma{0.57735026918962576};
-  double model_rel_floor{0.002};
+  double model_rel_floor{0.0};
   // Sequential test (F6): a hypothesis is confirmed when its cumulative log-likelihood ratio
   // exceeds confirm_llr and leads the runner-up by margin_llr; a window whose no-fault chi-square
   // (3 dof) exceeds suspect_chi2 raises a suspicion. Calibrated on healthy runs (README §F.4).
@@ -125,6 +125,8 @@ class FaultDetector {
   std::array<int, kThrusters> pod_{};
   FaultModel m_{};
   Mat3 j_inv_{Mat3::Identity()};
+  double j_inv_norm_{1.0};
+  double j_norm_{1.0};
 
   // Window accumulation (F2)-(F5): samples j = 1..n after the window's first sample.
   int n_{0};

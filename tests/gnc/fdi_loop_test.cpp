@@ -70,7 +70,7 @@ GncParams fdi_params() {
   p.law = LawId::kNtcl;
   p.fdi.enabled = true;
   p.fdi.gyro_sigma = 1e-7;
-  p.fdi_table_rel_sigma = 1e-3;  // the table is the truth here (no identification)
+  p.fdi_table_rel_sigma = 1e-4;  // the table is the truth here (no identification)
   p.identification.config.r_prior_sigma = 1e-3;
   p.identification.config.k_prior_sigma = 1e-3;
   return p;
