@@ -341,7 +341,9 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   p.mekf.star_sigma = std::fmax(4.0 * std::sqrt(c.star_psd / m.sensor_period_s), 1e-7);
   p.identification.config.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
   if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
-  p.fdi.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
+  // A gyro is never noise-free: the detector assumes at least 1e-7 rad/s per sample (a
+  // navigation-grade gyro's resolution), so the noise-free cases do not trust rates to the bit.
+  p.fdi.gyro_sigma = std::fmax(std::sqrt(c.gyro_psd / m.sensor_period_s), 1e-7);
   if (noisy) p.fdi.window_ticks = g.fdi_window_noisy_ticks;
   const gnc::ParamCheck check = gnc::validate(p);
   if (!check.ok) {

@@ -22,6 +22,7 @@ Check validate(const FaultDetectorParams& p) {
   if (!finite_positive(p.confirm_llr)) return bad("fdi.confirm_llr", "must be positive");
   if (!finite_non_negative(p.margin_llr)) return bad("fdi.margin_llr", "must be >= 0");
   if (!finite_positive(p.suspect_chi2)) return bad("fdi.suspect_chi2", "must be positive");
+  if (!finite_non_negative(p.min_signature)) return bad("fdi.min_signature", "must be >= 0");
   return Check{};
 }
 
@@ -221,8 +222,10 @@ void FaultDetector::close_window() {
     // (sum c)^2 / n).
     const double sr = b.dot(sum_cr_[k]) - b.dot(r_mean) * sum_c_[k];
     const double ss = b.squaredNorm() * (sum_cc_[k] - sum_c_[k] * sum_c_[k] / n);
-    const double llr = (sr - 0.5 * ss) / var;
-    score_[k] = std::fmax(0.0, score_[k] + llr);
+    if (ss / var >= p_.min_signature) {  // else not observable in this window: no evidence
+      const double llr = (sr - 0.5 * ss) / var;
+      score_[k] = std::fmax(0.0, score_[k] + llr);
+    }
     if (score_[k] > best_s) {
       second = best_s;
       best_s = score_[k];

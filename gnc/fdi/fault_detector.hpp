@@ -40,8 +40,9 @@ struct FaultDetectorParams {
   double confirm_llr{25.0};
   double margin_llr{10.0};
   double suspect_chi2{16.27};  // chi-square(3) at 0.999
-  // A hypothesis whose LLR falls this far below zero is exonerated (its score resets).
-  double forget_llr{-5.0};
+  // A hypothesis is scored in a window only when its signature is observable there: its energy
+  // |S~|^2 / var at least this (a jet that barely fired, or not at all, tells nothing).
+  double min_signature{4.0};
   // true: a confirmed stuck-on closes its pod's latch valve (automatic isolation).
   bool auto_isolate{true};
 };

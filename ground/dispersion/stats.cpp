@@ -533,6 +533,29 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
       }
     }
   }
+  bool any_fdi = false;
+  for (const DrawResult& dr : draws) {
+    for (const StrategyOutcome& o : dr.runs) any_fdi = any_fdi || o.fdi.enabled;
+  }
+  if (any_fdi) {
+    md << "\n## Fault detection\n\nPer strategy: runs flown with the detector, runs with at least "
+          "one confirmed fault, with a window above the no-fault bound, and with a latch valve "
+          "closed.\n\n| strategy | runs | confirmed | suspected | valve closed |\n"
+          "|---|---:|---:|---:|---:|\n";
+    for (std::size_t k = 0; k < spec.strategies.size(); ++k) {
+      int n = 0, conf = 0, susp = 0, valve = 0;
+      for (const DrawResult& dr : draws) {
+        if (k >= dr.runs.size() || !dr.runs[k].fdi.enabled) continue;
+        const campaign::FdiReport& f = dr.runs[k].fdi;
+        ++n;
+        conf += f.confirmations > 0 ? 1 : 0;
+        susp += f.suspicions > 0 ? 1 : 0;
+        valve += f.valve_closed_s ? 1 : 0;
+      }
+      md << "| `" << spec.strategies[k].name << "` | " << n << " | " << conf << " | " << susp
+         << " | " << valve << " |\n";
+    }
+  }
   md << "\n## Worst draws\n\n";
   for (const StrategyStats& st : s.strategies) {
     md << "**`" << st.strategy << "`**\n\n";
