@@ -83,7 +83,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   params_ = params;
   configure_components();
   {
-    // The detector takes the new table; what it has confirmed stays latched.
+    // The detector takes the table now active; what it has confirmed stays latched.
     const std::uint16_t on = fdi_.confirmed_on();
     const std::uint16_t off = fdi_.confirmed_off();
     fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);

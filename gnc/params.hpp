@@ -63,7 +63,7 @@ MekfConfig build_mekf_config(const GncParams& p);
 IdentifierConfig build_identifier_config(const GncParams& p);
 
 // The model the table flies with a different J_tot, r_SO/BCM and thruster strengths: r_SO/BCM := r,
-// J_ast := J_tot - (the spacecraft's part of Eq. (1) at the new r), strength := k. The result is
+// J_ast := J_tot - (the spacecraft's part of Eq. (1) at the given r), strength := k. The result is
 // validated by the caller (validate() refuses a J_ast that is not positive definite).
 GncParams with_model(const GncParams& p, const Mat3& j_tot, const Vec3& r, const Vec16& k);
 

@@ -99,7 +99,7 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   pending_ = FaultEvents{};
   if (!p_.enabled) return pending_;
   if (!in.omega_valid || !in.thrust_valid || !in.omega.allFinite() || !in.thrust.allFinite()) {
-    have_start_ = false;  // a gap breaks the window; the next valid sample starts a new one
+    have_start_ = false;  // a gap breaks the window; the next valid sample starts another
     return pending_;
   }
   if (!have_start_) {

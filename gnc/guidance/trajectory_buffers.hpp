@@ -1,4 +1,4 @@
-// Two statically allocated trajectory tables (double buffer). TRACK follows the active one; a new
+// Two statically allocated trajectory tables (double buffer). TRACK follows the active one; a
 // plan (a re-plan, or the next one) is validated and copied into the standby one while TRACK runs,
 // and the two swap at a tick boundary (Gnc::step), never inside a tick: no copy, no heap.
 //
