@@ -268,3 +268,44 @@ TEST(CommandContract, UninitialisedApplicationRejectsAndCommandsNothing) {
 
 }  // namespace
 }  // namespace rocksteady::fsw
+
+namespace rocksteady::fsw {
+namespace {
+
+// Fault management from the ground: accepted, queued, and applied by the core at the next tick
+// boundary (the telemetry of that tick shows it); out-of-range arguments are refused.
+TEST(FaultCommands, DeclareValveInhibitAndClearReachTheCoreAtTheBoundary) {
+  test::AppFixture f;
+  f.ticks(2);
+  EXPECT_TRUE(f.send(Opcode::kFaultDeclare, {5.0, 2.0}).accepted);  // thruster 5 stuck off
+  EXPECT_TRUE(f.send(Opcode::kValve, {3.0, 0.0}).accepted);         // close pod 3
+  EXPECT_TRUE(f.send(Opcode::kIsolationInhibit, {1.0}).accepted);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_off, 0u);  // nothing before the boundary
+  f.ticks(1);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_off, 1u << 5);
+  EXPECT_FALSE(f.out.telemetry.fdi.valve_open[3]);
+  EXPECT_FALSE(f.out.command.valve_open[3]);
+  EXPECT_TRUE(f.out.telemetry.fdi.isolation_inhibited);
+  EXPECT_TRUE(f.send(Opcode::kFaultClear, {-1.0}).accepted);
+  EXPECT_TRUE(f.send(Opcode::kValve, {3.0, 1.0}).accepted);
+  f.ticks(2);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_off, 0u);
+  EXPECT_TRUE(f.out.command.valve_open[3]);
+  EXPECT_EQ(f.send(Opcode::kFaultDeclare, {16.0, 1.0}).reason, RejectReason::kOutOfRange);
+  EXPECT_EQ(f.send(Opcode::kFaultDeclare, {3.0, 0.0}).reason, RejectReason::kOutOfRange);
+  EXPECT_EQ(f.send(Opcode::kValve, {4.0, 1.0}).reason, RejectReason::kOutOfRange);
+  EXPECT_EQ(f.send(Opcode::kFaultClear, {-2.0}).reason, RejectReason::kOutOfRange);
+}
+
+TEST(FaultCommands, LoadIdentifiedIsRefusedWithTheReasonWhileIdentificationIsOff) {
+  test::AppFixture f;
+  f.ticks(1);
+  const CommandAck a = f.send(Opcode::kParamLoadIdentified);
+  EXPECT_FALSE(a.accepted);
+  EXPECT_EQ(a.reason, RejectReason::kInvalidTable);
+  // Nothing was loaded: an activation finds nothing to activate.
+  EXPECT_EQ(f.send(Opcode::kParamActivate).reason, RejectReason::kNothingToActivate);
+}
+
+}  // namespace
+}  // namespace rocksteady::fsw
