@@ -259,56 +259,45 @@ void CommandSecurity::refresh_state() {
   }
 }
 
-AuthResult CommandSecurity::verify(const GroundCommand& cmd) {
+// Key, MAC (constant time), then the replay window; only an authentic, fresh message consumes its
+// counter. `mac_of` computes the expected MAC of the message with the slot's key.
+template <class Msg, class MacFn>
+AuthResult CommandSecurity::verify_message(const Msg& m, MacFn mac_of) {
   if (lab_mode_) return AuthResult::kLabMode;
-  const int slot = cmd.key_id == active_ ? slot_of(cmd.key_id) : -1;
+  const int slot = m.key_id == active_ ? slot_of(m.key_id) : -1;
   if (slot < 0) {
     ++auth_rejected_;
     return AuthResult::kUnknownKey;
   }
   MacBytes expect;
-  mac_command(cmd, keys_.keys[static_cast<std::size_t>(slot)].key, expect);
+  mac_of(m, keys_.keys[static_cast<std::size_t>(slot)].key, expect);
   MacBytes got;
-  std::memcpy(got.data(), cmd.mac.data(), got.size());
+  std::memcpy(got.data(), m.mac.data(), got.size());
   const bool ok = mac_equal(expect, got);
   sodium_memzero(expect.data(), expect.size());
   if (!ok) {
     ++auth_rejected_;
     return AuthResult::kBadMac;
   }
-  const AuthResult c = check_counter(slot, cmd.seq);
+  const AuthResult c = check_counter(slot, m.seq);
   if (c != AuthResult::kOk) {
     ++replays_rejected_;
     return c;
   }
-  consume(slot, cmd.seq);
+  consume(slot, m.seq);
   return AuthResult::kOk;
 }
 
+AuthResult CommandSecurity::verify(const GroundCommand& cmd) {
+  return verify_message(cmd, [](const GroundCommand& c, const auto& key, MacBytes& out) {
+    mac_command(c, key, out);
+  });
+}
+
 AuthResult CommandSecurity::verify(const TrajectoryChunk& chunk) {
-  if (lab_mode_) return AuthResult::kLabMode;
-  const int slot = chunk.key_id == active_ ? slot_of(chunk.key_id) : -1;
-  if (slot < 0) {
-    ++auth_rejected_;
-    return AuthResult::kUnknownKey;
-  }
-  MacBytes expect;
-  mac_chunk(chunk, keys_.keys[static_cast<std::size_t>(slot)].key, expect);
-  MacBytes got;
-  std::memcpy(got.data(), chunk.mac.data(), got.size());
-  const bool ok = mac_equal(expect, got);
-  sodium_memzero(expect.data(), expect.size());
-  if (!ok) {
-    ++auth_rejected_;
-    return AuthResult::kBadMac;
-  }
-  const AuthResult c = check_counter(slot, chunk.seq);
-  if (c != AuthResult::kOk) {
-    ++replays_rejected_;
-    return c;
-  }
-  consume(slot, chunk.seq);
-  return AuthResult::kOk;
+  return verify_message(chunk, [](const TrajectoryChunk& c, const auto& key, MacBytes& out) {
+    mac_chunk(c, key, out);
+  });
 }
 
 bool CommandSecurity::can_rotate_to(std::int32_t key_id) const {

@@ -188,6 +188,8 @@ class CommandSecurity {
 
  private:
   int slot_of(std::int32_t key_id) const;
+  template <class Msg, class MacFn>
+  AuthResult verify_message(const Msg& m, MacFn mac_of);
   AuthResult check_counter(int slot, std::int64_t counter);
   void consume(int slot, std::int64_t counter);
   void refresh_state();
