@@ -92,6 +92,8 @@ const char* to_string(ChunkStatus s) {
       return "a completed table awaits the tick boundary";
     case ChunkStatus::kNotAuthenticated:
       return "not authenticated (bad authenticator, unknown key or replayed counter)";
+    case ChunkStatus::kOtherUplinkActive:
+      return "another uplink is in progress: abort it first";
   }
   return "?";
 }

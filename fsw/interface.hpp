@@ -116,6 +116,8 @@ enum class ChunkStatus : std::uint8_t {
   kHeaderMismatch,  // same upload id, different total / chunk count / CRC
   kBusy,            // a completed table is waiting for the tick boundary
   kNotAuthenticated,  // bad authenticator, unknown key or replayed counter (fsw/auth)
+  kOtherUplinkActive,  // another upload id is in progress: only an authenticated ABORT_UPLINK
+                       // (or its load) ends it
 };
 const char* to_string(ChunkStatus s);
 

@@ -14,6 +14,8 @@ constexpr char kChannelCommand[] = "RS_GROUND_CMD";
 constexpr char kChannelChunk[] = "RS_TRAJ_UPLINK";
 constexpr char kChannelAck[] = "RS_CMD_ACK";
 constexpr char kChannelEvents[] = "RS_EVENTS";
+constexpr char kChannelParams[] = "RS_PARAMS";
+constexpr std::int16_t kParamsVersion = 2;  // param_table_t VERSION (with key_id and mac)
 constexpr std::int16_t kVersion = 1;  // the messages' VERSION
 
 // The canonical encoder: fields go straight into the HMAC state (nothing buffered, no heap).
@@ -123,6 +125,20 @@ void mac_event(const EventFields& e, const Key& key, MacBytes& out) {
   c.i32(e.arg1);
   c.u32(static_cast<std::uint32_t>(e.text_len));
   c.bytes(e.text, e.text_len);
+  c.finish(out);
+}
+
+void mac_params(const ParamDump& d, std::int32_t key_id, const Key& key, MacBytes& out) {
+  Canonical c(key, kChannelParams, MessageKind::kParams);
+  c.i16(kParamsVersion);
+  c.i32(key_id);
+  c.f64(d.t);
+  c.u32(d.seq);
+  c.i32(d.count);
+  for (const std::int32_t n : d.value_count) c.i32(n);
+  for (const auto& row : d.values) {
+    for (const double v : row) c.f64(v);
+  }
   c.finish(out);
 }
 
@@ -335,6 +351,31 @@ bool CommandSecurity::sign_event(EventFields& event, MacBytes& out) const {
   }
   event.key_id = active_;
   mac_event(event, keys_.keys[static_cast<std::size_t>(slot_of(active_))].key, out);
+  return true;
+}
+
+bool CommandSecurity::sign_event_with(std::int32_t key_id, EventFields& event,
+                                      MacBytes& out) const {
+  const int slot = lab_mode_ ? -1 : slot_of(key_id);
+  if (slot < 0) {
+    event.key_id = 0;
+    out.fill(0);
+    return false;
+  }
+  event.key_id = key_id;
+  mac_event(event, keys_.keys[static_cast<std::size_t>(slot)].key, out);
+  return true;
+}
+
+bool CommandSecurity::sign_params(const ParamDump& dump, std::int32_t& key_id,
+                                  MacBytes& out) const {
+  if (lab_mode_) {
+    key_id = 0;
+    out.fill(0);
+    return false;
+  }
+  key_id = active_;
+  mac_params(dump, key_id, keys_.keys[static_cast<std::size_t>(slot_of(active_))].key, out);
   return true;
 }
 

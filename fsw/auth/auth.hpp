@@ -54,7 +54,7 @@ using Key = std::array<std::uint8_t, kKeyBytes>;
 using MacBytes = std::array<std::uint8_t, kMacBytes>;
 
 // What a MAC covers (domain separation; the numbers are the lcmtypes KIND of each message).
-enum class MessageKind : std::int16_t { kEvent = 4, kCommand = 5, kAck = 6, kChunk = 8 };
+enum class MessageKind : std::int16_t { kEvent = 4, kCommand = 5, kAck = 6, kChunk = 8, kParams = 9 };
 
 struct KeyEntry {
   std::int32_t id{0};  // > 0
@@ -99,6 +99,8 @@ void mac_command(const GroundCommand& cmd, const Key& key, MacBytes& out);
 void mac_chunk(const TrajectoryChunk& chunk, const Key& key, MacBytes& out);
 void mac_ack(const AckFields& ack, const Key& key, MacBytes& out);
 void mac_event(const EventFields& event, const Key& key, MacBytes& out);
+// The parameter read-back (RS_PARAMS): every field of the dump, with the signing key's id.
+void mac_params(const ParamDump& dump, std::int32_t key_id, const Key& key, MacBytes& out);
 // Constant-time comparison of two MACs.
 bool mac_equal(const MacBytes& a, const MacBytes& b);
 
@@ -180,6 +182,12 @@ class CommandSecurity {
   bool sign_ack(AckFields& ack, MacBytes& out) const;
   // Downlink authenticator of an event, with the active key (sets event.key_id). False in lab mode.
   bool sign_event(EventFields& event, MacBytes& out) const;
+  // The same with a given key (the watchdog thread signs with the key id the tick thread last
+  // published; it reads only the key material, which is fixed after init). False in lab mode or
+  // for an unknown id.
+  bool sign_event_with(std::int32_t key_id, EventFields& event, MacBytes& out) const;
+  // Downlink authenticator of the parameter read-back, with the active key. False in lab mode.
+  bool sign_params(const ParamDump& dump, std::int32_t& key_id, MacBytes& out) const;
 
   const SecurityState& state() const { return state_; }
   std::uint64_t auth_rejected() const { return auth_rejected_; }

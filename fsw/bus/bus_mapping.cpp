@@ -198,7 +198,7 @@ void to_message(const Event& e, rocksteady::event_t& m) {
   std::memset(m.mac, 0, sizeof m.mac);
 }
 
-void to_message(const ParamDump& d, rocksteady::param_table_t& m) {
+void to_message(const ParamDump& d, const FlightApp& app, rocksteady::param_table_t& m) {
   m.kind = rocksteady::param_table_t::KIND;
   m.version = rocksteady::param_table_t::VERSION;
   m.t = d.t;
@@ -209,6 +209,11 @@ void to_message(const ParamDump& d, rocksteady::param_table_t& m) {
     m.value_count[i] = d.value_count[k];
     for (int v = 0; v < kMaxParamValues; ++v) m.values[i][v] = d.values[k][static_cast<std::size_t>(v)];
   }
+  auth::MacBytes mac{};
+  std::int32_t key_id = 0;
+  (void)app.security().sign_params(d, key_id, mac);
+  m.key_id = key_id;
+  for (int i = 0; i < kMacSize; ++i) m.mac[i] = static_cast<std::int8_t>(mac[static_cast<std::size_t>(i)]);
 }
 
 void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m) {

@@ -42,8 +42,8 @@ auth::EventFields event_fields(const rocksteady::event_t& m);
 bool sign(const FlightApp& app, rocksteady::event_t& m);
 // Event -> event_t.
 void to_message(const Event& e, rocksteady::event_t& m);
-// ParamDump -> param_table_t.
-void to_message(const ParamDump& d, rocksteady::param_table_t& m);
+// ParamDump -> param_table_t, with the flight's downlink authenticator (no MAC in lab mode).
+void to_message(const ParamDump& d, const FlightApp& app, rocksteady::param_table_t& m);
 
 // The fsw's part of gnc_telemetry_t: executive, commanding, health counters, tables, uplink.
 void fill_health(const HealthTelemetry& h, rocksteady::gnc_telemetry_t& m);

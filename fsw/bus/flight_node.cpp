@@ -164,7 +164,7 @@ void FlightNode::on_command(const lcm_recv_buf_t* rbuf, const char* /*channel*/,
   sign(n.computer_.app(), n.ack_msg_);
   n.publish(channels::kCmdAck, n.ack_msg_);
   if (n.computer_.take_param_dump(n.dump_)) {  // PARAM_DUMP: the table goes out with the ack
-    to_message(n.dump_, n.params_msg_);
+    to_message(n.dump_, n.computer_.app(), n.params_msg_);
     n.publish(channels::kParams, n.params_msg_);
   }
   n.drain_events();
@@ -274,6 +274,7 @@ void FlightNode::tick(const Tick& t, const NodeOptions& o) {
     wd_seq_.store(computer_.echo_seq(), std::memory_order_relaxed);
     wd_t_.store(computer_.onboard_time(), std::memory_order_relaxed);
     wd_tick_.store(t.index, std::memory_order_relaxed);
+    wd_key_id_.store(computer_.app().security().active_key_id(), std::memory_order_relaxed);
     watchdog_.feed();
   }
   if (r.gnc_ran) publish_telemetry(o);
@@ -321,7 +322,8 @@ void FlightNode::status_line(const char* prefix) const {
 }
 
 // Runs on the watchdog thread while the tick thread is stuck: only atomics, the thread-safe
-// thruster sink, and the watchdog's own message and buffer (LCM's publish is thread-safe).
+// thruster sink, the key material (read-only after init), and the watchdog's own message and
+// buffer (LCM's publish is thread-safe).
 void FlightNode::on_watchdog(void* self, std::int64_t since_feed_ns) {
   auto& n = *static_cast<FlightNode*>(self);
   const std::int64_t seq = n.wd_seq_.load();
@@ -339,6 +341,14 @@ void FlightNode::on_watchdog(void* self, std::int64_t since_feed_ns) {
   char text[96];
   std::snprintf(text, sizeof text, "watchdog: no GNC cycle for %d ms: thrusters off, exiting", ms);
   e.text = text;
+  // Signed with the key the tick thread last used (the key material is fixed after init), so the
+  // ground can tell the flight's watchdog from a forged one.
+  e.key_id = 0;
+  auth::EventFields f = event_fields(e);
+  auth::MacBytes mac{};
+  (void)n.computer_.app().security().sign_event_with(n.wd_key_id_.load(), f, mac);
+  e.key_id = f.key_id;
+  for (int i = 0; i < kMacSize; ++i) e.mac[i] = static_cast<std::int8_t>(mac[static_cast<std::size_t>(i)]);
   const int len = wire::encode(e, n.wd_buf_, static_cast<int>(sizeof n.wd_buf_));
   if (len > 0) lcm_publish(n.out_, channels::kEvents, n.wd_buf_, static_cast<unsigned int>(len));
   std::fprintf(stderr,

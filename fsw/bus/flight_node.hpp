@@ -217,6 +217,7 @@ class FlightNode {
   std::atomic<std::int64_t> wd_seq_{0};
   std::atomic<double> wd_t_{0.0};
   std::atomic<std::uint64_t> wd_tick_{0};
+  std::atomic<std::int32_t> wd_key_id_{0};  // the active command key, for the watchdog's event
   rocksteady::event_t wd_event_msg_{};
   unsigned char wd_buf_[1024]{};
 };

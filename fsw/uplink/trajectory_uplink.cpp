@@ -40,13 +40,14 @@ ChunkResult TrajectoryUplink::receive(const TrajectoryChunk& c) {
       r.status = ChunkStatus::kHeaderMismatch;
       return r;
     }
+  } else if (active()) {
+    // An uplink ends only by its load or an authenticated ABORT_UPLINK naming its id: a chunk of
+    // another upload (stray, or a new upload started before the ground aborted this one) is
+    // refused and leaves the uplink in progress untouched.
+    r.status = ChunkStatus::kOtherUplinkActive;
+    r.active_id = upload_id_;
+    return r;
   } else {
-    // A new uplink replaces an unfinished (or finished but never loaded) one.
-    if (active()) {
-      r.abandoned = true;
-      r.abandoned_id = upload_id_;
-      r.abandoned_received = received_;
-    }
     clear();
     upload_id_ = c.upload_id;
     chunk_count_ = c.chunk_count;

@@ -14,11 +14,9 @@ namespace rocksteady::fsw {
 
 struct ChunkResult {
   ChunkStatus status{ChunkStatus::kStored};
-  bool started{false};    // this chunk opened a new uplink
-  bool abandoned{false};  // ... and dropped an unfinished one
-  std::int32_t abandoned_id{-1};
-  std::int32_t abandoned_received{0};
-  bool completed{false};  // this chunk was the last missing one
+  bool started{false};          // this chunk opened a new uplink
+  std::int32_t active_id{-1};   // kOtherUplinkActive: the upload id in progress
+  bool completed{false};        // this chunk was the last missing one
 };
 
 class TrajectoryUplink {

@@ -17,6 +17,16 @@ void UplinkLifecycle::reset() {
 
 ChunkStatus UplinkLifecycle::receive(const TrajectoryChunk& chunk, EventLog& log) {
   const ChunkResult r = uplink_.receive(chunk);
+  if (r.status == ChunkStatus::kOtherUplinkActive) {
+    ++chunks_rejected_;
+    log.emit(Severity::kWarning, EventId::kChunkRejected, chunk.upload_id,
+             static_cast<std::int32_t>(r.status),
+             "uplink %" PRId32 " chunk %" PRId32 " refused: uplink %" PRId32
+             " in progress (%" PRId32 "/%" PRId32 "); ABORT_UPLINK %" PRId32 " ends it",
+             chunk.upload_id, chunk.chunk_index, r.active_id, uplink_.chunks_received(),
+             uplink_.chunk_count(), r.active_id);
+    return r.status;
+  }
   if (r.status != ChunkStatus::kStored) {
     ++chunks_rejected_;
     log.emit(Severity::kWarning, EventId::kChunkRejected, chunk.upload_id,
@@ -24,12 +34,6 @@ ChunkStatus UplinkLifecycle::receive(const TrajectoryChunk& chunk, EventLog& log
              "uplink %" PRId32 " chunk %" PRId32 " rejected: %s", chunk.upload_id,
              chunk.chunk_index, to_string(r.status));
     return r.status;
-  }
-  if (r.abandoned) {
-    log.emit(Severity::kWarning, EventId::kUplinkAbandoned, r.abandoned_id, r.abandoned_received,
-             "trajectory uplink %" PRId32 " abandoned for %" PRId32 " (%" PRId32
-             " chunks received)",
-             r.abandoned_id, chunk.upload_id, r.abandoned_received);
   }
   if (r.started) {
     log.emit(Severity::kInfo, EventId::kUplinkStarted, chunk.upload_id, chunk.chunk_count,

@@ -1,5 +1,5 @@
 // A trajectory uplink's life cycle: chunks are stored as they arrive (events when an uplink starts,
-// completes, is abandoned or a chunk is rejected); LOAD_TRAJECTORY validates the complete table and
+// completes, is aborted or a chunk is rejected; a chunk of another upload never ends one in progress); LOAD_TRAJECTORY validates the complete table and
 // queues the hand-over, which happens at the next tick boundary; ABORT_UPLINK discards it.
 #pragma once
 

@@ -79,6 +79,10 @@ class UplinkWatcher {
         complete_ = true;
         break;
       case kEventChunkRejected:
+        if (e.arg1 == kChunkStatusOtherUplinkActive) {
+          refused_ = true;
+          refusal_ = sanitize_text(e.text);
+        }
         ++rejections_;
         last_rejection_ = Clock::now();
         if (log_ != nullptr) {
@@ -106,6 +110,9 @@ class UplinkWatcher {
   }
   bool complete() const { return complete_; }
   bool abandoned() const { return abandoned_; }
+  // The flight refuses this upload while another one is in progress: resending cannot help.
+  bool refused() const { return refused_; }
+  const std::string& refusal() const { return refusal_; }
   std::uint64_t rejections() const { return rejections_; }
   Clock::time_point last_rejection() const { return last_rejection_; }
 
@@ -115,6 +122,8 @@ class UplinkWatcher {
   std::FILE* log_;
   bool complete_{false};
   bool abandoned_{false};
+  bool refused_{false};
+  std::string refusal_;
   std::uint64_t rejections_{0};
   Clock::time_point last_rejection_{};
 };
@@ -146,7 +155,12 @@ class Monitor {
     ++counts_.events;
     // With a key: the flight's events are signed; anything else is shown as such.
     const bool forged = auth_configured() && verify_event(e) == AckAuth::kForged;
-    show(std::string(forged ? "EVENT (unauthenticated) " : "EVENT ") + format_event(e));
+    // The plant's events (ids from 1000) are the simulator's, which holds no flight key.
+    const bool simulator = forged && e.id >= kFirstPlantEventId && e.key_id == 0;
+    show(std::string(simulator ? "EVENT (simulator) "
+                     : forged  ? "EVENT (unauthenticated) "
+                               : "EVENT ") +
+         format_event(e));
   }
   void on_ack(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     rocksteady::cmd_ack_t a;
@@ -286,15 +300,26 @@ class ParamCatcher {
   void on_table(const lcm::ReceiveBuffer* rbuf, const std::string&) {
     rocksteady::param_table_t t;
     if (!wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), t, &rx_)) return;
+    // Only the flight's authentic read-back is believed; a forged table is counted and dropped.
+    const AckAuth a = verify_params(t);
+    if (a == AckAuth::kForged) {
+      ++forged_;
+      return;
+    }
     table_ = t;
+    lab_ = a == AckAuth::kLabMode;
     have_ = true;
   }
   bool have() const { return have_; }
+  bool lab() const { return lab_; }
+  std::uint64_t forged() const { return forged_; }
   const rocksteady::param_table_t& table() const { return table_; }
 
  private:
   rocksteady::param_table_t table_{};
   bool have_{false};
+  bool lab_{false};
+  std::uint64_t forged_{0};
   wire::RxCounters rx_{};
 };
 }  // namespace
@@ -341,6 +366,8 @@ ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd_in,
   }
   r.have_table = catcher.have();
   r.table = catcher.table();
+  r.table_unauthenticated = catcher.lab();
+  r.forged_tables = catcher.forged();
   return r;
 }
 
@@ -381,7 +408,8 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
   lcm::Subscription* tlm =
       lcm.subscribe(channels::kGncTelemetry, &UplinkWatcher::on_telemetry, &watcher);
 
-  for (int pass = 1; pass <= options.passes && !watcher.complete() && !watcher.abandoned();
+  for (int pass = 1; pass <= options.passes && !watcher.complete() && !watcher.abandoned() &&
+                     !watcher.refused();
        ++pass) {
     r.passes_used = pass;
     const std::uint64_t rejections_before = watcher.rejections();
@@ -414,7 +442,7 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
     // Wait for completion; after a rejected chunk (e.g. busy: the previous table is still waiting
     // for the tick boundary) the next pass starts once the rejections have stopped for a while.
     const Clock::time_point deadline = after(options.wait_s);
-    while (!watcher.complete() && !watcher.abandoned()) {
+    while (!watcher.complete() && !watcher.abandoned() && !watcher.refused()) {
       if (watcher.rejections() > rejections_before &&
           Clock::now() - watcher.last_rejection() > std::chrono::milliseconds(kResendQuietMs)) {
         break;
@@ -433,6 +461,10 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
                 std::to_string(r.chunks) + " chunks)";
   } else if (watcher.abandoned()) {
     r.message = "the flight abandoned upload " + std::to_string(options.upload_id);
+  } else if (watcher.refused()) {
+    r.message = "the flight refuses upload " + std::to_string(options.upload_id) +
+                " while another is in progress (" + watcher.refusal() +
+                "): abort that one with `send abort-uplink ID`, then upload again";
   } else {
     r.message = "no uplink_complete for upload " + std::to_string(options.upload_id) + " after " +
                 std::to_string(r.passes_used) + " passes";

@@ -45,11 +45,14 @@ SendResult send_and_wait(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, dou
 struct ParamReadback {
   SendResult send;                  // the PARAM_DUMP's acknowledgement
   bool have_table{false};
-  rocksteady::param_table_t table{};  // the flight's active table (RS_PARAMS)
+  rocksteady::param_table_t table{};  // the flight's active table (RS_PARAMS), authentic
+  bool table_unauthenticated{false};  // lab mode: the table carries no authenticator
+  std::uint64_t forged_tables{0};     // tables on RS_PARAMS that failed authentication
 };
 
 // Publishes a PARAM_DUMP `cmd` and waits up to `timeout_s` for its acknowledgement and, once
-// accepted, for the table the flight publishes with it.
+// accepted, for the table the flight publishes with it. A table that fails the downlink
+// authenticator is counted in forged_tables and never returned.
 ParamReadback read_params(lcm::LCM& lcm, const rocksteady::ground_cmd_t& cmd, double timeout_s);
 
 // The read-back as text: one line per parameter with its name, values and units.

@@ -39,13 +39,15 @@ std::optional<int> enum_index(const char* enum_name, const std::string& key) {
   return dictionary::enum_value(enum_name, key);
 }
 
-constexpr std::array<const char*, 6> kChunkStatus{
+constexpr std::array<const char*, 8> kChunkStatus{
     "stored",
     "bad header (upload id, total samples or chunk count)",
     "chunk index out of range",
     "wrong number of samples in chunk",
     "header differs from the uplink in progress",
     "a completed table awaits the tick boundary",
+    "not authenticated (bad authenticator, unknown key or replayed counter)",
+    "another uplink is in progress: abort it first",
 };
 
 template <std::size_t N>

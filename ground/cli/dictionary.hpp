@@ -46,10 +46,12 @@ std::optional<ParamEntry> find_param(const std::string& name_or_id);
 std::string reason_name(int reason);
 inline constexpr int kReasonCount = 14;
 
-// fsw::EventId names (100..124), gnc-level event names are not on the bus; "event N" otherwise.
+// fsw::EventId names (100..138), gnc-level event names are not on the bus; "event N" otherwise.
 std::string event_name(int id);
 inline constexpr int kFirstEventId = 100;
-inline constexpr int kLastEventId = 124;
+inline constexpr int kLastEventId = 138;
+// The plant's (simulator's) event ids start here (event_t.id); they carry no flight authenticator.
+inline constexpr int kFirstPlantEventId = 1000;
 // Event ids the uplink procedure listens to.
 inline constexpr int kEventChunkRejected = 117;
 inline constexpr int kEventUplinkStarted = 118;
@@ -60,6 +62,9 @@ inline constexpr int kEventTrajectoryLoaded = 122;
 
 // fsw::ChunkStatus descriptions (arg1 of chunk_rejected).
 std::string chunk_status_name(int status);
+// fsw::ChunkStatus::kOtherUplinkActive: the flight has another upload in progress and refuses
+// this one until the ground aborts it.
+inline constexpr int kChunkStatusOtherUplinkActive = 7;
 
 // event_t SEV_* names (DEBUG .. FATAL).
 const char* severity_name(int severity);

@@ -232,4 +232,30 @@ AckAuth verify_event(const rocksteady::event_t& e) {
   return auth::mac_equal(expect, got) ? AckAuth::kAuthentic : AckAuth::kForged;
 }
 
+AckAuth verify_params(const rocksteady::param_table_t& m) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (g_state.configured && g_state.lab) return AckAuth::kLabMode;
+  if (!g_state.configured) return AckAuth::kForged;
+  const auth::KeyEntry* k = g_state.keys.find(m.key_id);
+  if (k == nullptr || m.count < 0 || m.count > fsw::kMaxDumpParams) return AckAuth::kForged;
+  // The flight's ParamDump as fsw/bus maps it (to_message).
+  fsw::ParamDump d;
+  d.t = m.t;
+  d.seq = static_cast<std::uint32_t>(m.dump_seq);
+  if (static_cast<std::int64_t>(d.seq) != m.dump_seq) return AckAuth::kForged;
+  d.count = m.count;
+  for (int i = 0; i < fsw::kMaxDumpParams; ++i) {
+    const auto p = static_cast<std::size_t>(i);
+    d.value_count[p] = m.value_count[i];
+    for (int v = 0; v < fsw::kMaxParamValues; ++v) {
+      d.values[p][static_cast<std::size_t>(v)] = m.values[i][v];
+    }
+  }
+  auth::MacBytes expect;
+  auth::mac_params(d, m.key_id, k->key, expect);
+  auth::MacBytes got;
+  std::memcpy(got.data(), m.mac, got.size());
+  return auth::mac_equal(expect, got) ? AckAuth::kAuthentic : AckAuth::kForged;
+}
+
 }  // namespace rocksteady::ground::cli

@@ -23,6 +23,7 @@
 #include "rocksteady/cmd_ack_t.hpp"
 #include "rocksteady/event_t.hpp"
 #include "rocksteady/ground_cmd_t.hpp"
+#include "rocksteady/param_table_t.hpp"
 #include "rocksteady/trajectory_chunk_t.hpp"
 
 namespace rocksteady::ground::cli {
@@ -56,7 +57,10 @@ void authenticate(rocksteady::trajectory_chunk_t& chunk);
 enum class AckAuth { kAuthentic, kForged, kLabMode };
 // Checks an acknowledgement's downlink authenticator (kLabMode when the ground is in lab mode).
 AckAuth verify_ack(const rocksteady::cmd_ack_t& ack);
-// The same for an event (the flight signs its events; the plant's and the watchdog's are not).
+// The same for an event (the flight signs its events, the watchdog thread's included; the
+// plant's events come from the simulator, not the spacecraft, and carry none).
 AckAuth verify_event(const rocksteady::event_t& event);
+// The same for the parameter read-back (RS_PARAMS).
+AckAuth verify_params(const rocksteady::param_table_t& table);
 
 }  // namespace rocksteady::ground::cli

@@ -315,6 +315,12 @@ int run_params_get(const SendArgs& a, const std::string& url) {
       std::printf("%s\n", cli::format_ack_verdict(r.send.ack).c_str());
       return cli::kExitRunFailed;
     }
+    if (!r.have_table && r.forged_tables > 0) {
+      std::printf("FORGED: %llu parameter table(s) on RS_PARAMS failed authentication; none "
+                  "believed\n",
+                  static_cast<unsigned long long>(r.forged_tables));
+      return cli::kExitRunFailed;
+    }
     if (!r.have_table) {
       std::printf("TIMEOUT: no parameter table (seq %lld) within %g s%s\n",
                   static_cast<long long>(cmd.seq), a.timeout,
@@ -322,6 +328,11 @@ int run_params_get(const SendArgs& a, const std::string& url) {
       return cli::kExitRunFailed;
     }
     std::fputs(cli::format_params(r.table).c_str(), stdout);
+    if (r.table_unauthenticated) std::printf("(lab mode: the table carries no authenticator)\n");
+    if (r.forged_tables > 0) {
+      std::printf("warning: %llu forged parameter table(s) on RS_PARAMS ignored\n",
+                  static_cast<unsigned long long>(r.forged_tables));
+    }
     return cli::kExitAccepted;
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "error: %s\n", ex.what());

@@ -136,21 +136,44 @@ TEST(TrajectoryUplinkApp, CrcMismatchRejectsTheTable) {
   EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryRejected), 1);
 }
 
-TEST(TrajectoryUplinkApp, ANewUploadAbandonsAnUnfinishedOneAndAbortDiscards) {
+TEST(TrajectoryUplinkApp, OnlyAnAbortEndsAnUnfinishedUploadAndAnotherUploadIsRefused) {
   AppFixture f;
   Plan a(70);
   Plan b(40);
   const auto ca = test::chunks_of(*a.table, 1);
   const auto cb = test::chunks_of(*b.table, 2);
-  f.app->receive_chunk(ca[0]);
-  f.app->receive_chunk(cb[1]);
-  EXPECT_EQ(f.app->uplink().upload_id(), 2);
+  EXPECT_EQ(f.app->receive_chunk(ca[0]), ChunkStatus::kStored);
+  // A chunk of another upload (a stray one, or a new upload begun without aborting) is refused
+  // and the uplink in progress keeps every chunk it had.
+  EXPECT_EQ(f.app->receive_chunk(cb[1]), ChunkStatus::kOtherUplinkActive);
+  EXPECT_EQ(f.app->uplink().upload_id(), 1);
   EXPECT_EQ(f.app->uplink().chunks_received(), 1);
-  EXPECT_EQ(f.send(Opcode::kAbortUplink, {1.0}).reason, RejectReason::kOutOfRange);
-  EXPECT_TRUE(f.send(Opcode::kAbortUplink, {2.0}).accepted);
+  EXPECT_EQ(f.app->health().uplink_chunks_rejected, 1u);
+  {
+    const auto ev = test::drain(*f.app);
+    EXPECT_EQ(test::count_events(ev, EventId::kUplinkAbandoned), 0);
+    ASSERT_EQ(test::count_events(ev, EventId::kChunkRejected), 1);
+    for (const auto& e : ev) {
+      if (e.id != EventId::kChunkRejected) continue;
+      EXPECT_EQ(e.arg0, 2);
+      EXPECT_EQ(e.arg1, static_cast<std::int32_t>(ChunkStatus::kOtherUplinkActive));
+      EXPECT_NE(std::string(e.text.data()).find("ABORT_UPLINK 1"), std::string::npos) << e.text.data();
+    }
+  }
+  // The first upload completes and loads despite the stray chunk.
+  for (std::size_t i = 1; i < ca.size(); ++i) {
+    EXPECT_EQ(f.app->receive_chunk(ca[i]), ChunkStatus::kStored);
+  }
+  EXPECT_TRUE(f.app->uplink().complete());
+  // Only an ABORT_UPLINK naming the upload in progress ends it; then the other upload can start.
+  EXPECT_EQ(f.send(Opcode::kAbortUplink, {2.0}).reason, RejectReason::kOutOfRange);
+  EXPECT_TRUE(f.app->uplink().active());
+  EXPECT_TRUE(f.send(Opcode::kAbortUplink, {1.0}).accepted);
   EXPECT_FALSE(f.app->uplink().active());
+  EXPECT_EQ(f.app->receive_chunk(cb[1]), ChunkStatus::kStored);
+  EXPECT_EQ(f.app->uplink().upload_id(), 2);
   const auto ev = test::drain(*f.app);
-  EXPECT_EQ(test::count_events(ev, EventId::kUplinkAbandoned), 2);  // replaced, then aborted
+  EXPECT_EQ(test::count_events(ev, EventId::kUplinkAbandoned), 1);  // the abort
 }
 
 TEST(TrajectoryUplinkApp, TrackCannotHaveItsTableReplaced) {

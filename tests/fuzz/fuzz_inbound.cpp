@@ -154,8 +154,14 @@ void use_chunk(const rs::trajectory_chunk_t& m) {
   }
   const rs::fsw::ChunkResult r = uplink.receive(c);
   // The codec's checks cover the header, index and count rules; only a clash with the upload in
-  // progress remains.
-  require(r.status == rs::fsw::ChunkStatus::kStored || r.status == rs::fsw::ChunkStatus::kHeaderMismatch);
+  // progress remains (its header, or another upload id, which an abort would end).
+  require(r.status == rs::fsw::ChunkStatus::kStored ||
+          r.status == rs::fsw::ChunkStatus::kHeaderMismatch ||
+          r.status == rs::fsw::ChunkStatus::kOtherUplinkActive);
+  if (r.status == rs::fsw::ChunkStatus::kOtherUplinkActive) {
+    require(uplink.active() && uplink.upload_id() == r.active_id);
+    uplink.clear();  // the ground's ABORT_UPLINK
+  }
   if (uplink.complete()) {
     (void)uplink.finalize(0.05);
     uplink.clear();

@@ -290,7 +290,9 @@ TEST(GroundDictionary, NamesMatchTheFlightNames) {
   for (int op = 0; op < fsw::kOpcodeCount; ++op) {
     EXPECT_EQ(opcode_name(op), fsw::to_string(static_cast<fsw::Opcode>(op)));
   }
-  for (int s = 0; s <= static_cast<int>(fsw::ChunkStatus::kBusy); ++s) {
+  EXPECT_EQ(kChunkStatusOtherUplinkActive,
+            static_cast<int>(fsw::ChunkStatus::kOtherUplinkActive));
+  for (int s = 0; s <= static_cast<int>(fsw::ChunkStatus::kOtherUplinkActive); ++s) {
     EXPECT_EQ(chunk_status_name(s), fsw::to_string(static_cast<fsw::ChunkStatus>(s)));
   }
   for (int m = 0; m < gnc::kModeCount; ++m) {
