@@ -131,6 +131,45 @@ TEST(CommandSecurity, NeitherKeysNorLabModeIsRefusedAtInit) {
   EXPECT_FALSE(app->init(c, clock).ok);  // lab mode and keys are exclusive
 }
 
+// The downlink beyond acks and events: the parameter read-back of an accepted PARAM_DUMP is
+// signed with the active key over every field (mac_params recomputed here), and the watchdog
+// thread signs its event with the key id the tick thread published (sign_event_with), never with
+// an unknown id; in lab mode nothing is signed.
+TEST(CommandSecurity, ParameterReadBackAndWatchdogEventCarryTheDownlinkAuthenticator) {
+  KeyedFixture f;
+  f.ticks(1);
+  ASSERT_TRUE(f.send_signed(Opcode::kParamDump).accepted);
+  ParamDump d;
+  ASSERT_TRUE(f.app->take_param_dump(d));
+  std::int32_t key_id = -1;
+  auth::MacBytes mac{};
+  ASSERT_TRUE(f.app->security().sign_params(d, key_id, mac));
+  EXPECT_EQ(key_id, 1);
+  auth::MacBytes expect{};
+  auth::mac_params(d, 1, kKey1, expect);
+  EXPECT_TRUE(auth::mac_equal(mac, expect));
+  ParamDump changed = d;
+  changed.values[0][0] += 1.0;
+  auth::mac_params(changed, 1, kKey1, expect);
+  EXPECT_FALSE(auth::mac_equal(mac, expect));
+
+  auth::EventFields e;
+  e.t = 12.0;
+  e.id = 203;
+  e.arg0 = 250;
+  ASSERT_TRUE(f.app->security().sign_event_with(2, e, mac));
+  EXPECT_EQ(e.key_id, 2);
+  auth::mac_event(e, kKey2, expect);
+  EXPECT_TRUE(auth::mac_equal(mac, expect));
+  EXPECT_FALSE(f.app->security().sign_event_with(3, e, mac));  // not a loaded key
+  EXPECT_EQ(e.key_id, 0);
+
+  test::AppFixture lab;  // small_config: lab mode
+  EXPECT_FALSE(lab.app->security().sign_params(d, key_id, mac));
+  EXPECT_EQ(key_id, 0);
+  EXPECT_FALSE(lab.app->security().sign_event_with(1, e, mac));
+}
+
 TEST(CommandSecurity, LabModeIsAnnouncedAndFlaggedInTelemetry) {
   test::AppFixture lab;  // small_config: lab mode
   const std::vector<Event> ev = test::drain(*lab.app);

@@ -11,6 +11,7 @@
 #include "fsw/auth/key_file.hpp"
 #include "ground/cli/ground_auth.hpp"
 #include "test_util.hpp"
+#include "rocksteady/param_table_t.hpp"
 #include "wire/codec.hpp"
 
 namespace rocksteady::ground::cli {
@@ -88,6 +89,71 @@ TEST(GroundAuth, AcksAndEventsAreAuthenticOnlyWithTheFlightsAuthenticator) {
   EXPECT_EQ(verify_ack(a), AckAuth::kForged);
   a.key_id = 7;  // unknown key id
   EXPECT_EQ(verify_ack(a), AckAuth::kForged);
+}
+
+// RS_PARAMS: the read-back is believed only with the flight's authenticator over every field
+// (computed here with the flight's canonical encoding, fsw/auth mac_params); any changed value,
+// counter, count or key id, an unknown key, a zero MAC, or a dump number the flight cannot have
+// sent (above 32 bits) is forged. Lab mode shows it as unauthenticated.
+TEST(GroundAuth, ParameterReadBackIsAuthenticOnlyWithTheFlightsAuthenticator) {
+  Keyed k;
+  fsw::ParamDump d;
+  d.t = 812.5;
+  d.seq = 3;
+  d.count = 2;
+  d.value_count[0] = 6;
+  d.value_count[1] = 1;
+  for (int v = 0; v < 6; ++v) d.values[0][static_cast<std::size_t>(v)] = 1e4 * (v + 1);
+  d.values[1][0] = 0.25;
+  auth::MacBytes mac;
+  auth::mac_params(d, 2, k.keys.find(2)->key, mac);
+  auto m = wire::make<rocksteady::param_table_t>();
+  m.t = d.t;
+  m.dump_seq = d.seq;
+  m.count = d.count;
+  for (int i = 0; i < fsw::kMaxDumpParams; ++i) {
+    m.value_count[i] = d.value_count[static_cast<std::size_t>(i)];
+    for (int v = 0; v < fsw::kMaxParamValues; ++v) {
+      m.values[i][v] = d.values[static_cast<std::size_t>(i)][static_cast<std::size_t>(v)];
+    }
+  }
+  m.key_id = 2;
+  std::memcpy(m.mac, mac.data(), mac.size());
+  ASSERT_EQ(verify_params(m), AckAuth::kAuthentic);
+
+  const auto forged_after = [&](auto change) {
+    auto x = m;
+    change(x);
+    return verify_params(x) == AckAuth::kForged;
+  };
+  EXPECT_TRUE(forged_after([](auto& x) { x.values[0][0] = 2e4; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.values[31][5] = 1.0; }));  // an unused slot
+  EXPECT_TRUE(forged_after([](auto& x) { x.value_count[1] = 2; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.count = 3; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.t = 812.6; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.dump_seq = 4; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.dump_seq += std::int64_t{1} << 32; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.key_id = 1; }));   // another known key
+  EXPECT_TRUE(forged_after([](auto& x) { x.key_id = 9; }));   // unknown key
+  EXPECT_TRUE(forged_after([](auto& x) { std::memset(x.mac, 0, sizeof x.mac); }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.mac[31] ^= 1; }));
+  EXPECT_TRUE(forged_after([](auto& x) { x.count = -1; }));
+  // An event's authenticator with the same key and the same leading numbers never verifies as a
+  // table (the channel and message kind are inside the MAC).
+  {
+    auth::EventFields f;
+    f.t = d.t;
+    f.seq = d.seq;
+    f.key_id = 2;
+    auth::MacBytes ev;
+    auth::mac_event(f, k.keys.find(2)->key, ev);
+    EXPECT_TRUE(forged_after([&](auto& x) { std::memcpy(x.mac, ev.data(), ev.size()); }));
+  }
+  reset_auth();
+  AuthOptions lab;
+  lab.lab = true;
+  ASSERT_EQ(configure_auth(lab), "");
+  EXPECT_EQ(verify_params(m), AckAuth::kLabMode);
 }
 
 TEST(GroundAuth, NoKeyOrATooOpenKeyFileIsRefused) {

@@ -8,6 +8,8 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -15,6 +17,8 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm.h>
 
+#include "fsw/auth/auth.hpp"
+#include "fsw/auth/key_file.hpp"
 #include "rt/udpm_receiver.hpp"
 
 #include "tests/pil/pil_harness.hpp"
@@ -115,9 +119,19 @@ TEST(PilWatchdog, AStalledTickIsCaughtWhileStalledThrustersOffAndANonZeroExit) {
   const std::string dir = scratch_dir("watchdog");
   const std::string url = lcm_url(7865);
   TestBus bus(url);
-  Process fsw(fsw_realtime(url, {"--case", "1", "--start-mode", "DETUMBLE", "--watchdog-ms", "300",
-                                 "--test-stall-at-tick", "15"}),
-              dir + "/fsw.log");
+  // With command keys (not lab mode): the watchdog thread's event carries the flight's downlink
+  // authenticator, so the ground can tell it from a forged one.
+  const std::string key_file = dir + "/key";
+  std::remove(key_file.c_str());
+  ASSERT_EQ(rocksteady::fsw::auth::generate_key_file(key_file, 1), "");
+  rocksteady::fsw::auth::KeySet keys;
+  ASSERT_EQ(rocksteady::fsw::auth::load_key_file(key_file, keys), "");
+  std::vector<std::string> argv = fsw_realtime(url, {"--case", "1", "--start-mode", "DETUMBLE",
+                                                     "--watchdog-ms", "300",
+                                                     "--test-stall-at-tick", "15", "--key-file",
+                                                     key_file, "--state-file", dir + "/state"});
+  argv.erase(std::find(argv.begin(), argv.end(), std::string("--lab-mode")));
+  Process fsw(argv, dir + "/fsw.log");
   Process plant({plant_exe(), "--lcm-url", url, "--config-dir", config_dir(), "--case", "1",
                  "--mode", "realtime", "--duration", "20"},
                 dir + "/plant.log");
@@ -146,6 +160,24 @@ TEST(PilWatchdog, AStalledTickIsCaughtWhileStalledThrustersOffAndANonZeroExit) {
   EXPECT_EQ(static_cast<int>(ev->severity), int{rocksteady::event_t::SEV_ERROR});
   EXPECT_GE(ev->arg0, 300);  // ms since the last GNC cycle
   EXPECT_EQ(ev->arg1, 14);   // the last GNC cycle's base tick
+  ASSERT_EQ(ev->key_id, 1);
+  {
+    rocksteady::fsw::auth::EventFields f;
+    f.t = ev->t;
+    f.seq = ev->seq;
+    f.severity = ev->severity;
+    f.id = ev->id;
+    f.arg0 = ev->arg0;
+    f.arg1 = ev->arg1;
+    f.key_id = ev->key_id;
+    f.text = ev->text.c_str();
+    f.text_len = ev->text.size();
+    rocksteady::fsw::auth::MacBytes expect{};
+    rocksteady::fsw::auth::mac_event(f, keys.find(1)->key, expect);
+    rocksteady::fsw::auth::MacBytes got{};
+    std::memcpy(got.data(), ev->mac, got.size());
+    EXPECT_TRUE(rocksteady::fsw::auth::mac_equal(expect, got)) << "watchdog event not authentic";
+  }
   EXPECT_GT(bus.thruster_firing_count, 0u) << "the despin never fired: nothing to turn off";
   ASSERT_TRUE(bus.have_thruster);
   EXPECT_FALSE(bus.thruster.enabled);
