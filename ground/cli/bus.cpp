@@ -455,6 +455,7 @@ UploadResult upload_chunks(lcm::LCM& lcm, const gnc::TrajectoryTable& table,
   lcm.unsubscribe(ev);
   lcm.unsubscribe(tlm);
   r.complete = watcher.complete();
+  r.refused = !r.complete && watcher.refused();
   r.chunk_rejections = watcher.rejections();
   if (r.complete) {
     r.message = "upload " + std::to_string(options.upload_id) + " complete on board (" +

@@ -71,6 +71,7 @@ struct UploadOptions {
 
 struct UploadResult {
   bool complete{false};
+  bool refused{false};  // the flight has another upload in progress (abort it first)
   int chunks{0};
   int passes_used{0};
   std::uint64_t chunk_rejections{0};  // chunk_rejected events for this upload

@@ -261,6 +261,10 @@ int upload(lcm::LCM* lcm, SeqSource& seqs, const SendArgs& a) {
   options.sender = a.sender;
   const cli::UploadResult r = cli::upload_chunks(*lcm, *table, options, stderr);
   std::fprintf(stderr, "%s\n", r.message.c_str());
+  if (r.refused) {
+    std::printf("REFUSED: %s\n", r.message.c_str());
+    return cli::kExitRunFailed;
+  }
   if (!r.complete) {
     std::printf("TIMEOUT: %s\n", r.message.c_str());
     return cli::kExitRunFailed;

@@ -53,6 +53,15 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
        " --chunk-interval 0.01 --wait 5 --timeout 5" + state + "; echo rc=$?\n";
   s += g + "monitor --count 2 --seconds 5 --plain; echo rc=$?\n";
   s += g + "params get --timeout 5" + state + "; echo rc=$?\n";
+  // An uplink in progress (complete, not loaded) is ended only by an authenticated abort: another
+  // upload is refused with the id to abort; after the abort it goes through.
+  const std::string up = g + "send upload-trajectory " + test::quote(file) +
+                         " --no-load --chunk-interval 0.01 --wait 5 --passes 1 --timeout 5" +
+                         state;
+  s += up + " --upload-id 41; echo rc=$?\n";
+  s += up + " --upload-id 42; echo rc=$?\n";
+  s += g + "send abort-uplink 41 --timeout 5" + state + "; echo rc=$?\n";
+  s += up + " --upload-id 42; echo rc=$?\n";
   s += "kill $fpid; wait $fpid\n";
   const test::Run r = test::run_in_namespace(s, dir, 90);
   const std::string& o = r.out;
@@ -82,6 +91,20 @@ TEST(GroundCliWithFlight, CommandsMonitorAndUploadAgainstRocksteadyFsw) {
       << said;
   EXPECT_NE(o.find("23  mode.sensor_timeout            s                1\n"), std::string::npos)
       << said;
+  EXPECT_EQ(o.find("FORGED"), std::string::npos) << said;  // the read-back is authentic
+  const std::size_t first = o.find("UPLOADED: upload id 41 ");
+  const std::size_t refused = o.find("REFUSED: the flight refuses upload 42 while another is in progress");
+  const std::size_t aborted = o.find("ACCEPTED\nrc=0\n", refused);
+  const std::size_t second = o.find("UPLOADED: upload id 42 ");
+  ASSERT_NE(first, std::string::npos) << said;
+  ASSERT_NE(refused, std::string::npos) << said;
+  EXPECT_NE(o.find("ABORT_UPLINK 41", refused), std::string::npos) << said;
+  EXPECT_EQ(o.substr(o.find('\n', refused), 6), "\nrc=1\n") << said;
+  ASSERT_NE(aborted, std::string::npos) << said;
+  ASSERT_NE(second, std::string::npos) << said;
+  EXPECT_LT(first, refused);
+  EXPECT_LT(refused, aborted);
+  EXPECT_LT(aborted, second);
 }
 
 // The replay state survives a restart of the flight process: a command accepted before the restart
