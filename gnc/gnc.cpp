@@ -53,6 +53,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   candidate_status_ = params_.identification.enabled ? ModelCandidate::kNotConfident
                                                      : ModelCandidate::kDisabled;
   candidate_windows_ = 0;
+  fault_model_stale_ = false;
   last_adoption_t_ = 0.0;
   adopted_once_ = false;
   adoptions_ = 0;
@@ -101,6 +102,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
     ident_.configure(build_identifier_config(params_));
     candidate_status_ = ModelCandidate::kNotConfident;
     candidate_windows_ = 0;
+    fault_model_stale_ = false;
   } else if (model_changed && declared_change) {
     candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
     ident_.reinflate_all();
@@ -358,12 +360,20 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     in.omega = mekf ? Vec3(m.omega - id_bias_) : m.omega;
     in.omega_valid = m.omega_valid && (!mekf || mekf_.initialised());
     in.force = last_force_;
-    ident_.update(in);
+    // The identifier's step blocks stay off the fault detector's window-close ticks.
+    const bool fdi_busy = params_.fdi.enabled && fdi_.window_closes_next();
+    ident_.update(in, !fdi_busy);
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
       if (mekf) id_bias_ = mekf_.bias();
-      refresh_fault_model();  // the detector predicts with the latest identified model
+      fault_model_stale_ = true;
+    }
+    // The detector predicts with the latest identified model, refreshed on a tick that does not
+    // close its window (never inside one: it only rescales the next window's prediction).
+    if (fault_model_stale_ && !fdi_busy) {
+      refresh_fault_model();
+      fault_model_stale_ = false;
     }
   }
 

@@ -102,6 +102,7 @@ class Gnc {
   std::uint32_t adoptions_{0};
   ModelCandidate candidate_status_{ModelCandidate::kDisabled};
   std::uint32_t candidate_windows_{0};
+  bool fault_model_stale_{false};  // a window closed: refresh the detector's model
   GncParams candidate_{};  // scratch for the automatic adoption (too large for a tick's stack)
 };
 

@@ -1,5 +1,6 @@
 #include "gnc/estimation/identifier.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -145,6 +146,21 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
 void Identifier::configure(const IdentifierConfig& c) {
   c_ = c;
   n_ = static_cast<int>(std::lround(c.window_s / c.dt));
+  // Ticks of one joint step: linearisation, gain rows, apply, covariance rows, finish, strengths
+  // and report. Smallest blocks that let the step end well before the next window closes.
+  const auto ticks_for = [](int g, int r) {
+    return 1 + (kIdParams + g - 1) / g + 1 + 1 + (kIdParams + r - 1) / r +
+           (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
+           (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1;
+  };
+  gain_rows_per_tick_ = 4;
+  cov_rows_per_tick_ = 1;
+  // (4/5 of the window: ticks withheld for other periodic work must not make the step overrun.)
+  while (ticks_for(gain_rows_per_tick_, cov_rows_per_tick_) > (n_ - 1) * 4 / 5 &&
+         cov_rows_per_tick_ < kIdParams) {
+    cov_rows_per_tick_ = std::min(kIdParams, 2 * cov_rows_per_tick_);
+    gain_rows_per_tick_ = std::min(kIdParams, 2 * gain_rows_per_tick_);
+  }
   for (int i = 0; i < kThrusters; ++i) {
     e_[i] = thruster_direction(c.rcs, i);
     p_pos_[i] = thruster_position(c.rcs, i);
@@ -166,6 +182,7 @@ void Identifier::reset() {
   p_all_.bottomRightCorner<kThrusters, kThrusters>() = p_k_;
   reference_.fill(true);
   joint_ = JointStep{};
+  anchor_ = AnchorStep{};
   acc_ = Window{};
   latched_ = Window{};
   sample_ = -1;
@@ -191,6 +208,7 @@ void reinflate_block(Eigen::Matrix<double, N, N>& p, int first, int n, double va
 
 void Identifier::reinflate_inertia() {
   joint_finish_covariance();
+  finish_anchor();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.j_prior_sigma * c_.j_prior_sigma;
@@ -201,6 +219,7 @@ void Identifier::reinflate_inertia() {
 
 void Identifier::reinflate_offset() {
   joint_finish_covariance();
+  finish_anchor();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.r_prior_sigma * c_.r_prior_sigma;
@@ -212,6 +231,7 @@ void Identifier::reinflate_offset() {
 void Identifier::reinflate_thruster(int i) {
   if (i < 0 || i >= kThrusters) return;
   joint_finish_covariance();
+  finish_anchor();
   joint_.pending = false;
   joint_.started = false;
   const double v = c_.k_prior_sigma * c_.k_prior_sigma;
@@ -238,8 +258,9 @@ void Identifier::sync_blocks() {
 void Identifier::joint_gain() {
   // (I13): e(x) = A_J a - sum_i k_i [(p_i + r) x e_i] ∫ w F_i dt = noise, linearised at the
   // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat)], one extended-RLS step on all 25 parameters.
-  // The gain takes two ticks (joint_gain, joint_gain_finish), the update a third (joint_apply),
-  // so no tick carries more than a third of the 25-parameter step.
+  // The gain is formed over several ticks (joint_gain, then joint_gain_rows per block of rows),
+  // the update applied on one (joint_apply) and the covariance updated over several
+  // (joint_covariance_step), so no tick carries more than a block of the 25-parameter step.
   joint_.pending = false;
   joint_.started = false;
   const Vec3 force = net_force_impulse();
@@ -272,28 +293,40 @@ void Identifier::joint_gain() {
   if (joint_.any_thruster && c_.k_forget_s > 0.0) {
     d.tail<kThrusters>().setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
   }
-  // P_f H' = D P D H' without forming P_f; the first rows now, the rest next tick.
+  // P_f H' = D P D H' without forming P_f, a block of rows per tick (joint_gain_rows).
   joint_.h = h;
   joint_.dht = d.asDiagonal() * h.transpose();
-  joint_.p_ht.topRows<kSplit>() =
-      d.head<kSplit>().asDiagonal() * (p_all_.topRows<kSplit>() * joint_.dht);
+  joint_.gain_rows = 0;
   joint_.started = true;
 }
 
-void Identifier::joint_gain_finish() {
-  if (!joint_.started) return;
+bool Identifier::joint_gain_rows() {
+  if (!joint_.started) return true;
+  const int first = joint_.gain_rows;
+  if (first < kIdParams) {
+    const int n = std::min(gain_rows_per_tick_, kIdParams - first);
+    for (int i = first; i < first + n; ++i) {
+      Vec3 acc = Vec3::Zero();  // row i of P times D H' (a plain loop: no GEMM packing per row)
+      for (int j = 0; j < kIdParams; ++j) acc += p_all_(i, j) * joint_.dht.row(j).transpose();
+      joint_.p_ht.row(i) = joint_.d(i) * acc.transpose();
+    }
+    joint_.gain_rows = first + n;
+    return false;
+  }
+  // Every row done: S and the gain on a tick of their own.
   joint_.started = false;
-  constexpr int kRest = kIdParams - kSplit;
-  joint_.p_ht.bottomRows<kRest>() =
-      joint_.d.tail<kRest>().asDiagonal() * (p_all_.bottomRows<kRest>() * joint_.dht);
-  joint_.s = latched_noise_ * Mat3::Identity() + joint_.h * joint_.p_ht;
+  joint_.s = latched_noise_ * Mat3::Identity() + joint_.h.lazyProduct(joint_.p_ht);
   residual_cov_ = joint_.s;
   const Eigen::LDLT<Mat3> ldlt(joint_.s);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return;
-  joint_.k = ldlt.solve(joint_.p_ht.transpose()).transpose();
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return true;
+  // K = P H' S^-1 with S^-1 from the 3x3 factorisation (a 25 x 3 times 3 x 3 product, no
+  // blocked triangular solve over 25 right-hand sides).
+  const Mat3 s_inv = ldlt.solve(Mat3::Identity());
+  joint_.k = joint_.p_ht.lazyProduct(s_inv);
   // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
   if (!exc_.offset) joint_.k.middleRows<3>(6).setZero();
   joint_.pending = true;
+  return true;
 }
 
 void Identifier::joint_apply() {
@@ -319,8 +352,10 @@ void Identifier::joint_apply() {
     if (!r_ok) ++counters_.offset_refused;
     return;
   }
-  // The covariance is updated row block by row block: the first rows now, the rest next tick.
-  joint_covariance_rows(0, kSplit);
+  // The covariance is updated a block of rows per tick from the next tick on (each row needs
+  // only its own old row, p_ht, K and S).
+  joint_.cov_rows = 0;
+  joint_.sym_rows = 0;
   joint_.rows_pending = true;
   a_ = x.head<6>();
   r_ = x.segment<3>(6);
@@ -352,11 +387,46 @@ void Identifier::joint_covariance_rows(int first, int n) {
   }
 }
 
+void Identifier::symmetrise_rows(int first, int n) {
+  // (P + P')/2 over the pairs (i, j > i) of rows [first, first + n): the same values as the whole
+  // matrix at once, in blocks.
+  for (int i = first; i < first + n; ++i) {
+    for (int j = i + 1; j < kIdParams; ++j) {
+      const double v = 0.5 * (p_all_(i, j) + p_all_(j, i));
+      p_all_(i, j) = v;
+      p_all_(j, i) = v;
+    }
+  }
+}
+
+bool Identifier::joint_covariance_step() {
+  if (!joint_.rows_pending) return true;
+  if (joint_.cov_rows < kIdParams) {
+    const int n = std::min(cov_rows_per_tick_, kIdParams - joint_.cov_rows);
+    joint_covariance_rows(joint_.cov_rows, n);
+    joint_.cov_rows += n;
+    return false;
+  }
+  if (joint_.sym_rows < kIdParams) {
+    const int n = std::min(kSymmetriseRowsPerTick, kIdParams - joint_.sym_rows);
+    symmetrise_rows(joint_.sym_rows, n);
+    joint_.sym_rows += n;
+    return false;
+  }
+  return true;
+}
+
 void Identifier::joint_finish_covariance() {
   if (!joint_.rows_pending) return;
   joint_.rows_pending = false;
-  joint_covariance_rows(kSplit, kIdParams - kSplit);
-  p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+  if (joint_.cov_rows < kIdParams) {
+    joint_covariance_rows(joint_.cov_rows, kIdParams - joint_.cov_rows);
+    joint_.cov_rows = kIdParams;
+  }
+  if (joint_.sym_rows < kIdParams) {
+    symmetrise_rows(joint_.sym_rows, kIdParams - joint_.sym_rows);
+    joint_.sym_rows = kIdParams;
+  }
   // No variance above its prior (no wind-up while a direction is not excited).
   const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
                           c_.k_prior_sigma * c_.k_prior_sigma};
@@ -387,14 +457,22 @@ void Identifier::anchor_scale() {
   c /= n;
   b /= n;
   if (c_.mode == IdentifierMode::kJoint) {
-    const VecId pc = p_all_ * c;
+    // c is sparse (1/n on the reference thrusters): P c sums those columns (the Cortex-M7 tick
+    // budget).
+    VecId pc = VecId::Zero();
+    for (int i = 0; i < kThrusters; ++i) {
+      if (reference_[i]) pc += p_all_.col(9 + i) * c(9 + i);
+    }
     const double cpc = c.dot(pc);
     if (!(cpc > 0.0)) return;
     VecId x;
     x << a_, r_, k_;
     x -= pc * ((c.dot(x) - b) / cpc);
-    p_all_.noalias() -= pc * pc.transpose() / cpc;
-    p_all_ = 0.5 * (p_all_ + p_all_.transpose()).eval();
+    // P -= P c c'P / (c'P c), a block of rows per tick from the next tick on (anchor_rows).
+    anchor_.pc = pc;
+    anchor_.g = pc / cpc;
+    anchor_.rows = 0;
+    anchor_.pending = true;
     a_ = x.head<6>();
     r_ = x.segment<3>(6);
     k_ = x.tail<kThrusters>();
@@ -406,6 +484,30 @@ void Identifier::anchor_scale() {
     k_ -= pc * ((ck.dot(k_) - b) / cpc);
     p_k_.noalias() -= pc * pc.transpose() / cpc;
     p_k_ = 0.5 * (p_k_ + p_k_.transpose()).eval();
+  }
+}
+
+bool Identifier::anchor_rows() {
+  if (!anchor_.pending) return true;
+  // Element (i, j) loses g(lo) pc(hi), lo = min(i, j): the same product for (j, i), so a
+  // symmetric P stays exactly symmetric whichever rows are done first.
+  const int first = anchor_.rows;
+  const int n = std::min(kAnchorRowsPerTick, kIdParams - first);
+  for (int i = first; i < first + n; ++i) {
+    for (int j = 0; j < kIdParams; ++j) {
+      const int lo = i < j ? i : j;
+      const int hi = i < j ? j : i;
+      p_all_(i, j) -= anchor_.g(lo) * anchor_.pc(hi);
+    }
+  }
+  anchor_.rows = first + n;
+  if (anchor_.rows < kIdParams) return false;
+  anchor_.pending = false;
+  return true;
+}
+
+void Identifier::finish_anchor() {
+  while (!anchor_rows()) {
   }
 }
 
@@ -452,49 +554,14 @@ void Identifier::accumulate(const IdentifierInput& in) {
   acc_.sum_gyro2 += wdt * wdt * in.omega.squaredNorm();
 }
 
-void Identifier::update(const IdentifierInput& in) {
-  // Work on the latched window first: one group per tick (J, r, k, report).
-  switch (phase_) {
-    case Phase::kInertia:
-      if (c_.mode == IdentifierMode::kJoint) {
-        joint_gain();
-      } else {
-        update_inertia();
-      }
-      phase_ = Phase::kGain;
-      break;
-    case Phase::kGain:
-      if (c_.mode == IdentifierMode::kJoint) joint_gain_finish();
-      phase_ = Phase::kOffset;
-      break;
-    case Phase::kOffset:
-      if (c_.mode == IdentifierMode::kJoint) {
-        joint_apply();
-      } else {
-        update_offset();
-      }
-      phase_ = Phase::kApply;
-      break;
-    case Phase::kApply:
-      if (c_.mode == IdentifierMode::kJoint) joint_finish_covariance();
-      phase_ = Phase::kStrength;
-      break;
-    case Phase::kStrength:
-      if (c_.mode == IdentifierMode::kJoint) {
-        anchor_scale();
-        sync_blocks();
-      } else {
-        update_strengths();
-      }
-      phase_ = Phase::kReport;
-      break;
-    case Phase::kReport:
-      report();
-      phase_ = Phase::kIdle;
-      break;
-    case Phase::kIdle:
-      break;
-  }
+void Identifier::finish_step() {
+  for (int guard = 0; phase_ != Phase::kIdle && guard < 4 * kIdParams; ++guard) step_phase();
+}
+
+void Identifier::update(const IdentifierInput& in, bool background) {
+  // Work on the latched window first: one block per tick (J, gain rows, apply, covariance rows,
+  // strengths, report).
+  if (background) step_phase();
 
   const bool ok = in.omega_valid && in.omega.allFinite() &&
                   (sample_ < 0 || (in.force_valid && in.force.allFinite()));
@@ -506,6 +573,7 @@ void Identifier::update(const IdentifierInput& in) {
   }
   accumulate(in);
   if (sample_ == n_) {
+    finish_step();  // only when ticks were withheld from a window too short for the blocks
     latched_ = acc_;
     latched_noise_ = window_noise();
     ++counters_.windows;
@@ -514,6 +582,56 @@ void Identifier::update(const IdentifierInput& in) {
     acc_ = Window{};
     sample_ = -1;
     accumulate(in);
+  }
+}
+
+void Identifier::step_phase() {
+  switch (phase_) {
+    case Phase::kInertia:
+      if (c_.mode == IdentifierMode::kJoint) {
+        joint_gain();
+      } else {
+        update_inertia();
+      }
+      phase_ = Phase::kGain;
+      break;
+    case Phase::kGain:
+      if (c_.mode != IdentifierMode::kJoint || joint_gain_rows()) phase_ = Phase::kOffset;
+      break;
+    case Phase::kOffset:
+      if (c_.mode == IdentifierMode::kJoint) {
+        joint_apply();
+      } else {
+        update_offset();
+      }
+      phase_ = Phase::kApply;
+      break;
+    case Phase::kApply:
+      // Row blocks of the covariance update, then (its own tick) symmetrise and cap.
+      if (c_.mode != IdentifierMode::kJoint || joint_covariance_step()) {
+        if (c_.mode == IdentifierMode::kJoint) joint_finish_covariance();
+        phase_ = Phase::kStrength;
+      }
+      break;
+    case Phase::kStrength:
+      if (c_.mode == IdentifierMode::kJoint) {
+        anchor_scale();
+        phase_ = Phase::kAnchor;
+      } else {
+        update_strengths();
+        phase_ = Phase::kReport;
+      }
+      break;
+    case Phase::kAnchor:
+      if (anchor_rows()) phase_ = Phase::kReport;
+      break;
+    case Phase::kReport:
+      if (c_.mode == IdentifierMode::kJoint) sync_blocks();
+      report();
+      phase_ = Phase::kIdle;
+      break;
+    case Phase::kIdle:
+      break;
   }
 }
 

@@ -171,7 +171,10 @@ class Identifier {
   // Back to the priors and empty windows.
   void reset();
   // One tick.
-  void update(const IdentifierInput& in);
+  // `background`: whether this tick may carry a block of the latched window's step (the
+  // executive leaves it out on ticks that already carry other periodic work, e.g. the fault
+  // detector's window close). A step still running when the next window closes is finished then.
+  void update(const IdentifierInput& in, bool background = true);
 
   // Re-inflation on a declared change (a fault, a table switch): the group's covariance goes
   // back to its prior; the estimate is kept as the starting point.
@@ -197,7 +200,9 @@ class Identifier {
     double sum_alpha2{0.0};        // sum of the per-sample weights on L(omega), squared (I5)
     double sum_gyro2{0.0};         // sum of (w dt |omega|)^2 (I5)
   };
-  enum class Phase : std::uint8_t { kIdle, kInertia, kGain, kOffset, kApply, kStrength, kReport };
+  enum class Phase : std::uint8_t {
+    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport
+  };
 
   void accumulate(const IdentifierInput& in);
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
@@ -210,18 +215,24 @@ class Identifier {
   Mat3 consider_inertia() const;      // (I7)
   Mat3 consider_offset() const;
   Mat3 consider_strengths() const;
-  void joint_gain();         // (I13) gain of the joint step, first part
-  void joint_gain_finish();  // ... second part
+  void joint_gain();         // (I13) gain of the joint step: the linearisation
+  bool joint_gain_rows();    // ... a block of rows of P H'; then S and K (true when done)
   void joint_apply();
   void joint_covariance_rows(int first, int n);  // rows [first, first + n) of the P update
+  bool joint_covariance_step();    // a block of rows of the P update (true when all are done)
+  void symmetrise_rows(int first, int n);
   void joint_finish_covariance();  // the remaining rows, symmetrise, cap        // (I13), (I14)
                                    // apply it, guarded
   void sync_blocks();              // joint covariance -> per-group blocks
-  void anchor_scale();             // (I15)
+  void anchor_scale();             // (I15) the state, and the covariance's rank-one term
+  bool anchor_rows();              // ... a block of rows of the covariance (true when done)
+  void finish_anchor();            // ... every remaining row
   void update_inertia();
   void update_offset();
   void update_strengths();
   void report();
+  void step_phase();   // one block of the latched window's step
+  void finish_step();  // every remaining block at once
 
   IdentifierConfig c_{};
   int n_{200};                                // ticks per window
@@ -238,11 +249,20 @@ class Identifier {
   Mat16 p_k_{Mat16::Identity()};
   MatId p_all_{MatId::Identity()};            // kJoint: [a; r; k]
   std::array<bool, kThrusters> reference_{};  // thrusters that define the thrust scale
-  static constexpr int kSplit = 13;           // rows of P H' computed on the first gain tick
-  struct JointStep {                          // computed over two ticks, applied on the third
+  // The joint step is spread over ticks in row blocks (the Cortex-M7 tick budget): rows of P H'
+  // per tick while the gain is formed, rows of P per tick while the covariance is updated. For a
+  // window too short for that many ticks, configure() takes bigger blocks (every step must be done
+  // before the next window closes).
+  int gain_rows_per_tick_{4};
+  int cov_rows_per_tick_{1};
+  static constexpr int kSymmetriseRowsPerTick = 9;
+  struct JointStep {  // the gain over several ticks, applied on one, the covariance over several
     bool started{false};
     bool pending{false};
-    bool rows_pending{false};  // the covariance's last rows are still to be updated
+    bool rows_pending{false};  // covariance rows still to be updated
+    int gain_rows{0};          // rows of p_ht computed so far
+    int cov_rows{0};           // rows of P updated so far
+    int sym_rows{0};           // ... then symmetrised
     Eigen::Matrix<double, 3, kIdParams> h{Eigen::Matrix<double, 3, kIdParams>::Zero()};
     Eigen::Matrix<double, kIdParams, 3> dht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
     bool any_thruster{false};
@@ -253,6 +273,14 @@ class Identifier {
     Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
   };
   JointStep joint_{};
+  static constexpr int kAnchorRowsPerTick = 9;
+  struct AnchorStep {  // the thrust-scale anchor's covariance term, a block of rows per tick
+    bool pending{false};
+    int rows{0};
+    VecId pc{VecId::Zero()};  // P c
+    VecId g{VecId::Zero()};   // P c / (c' P c)
+  };
+  AnchorStep anchor_{};
 
   // Window in progress and the latched one.
   Window acc_{};

@@ -123,8 +123,24 @@ void Mekf::propagate(const Vec3& gyro_mean) {
   const Vec3 w = gyro_mean - bias_;
   beta_ = quat::multiply(beta_, rotation_increment(w, c_.dt)).normalized();
   const Mat6 phi = transition(w, c_.dt);
-  p_ = phi * p_ * phi.transpose() + q_;
-  p_ = 0.5 * (p_ + p_.transpose()).eval();
+  // Phi = [A B; 0 I] (transition), so Phi P Phi' by 3x3 blocks (P21 = P12'):
+  //   M1 = A P11 + B P12',  M2 = A P12 + B P22,
+  //   P11+ = M1 A' + M2 B',  P12+ = M2,  P22+ = P22;
+  // six 3x3 products instead of two 6x6 ones (the Cortex-M7 tick budget).
+  const Mat3 a = phi.topLeftCorner<3, 3>();
+  const Mat3 b = phi.topRightCorner<3, 3>();
+  const Mat3 p11 = p_.topLeftCorner<3, 3>();
+  const Mat3 p12 = p_.topRightCorner<3, 3>();
+  const Mat3 p22 = p_.bottomRightCorner<3, 3>();
+  const Mat3 m1 = a * p11 + b * p12.transpose();
+  const Mat3 m2 = a * p12 + b * p22;
+  const Mat3 n11 = m1 * a.transpose() + m2 * b.transpose();
+  const Mat3 n22 = p22 + q_.bottomRightCorner<3, 3>();
+  const Mat3 n12 = m2 + q_.topRightCorner<3, 3>();
+  p_.topLeftCorner<3, 3>() = 0.5 * (n11 + n11.transpose()) + q_.topLeftCorner<3, 3>();
+  p_.topRightCorner<3, 3>() = n12;
+  p_.bottomLeftCorner<3, 3>() = n12.transpose();
+  p_.bottomRightCorner<3, 3>() = 0.5 * (n22 + n22.transpose());
 }
 
 void Mekf::star_update(const Vec4& beta_meas) {
@@ -154,10 +170,27 @@ void Mekf::star_update(const Vec4& beta_meas) {
   ++counters_.updates;
   // K = P H' S^-1; Joseph form P = (I - K H) P (I - K H)' + K R K' keeps P symmetric PD.
   const Eigen::Matrix<double, 6, 3> k = p_.leftCols<3>() * s_inv;
-  Mat6 ikh = Mat6::Identity();
-  ikh.leftCols<3>() -= k;
-  p_ = ikh * p_ * ikh.transpose() + r_var_ * (k * k.transpose());
-  p_ = 0.5 * (p_ + p_.transpose()).eval();
+  // With K = [K1; K2] and G = I - K1, I - K H = [G 0; -K2 I], so by 3x3 blocks (P21 = P12'):
+  //   P11+ = G P11 G' + r K1 K1'
+  //   P12+ = G (P12 - P11 K2') + r K1 K2'
+  //   P22+ = K2 P11 K2' - (K2 P12)' - K2 P12 + P22 + r K2 K2'
+  const Mat3 k1 = k.topRows<3>();
+  const Mat3 k2 = k.bottomRows<3>();
+  const Mat3 g = Mat3::Identity() - k1;
+  const Mat3 p11 = p_.topLeftCorner<3, 3>();
+  const Mat3 p12 = p_.topRightCorner<3, 3>();
+  const Mat3 p22 = p_.bottomRightCorner<3, 3>();
+  const Mat3 gp11 = g * p11;
+  const Mat3 k2p11 = k2 * p11;
+  const Mat3 k2p12 = k2 * p12;
+  const Mat3 n11 = gp11 * g.transpose() + r_var_ * (k1 * k1.transpose());
+  const Mat3 n12 = g * p12 - gp11 * k2.transpose() + r_var_ * (k1 * k2.transpose());
+  const Mat3 n22 = k2p11 * k2.transpose() - k2p12.transpose() - k2p12 + p22 +
+                   r_var_ * (k2 * k2.transpose());
+  p_.topLeftCorner<3, 3>() = 0.5 * (n11 + n11.transpose());
+  p_.topRightCorner<3, 3>() = n12;
+  p_.bottomLeftCorner<3, 3>() = n12.transpose();
+  p_.bottomRightCorner<3, 3>() = 0.5 * (n22 + n22.transpose());
   const Vec6 dx = k * nu;
   // Reset: fold the attitude error into the quaternion, the bias error into the bias.
   const Vec3 dtheta = dx.head<3>();

@@ -98,6 +98,11 @@ class FaultDetector {
   void configure(const FaultDetectorParams& p, const RcsLayout& rcs, double u_max, double dt);
   void reset();  // scores and windows; latched faults are kept (clear() removes them)
   void set_model(const FaultModel& m);
+  // Whether the next valid update closes a window (the executive keeps other periodic work off
+  // that tick).
+  bool window_closes_next() const {
+    return p_.enabled && have_start_ && n_ + 1 >= p_.window_ticks;
+  }
   FaultEvents update(const FaultDetectorInput& in);
 
   // Ground overrides and what the flight does after isolation.
