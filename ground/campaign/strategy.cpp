@@ -16,6 +16,9 @@ std::optional<Strategy> parse_base(const std::string& name) {
     s.reference = ReferenceKind::kDpdRef;
   } else if (ref == "fuel_optimal") {
     s.reference = ReferenceKind::kFuelOptimal;
+  } else if (ref == "replan") {
+    s.reference = ReferenceKind::kReplan;
+    s.identify = true;  // the re-planner plans for the identified model
   } else if (ref == "fuel_optimal_study") {
     s.reference = ReferenceKind::kFuelOptimal;
     s.horizon = PlanHorizon::kStudy;
@@ -44,7 +47,8 @@ std::optional<Strategy> parse_strategy(const std::string& name) {
     const std::size_t next = name.find(':', at + 1);
     const std::string mod = name.substr(at + 1, next == std::string::npos ? next : next - at - 1);
     bool& flag = mod == "mekf" ? s->mekf : mod == "id" ? s->identify : s->fdi;
-    if ((mod != "mekf" && mod != "id" && mod != "fdi") || flag) return std::nullopt;
+    if (mod != "mekf" && mod != "id" && mod != "fdi") return std::nullopt;
+    if (flag && !(mod == "id" && s->replans())) return std::nullopt;  // replan implies :id
     flag = true;
     at = next;
   }
