@@ -175,6 +175,9 @@ int main(int argc, char** argv) {
     sub->add_option("--replan-horizon", spec.replan.horizon_factor,
                     "replan strategies: plan horizon in shortest despins from the current state")
         ->capture_default_str();
+    sub->add_option("--replan-min-horizon", spec.replan.min_horizon_s,
+                    "replan strategies: shortest plan horizon, s")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");

@@ -78,6 +78,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     pol.on_model_update = o.on_model_update;
     pol.min_interval_s = o.min_interval_s;
     pol.horizon_factor = o.horizon_factor;
+    pol.min_horizon_s = o.min_horizon_s;
     replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
   }
 #else

@@ -87,7 +87,8 @@ struct ReplanOptions {
   double error_fraction{0.1};      // re-plan when |omega_hat - omega_d| > this |omega_d| (+ floor)
   bool on_model_update{true};      // re-plan when the flight adopts an identified model
   double min_interval_s{120.0};    // between two plans
-  double horizon_factor{8.0};      // plan horizon, in shortest despins from the current state
+  double horizon_factor{8.0};      // plan horizon, in shortest despins from the current state,
+  double min_horizon_s{0.0};       // and at least this long
 };
 
 // One plan of the re-planner, and what the flight did with it.

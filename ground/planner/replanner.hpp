@@ -43,7 +43,8 @@ struct ReplanPolicy {
   bool on_model_update{true};       // re-plan when the flight adopted an identified model
   double min_interval_s{120.0};     // between two plans (also after a failed one)
   double latency_s{10.0};           // planning latency: delivered no earlier than t + latency
-  double horizon_factor{kHorizonFactor};  // first plan: t_f = factor x shortest despin
+  double horizon_factor{kHorizonFactor};  // t_f = factor x shortest despin from the state,
+  double min_horizon_s{0.0};              // but at least this long (the least fuel falls with t_f)
   double stop_rate_fraction{0.05};
   int max_plans{20};
 };
