@@ -101,6 +101,9 @@ std::optional<Delivery> Replanner::update(const gnc::GncTelemetry& tl) {
     t0_ = tl.t - nearest_sample_time(*flying_table_, tl.omega_hat);
     resync_ = false;
   }
+  if (pending_table_ == nullptr) {
+    if (const auto why = decide(tl)) plan_now(tl, *why);  // may be due at once (no latency)
+  }
   if (pending_table_ != nullptr) {
     if (tl.t + 1e-9 < records_[pending_record_].t_due) return std::nullopt;
     Delivery d;
@@ -122,7 +125,6 @@ std::optional<Delivery> Replanner::update(const gnc::GncTelemetry& tl) {
     ++delivered_;
     return d;
   }
-  if (const auto why = decide(tl)) plan_now(tl, *why);
   return std::nullopt;
 }
 
