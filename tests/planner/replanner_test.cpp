@@ -1,7 +1,7 @@
 // The re-planner on synthetic telemetry (case 1's flight table): the first plan starts from the rate
 // predicted for the switch and is handed over no earlier than t + latency; a plan the flight
-// refuses leaves the previous reference; a re-plan from a mid-despin state is warm-started from the
-// verifies and starts on the plan being flown.
+// refuses leaves the previous reference; a re-plan from a mid-despin state verifies and starts on
+// the plan being flown.
 #include <gtest/gtest.h>
 
 #include "gnc/guidance/trajectory.hpp"
