@@ -197,8 +197,12 @@ void Replanner::plan_now(const gnc::GncTelemetry& tl, ReplanTrigger why) {
   // Receding horizon: never shorter than the rest of the plan being flown, nor than horizon_factor
   // shortest despins from here (the least fuel falls with the horizon, steeply below ~4x: keeping
   // the first plan's end would make every re-plan dearer than the plan it replaces).
-  t_f = std::max(policy_.horizon_factor * t_lower, policy_.min_horizon_s);
-  if (flying_ != nullptr) t_f = std::max(t_f, t_end_ - tl.t);
+  t_f = policy_.horizon_factor * t_lower;
+  if (flying_ == nullptr) {
+    t_f = std::max(t_f, policy_.min_horizon_s);
+  } else {
+    t_f = std::max(t_f, t_end_ - tl.t);
+  }
   p.settings.t_final_max = t_f;
   std::vector<PlanSample> rest;
   if (flying_ != nullptr) {

@@ -15,8 +15,9 @@
 //                  periodic: period_s after the last plan;
 //                  tracking error: |omega_hat - omega_d| > error_fraction |omega_d| + error_floor;
 //                  model update: the flight adopted an identified model (adoption count grew);
-//   horizon      receding: horizon_factor shortest despins from the current state, and never
-//                shorter than the rest of the plan being flown;
+//   horizon      the first plan: horizon_factor shortest despins (at least min_horizon_s); a
+//                re-plan: the rest of the plan being flown, or horizon_factor shortest despins
+//                from the current state if that is longer (a fixed minimum would recede for ever);
 //   stop         once |omega_hat| < stop_rate_fraction |omega| at the first plan, or the plan's
 //                end is less than one shortest-despin time away (the tail is rest-to-rest).
 #pragma once
@@ -44,7 +45,8 @@ struct ReplanPolicy {
   double min_interval_s{120.0};     // between two plans (also after a failed one)
   double latency_s{10.0};           // planning latency: delivered no earlier than t + latency
   double horizon_factor{kHorizonFactor};  // t_f = factor x shortest despin from the state,
-  double min_horizon_s{0.0};              // but at least this long (the least fuel falls with t_f)
+  double min_horizon_s{0.0};              // the first plan at least this long (the least fuel
+                                          // falls with t_f); re-plans keep its end
   double stop_rate_fraction{0.05};
   int max_plans{20};
 };
