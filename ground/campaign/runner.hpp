@@ -82,7 +82,7 @@ struct FdiReport {
 struct ReplanOptions {
   double latency_s{10.0};          // a plan from the state at t is activated no earlier than t + latency
   double first_plan_s{300.0};      // identification on the D+PD reference at least this long
-  double first_plan_max_s{1200.0}; // first plan then even without a confident model
+  double first_plan_max_s{600.0};  // first plan then even without a confident model
   double period_s{600.0};          // periodic re-plan (<= 0: off)
   double error_fraction{0.1};      // re-plan when |omega_hat - omega_d| > this |omega_d| (+ floor)
   bool on_model_update{true};      // re-plan when the flight adopts an identified model

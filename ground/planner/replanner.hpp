@@ -37,7 +37,7 @@ namespace rocksteady::ground::planner {
 
 struct ReplanPolicy {
   double first_plan_s{300.0};       // identify at least this long before the first plan
-  double first_plan_max_s{1200.0};  // plan then even if the model is not confident yet
+  double first_plan_max_s{600.0};   // plan then even if the model is not confident yet
   double period_s{600.0};           // periodic re-plan (<= 0: off)
   double error_fraction{0.1};       // tracking-error trigger (<= 0: off)
   double error_floor{2e-4};         // rad/s
