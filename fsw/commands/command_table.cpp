@@ -24,8 +24,10 @@ constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
     // A TRACK plan was computed for its target: change the target in HOLD, not while tracking.
     {Opcode::kSetTarget, 3, 3, kAllButTrack, {real(-1, 1), real(-1, 1), real(-1, 1)}},
     {Opcode::kSetLaw, 1, 2, kAllModes, {integer(0, gnc::kLawCount - 1), integer(0, 2)}},
-    // Loading replaces the table; the one TRACK follows cannot be replaced (leave TRACK first).
-    {Opcode::kLoadTrajectory, 1, 1, kAllButTrack, {integer(0, kIdMax)}},
+    // Loading outside TRACK replaces the table at the boundary; in TRACK the validated table goes
+    // to the standby buffer and the core switches to it at the boundary (a re-plan), re-synchronising
+    // the reference to the estimate, or refuses it there as stale and keeps the active one.
+    {Opcode::kLoadTrajectory, 1, 1, kAllModes, {integer(0, kIdMax)}},
     {Opcode::kAbortUplink, 1, 1, kAllModes, {integer(0, kIdMax)}},
     {Opcode::kResetCounters, 0, 0, kAllModes, {}},
     {Opcode::kParamLoad,

@@ -136,8 +136,13 @@ bool UplinkLifecycle::hand_over(std::int32_t id, gnc::Gnc& core, EventLog& log) 
   const gnc::TrajectoryError e = core.load_trajectory(uplink_.table());
   if (e == gnc::TrajectoryError::kOk) {
     ++loaded_;
+    // In TRACK the table is staged: the core switches to it (trajectory_switched) or refuses it as
+    // stale (trajectory_stale) in this tick, after this event.
     log.emit(Severity::kInfo, EventId::kTrajectoryLoaded, id, uplink_.table().count,
-             "trajectory uplink %" PRId32 " loaded: %d samples", id, uplink_.table().count);
+             core.trajectories().switch_pending()
+                 ? "trajectory uplink %" PRId32 " staged: %d samples, switch at this boundary"
+                 : "trajectory uplink %" PRId32 " loaded: %d samples",
+             id, uplink_.table().count);
   } else {
     log.emit(Severity::kError, EventId::kTrajectoryRejected, id, static_cast<std::int32_t>(e),
              "trajectory uplink %" PRId32 " refused by the core: %s", id, gnc::to_string(e));

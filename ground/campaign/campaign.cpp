@@ -125,6 +125,7 @@ void write_results_json(const std::string& path, const CampaignReport& rep) {
                     {"plan_wall_s", r.plan_wall_s},
                     {"estimation", estimation_json(r.estimation)},
                     {"fdi", fdi_json(r.fdi)},
+                    {"replan", replan_json(r.replan)},
                     {"timeseries", r.timeseries_path},
                     {"plot", r.plot_path}});
   }
@@ -402,6 +403,7 @@ CampaignReport run_campaign(const CampaignSpec& spec, TrajectorySource& source, 
       opt.log_interval_s = spec.log_interval_s >= 0 ? spec.log_interval_s : d / 5000.0;
       if (!spec.write_timeseries && !spec.write_plots) opt.log_interval_s = 0.0;
       opt.progress_ticks = &ticks;
+      opt.replan = spec.replan;
       RunResult r;
       try {
         GncFlightSide core_only;

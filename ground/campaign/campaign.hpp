@@ -33,6 +33,7 @@ struct CampaignSpec {
   // The flight side: the flight application through the in-process HAL (the code that flies), or the
   // bare flight core (for comparison).
   bool use_flight_app{true};
+  ReplanOptions replan;  // the replan strategies' policy and planning latency
 };
 
 struct CampaignReport {

@@ -36,6 +36,28 @@ std::optional<double> to_opt(const nlohmann::json& j) {
 }
 }  // namespace
 
+nlohmann::json replan_json(const ReplanReport& r) {
+  nlohmann::json plans = nlohmann::json::array();
+  for (const ReplanEvent& e : r.events) {
+    plans.push_back({{"trigger", e.trigger},
+                     {"t_state_s", e.t_state_s},
+                     {"t_due_s", e.t_due_s},
+                     {"t_delivered_s", e.t_delivered_s},
+                     {"ok", e.ok},
+                     {"error", e.error},
+                     {"identified_model", e.identified},
+                     {"planned_fuel_kg", e.planned_fuel_kg},
+                     {"t_final_s", e.t_final_s},
+                     {"nodes", e.nodes},
+                     {"iterations", e.iterations},
+                     {"solve_wall_s", e.wall_s},
+                     {"upload_id", e.upload_id}});
+  }
+  return {{"enabled", r.enabled},   {"plans", r.plans},       {"failed", r.failed},
+          {"delivered", r.delivered}, {"switched", r.switched}, {"refused", r.refused},
+          {"events", plans}};
+}
+
 nlohmann::json fdi_json(const FdiReport& f) {
   return {{"enabled", f.enabled},
           {"first_suspicion_s", opt(f.first_suspicion_s)},

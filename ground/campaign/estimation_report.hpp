@@ -11,6 +11,7 @@ namespace rocksteady::campaign {
 nlohmann::json estimation_json(const EstimationReport& e);
 nlohmann::json fdi_json(const FdiReport& f);
 FdiReport fdi_from_json(const nlohmann::json& j);
+nlohmann::json replan_json(const ReplanReport& r);
 // Throws nlohmann::json::exception on a malformed object (the caller names the file).
 EstimationReport estimation_from_json(const nlohmann::json& j);
 

@@ -4,6 +4,7 @@
 // the flight core alone behind the same HAL devices is kept for comparison (--flight core).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -32,6 +33,25 @@ class FlightSide {
   // The flight core's output of the last tick (telemetry for the runner's time series).
   virtual const gnc::GncOutput& output() const = 0;
   virtual std::string name() const = 0;
+
+  // A plan from the re-planner, mid-run, through the same path as a ground upload: the chunked
+  // uplink, LOAD_TRAJECTORY, and (enter_track, the first plan) SET_LAW law with the fuel-optimal
+  // reference, which requests TRACK. Takes effect at the next tick boundary. false with the reason
+  // when the flight software refused a chunk or a command (nothing thrown: the run goes on with the
+  // plan it had). The default: this flight side cannot take uplinks during a run.
+  virtual bool uplink_plan(const gnc::TrajectoryTable& table, std::int32_t upload_id,
+                           bool enter_track, gnc::LawId law, std::string& why) {
+    (void)table;
+    (void)upload_id;
+    (void)enter_track;
+    (void)law;
+    why = "this flight side takes no uplink during a run (re-planning needs the flight application)";
+    return false;
+  }
+  // The flight's verdicts at the tick boundary on plans loaded while tracking (events
+  // trajectory_switched / trajectory_stale), counted since setup.
+  virtual int trajectory_switches() const { return 0; }
+  virtual int trajectory_refusals() const { return 0; }
 };
 
 // gnc::Gnc alone behind the same HAL devices (gyro, star tracker, thruster bank; no executive, no

@@ -32,6 +32,8 @@ void FswFlightSide::setup(const FlightSetup& s, hal::SensorSource& sensors,
   have_trajectory_ = s.trajectory != nullptr;
   seq_ = 0;
   ticks_ = 0;
+  switches_ = 0;
+  refusals_ = 0;
   started_ = false;
   if (s.trajectory != nullptr) {
     // The chunked uplink, exactly as the ground sends it over the bus.
@@ -52,6 +54,51 @@ void FswFlightSide::setup(const FlightSetup& s, hal::SensorSource& sensors,
   }
 }
 
+fsw::CommandAck FswFlightSide::try_command(fsw::Opcode op, std::initializer_list<double> args) {
+  fsw::GroundCommand c;
+  c.seq = ++seq_;
+  c.source = kCampaignSource;
+  c.opcode = static_cast<std::int32_t>(op);
+  c.arg_count = static_cast<std::int32_t>(args.size());
+  std::copy(args.begin(), args.end(), c.args.begin());
+  return computer_->submit(c);
+}
+
+bool FswFlightSide::uplink_plan(const gnc::TrajectoryTable& table, std::int32_t upload_id,
+                                bool enter_track, gnc::LawId law, std::string& why) {
+  // The chunked uplink exactly as the ground sends it over the bus (wire::make_chunk, then the
+  // flight side's bus mapping), then the commands.
+  const int chunks = wire::chunk_count(table.count);
+  rocksteady::trajectory_chunk_t msg;
+  fsw::TrajectoryChunk chunk;
+  for (int c = 0; c < chunks; ++c) {
+    if (!wire::make_chunk(table, upload_id, c, msg)) {
+      why = "trajectory table cannot be chunked";
+      return false;
+    }
+    fsw::bus::to_chunk(msg, chunk);
+    const fsw::ChunkStatus st = computer_->receive_chunk(chunk);
+    if (st != fsw::ChunkStatus::kStored) {
+      why = std::string("uplink chunk refused: ") + fsw::to_string(st);
+      return false;
+    }
+  }
+  fsw::CommandAck ack = try_command(fsw::Opcode::kLoadTrajectory, {double(upload_id)});
+  if (!ack.accepted) {
+    why = std::string("LOAD_TRAJECTORY refused: ") + ack.text;
+    try_command(fsw::Opcode::kAbortUplink, {double(upload_id)});  // free the uplink
+    return false;
+  }
+  if (enter_track) {
+    ack = try_command(fsw::Opcode::kSetLaw, {double(static_cast<int>(law)), 2.0});
+    if (!ack.accepted) {
+      why = std::string("SET_LAW (fuel-optimal reference) refused: ") + ack.text;
+      return false;
+    }
+  }
+  return true;
+}
+
 void FswFlightSide::command(fsw::Opcode op, std::initializer_list<double> args) {
   fsw::GroundCommand c;
   c.seq = ++seq_;
@@ -70,6 +117,8 @@ void FswFlightSide::step() {
   computer_->step();  // sensors in, thrusters out: through the ports
   fsw::Event e;
   while (computer_->pop_event(e)) {
+    if (e.id == fsw::EventId::kTrajectorySwitched) ++switches_;
+    if (e.id == fsw::EventId::kTrajectoryStale) ++refusals_;
   }
   // After the first tick (the estimator has a state), the ground's commands for this run; they take
   // effect at the next tick boundary.

@@ -23,9 +23,14 @@ class FswFlightSide final : public FlightSide {
   const gnc::GncOutput& output() const override { return computer_->core_output(); }
   std::string name() const override { return "fsw::FlightComputer"; }
   const fsw::FlightComputer& computer() const { return *computer_; }
+  bool uplink_plan(const gnc::TrajectoryTable& table, std::int32_t upload_id, bool enter_track,
+                   gnc::LawId law, std::string& why) override;
+  int trajectory_switches() const override { return switches_; }
+  int trajectory_refusals() const override { return refusals_; }
 
  private:
   void command(fsw::Opcode op, std::initializer_list<double> args);
+  fsw::CommandAck try_command(fsw::Opcode op, std::initializer_list<double> args);
 
   std::unique_ptr<fsw::FlightComputer> computer_;  // large (two trajectory tables): once, on the heap
   fsw::FakeClock clock_{};  // lockstep: the plant owns time; execution-time statistics read 0
@@ -34,6 +39,8 @@ class FswFlightSide final : public FlightSide {
   std::int64_t seq_{0};
   int ticks_{0};
   bool started_{false};
+  int switches_{0};
+  int refusals_{0};
 };
 
 }  // namespace rocksteady::campaign

@@ -159,6 +159,25 @@ int main(int argc, char** argv) {
                     "app: the flight application through the in-process HAL; core: gnc::Gnc alone")
         ->check(CLI::IsMember({"app", "core"}))
         ->capture_default_str();
+    sub->add_option("--replan-latency", spec.replan.latency_s,
+                    "replan strategies: planning latency, s (a plan from the state at t is "
+                    "activated no earlier than t + latency)")
+        ->capture_default_str();
+    sub->add_option("--replan-period", spec.replan.period_s,
+                    "replan strategies: periodic re-plan, s (0: off)")
+        ->capture_default_str();
+    sub->add_option("--replan-first", spec.replan.first_plan_s,
+                    "replan strategies: identify on the D+PD reference at least this long, s")
+        ->capture_default_str();
+    sub->add_option("--replan-first-max", spec.replan.first_plan_max_s,
+                    "replan strategies: first plan by then even without a confident model, s")
+        ->capture_default_str();
+    sub->add_option("--replan-horizon", spec.replan.horizon_factor,
+                    "replan strategies: plan horizon in shortest despins from the current state")
+        ->capture_default_str();
+    sub->add_option("--replan-min-horizon", spec.replan.min_horizon_s,
+                    "replan strategies: shortest plan horizon, s")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");
@@ -241,6 +260,13 @@ int main(int argc, char** argv) {
       if (!r.timeseries_path.empty()) std::cout << "  time series         " << r.timeseries_path << "\n";
     }
     if (!r.note.empty()) std::cout << "  note: " << r.note << "\n";
+    for (const campaign::ReplanEvent& e : r.replan.events) {
+      std::printf("  plan %-14s from t=%8.1f s, due %8.1f s, delivered %8.1f s: %s%s, %.3f kg over "
+                  "%.0f s, %d nodes, %.2f s to solve\n",
+                  e.trigger.c_str(), e.t_state_s, e.t_due_s, e.t_delivered_s,
+                  e.ok ? "ok" : "failed: ", e.ok ? "" : e.error.c_str(), e.planned_fuel_kg,
+                  e.t_final_s, e.nodes, e.wall_s);
+    }
   } else {
     std::ifstream table(rep.results_md);
     std::cout << table.rdbuf() << "\n";

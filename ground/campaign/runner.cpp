@@ -3,12 +3,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
+#include <memory>
 
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/math/rotation.hpp"
 #include "ground/campaign/plant_binding.hpp"
 #include "ground/plant/plant.hpp"
+#ifdef ROCKSTEADY_HAVE_PLANNER
+#include "ground/planner/replanner.hpp"
+#endif
 
 namespace rocksteady::campaign {
 
@@ -56,6 +61,33 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;
   flight.setup(fs, ports, ports);
   if (options.on_start) options.on_start(plant);
+
+  // The re-planner, in simulated time: it reads the flight's telemetry each tick and uplinks its
+  // plans through the flight side (chunks + LOAD_TRAJECTORY), no earlier than t + latency.
+#ifdef ROCKSTEADY_HAVE_PLANNER
+  std::unique_ptr<ground::planner::Replanner> replanner;
+  int refusals_seen = 0;
+  if (strategy.replans()) {
+    ground::planner::ReplanPolicy pol;
+    const ReplanOptions& o = options.replan;
+    pol.latency_s = o.latency_s;
+    pol.first_plan_s = o.first_plan_s;
+    pol.first_plan_max_s = o.first_plan_max_s;
+    pol.period_s = o.period_s;
+    pol.error_fraction = o.error_fraction;
+    pol.on_model_update = o.on_model_update;
+    pol.min_interval_s = o.min_interval_s;
+    pol.horizon_factor = o.horizon_factor;
+    pol.min_horizon_s = o.min_horizon_s;
+    replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
+  }
+#else
+  if (strategy.replans()) {
+    r.status = RunStatus::kNoReference;
+    r.note = "no reference: re-planning needs the planner (not built into this campaign)";
+    return r;
+  }
+#endif
 
   const double dt = setup.truth.control_period_s;
   const double duration = options.duration_s >= 0.0 ? options.duration_s : setup.duration_s;
@@ -146,6 +178,20 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     flight.step();
     const gnc::GncOutput& out = flight.output();
     score_estimate(out);
+#ifdef ROCKSTEADY_HAVE_PLANNER
+    if (replanner) {
+      if (flight.trajectory_refusals() > refusals_seen) {
+        refusals_seen = flight.trajectory_refusals();
+        replanner->refused("trajectory_stale at the switch");
+      }
+      if (const auto d = replanner->update(out.telemetry)) {
+        std::string why;
+        if (!flight.uplink_plan(*d->table, d->upload_id, d->first, fs.params.law, why)) {
+          replanner->refused(why);
+        }
+      }
+    }
+#endif
     if (fs.params.fdi.enabled) {
       const gnc::FdiTelemetry& f = out.telemetry.fdi;
       FdiReport& d = r.fdi;
@@ -218,6 +264,49 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   for (int i = 0; i < 16; ++i) {
     r.fdi.confirmations += (((r.fdi.confirmed_on | r.fdi.confirmed_off) >> i) & 1u) ? 1 : 0;
   }
+#ifdef ROCKSTEADY_HAVE_PLANNER
+  if (replanner) {
+    ReplanReport& rep = r.replan;
+    rep.enabled = true;
+    rep.switched = flight.trajectory_switches();
+    rep.refused = flight.trajectory_refusals();
+    for (const ground::planner::ReplanRecord& x : replanner->records()) {
+      ReplanEvent e;
+      e.trigger = ground::planner::to_string(x.trigger);
+      e.t_state_s = x.t_state;
+      e.t_due_s = x.t_due;
+      e.t_delivered_s = x.t_delivered;
+      e.ok = x.ok;
+      e.error = x.error;
+      e.identified = x.identified;
+      e.planned_fuel_kg = x.fuel_kg;
+      e.t_final_s = x.t_final;
+      e.nodes = x.nodes;
+      e.iterations = x.iterations;
+      e.wall_s = x.wall_s;
+      e.upload_id = x.upload_id;
+      rep.plans += x.ok || x.t_delivered >= 0.0 ? 1 : 0;
+      rep.failed += x.ok ? 0 : 1;
+      rep.delivered += x.ok && x.t_delivered >= 0.0 ? 1 : 0;
+      r.plan_wall_s += x.wall_s;
+      rep.events.push_back(e);
+    }
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "re-planner: %d plans delivered (%d switched in TRACK, %d refused stale), %d "
+                  "failed; latency %.0f s",
+                  rep.delivered, rep.switched, rep.refused, rep.failed, options.replan.latency_s);
+    r.note = buf;
+    if (rep.delivered == 0 && r.status == RunStatus::kOk) {
+      for (const ReplanEvent& e : rep.events) {
+        if (!e.error.empty()) {
+          r.note += "; first failure: " + e.error;
+          break;
+        }
+      }
+    }
+  }
+#endif
   r.ticks = plant.ticks();
   r.clipped_ticks = plant.clipped_periods();
   r.sim_s = plant.t();

@@ -77,6 +77,47 @@ struct FdiReport {
   std::uint32_t suspicions{0};
 };
 
+// The re-planner's policy for the replan strategies (ground/planner/replanner.hpp, ReplanPolicy):
+// all times are simulated seconds.
+struct ReplanOptions {
+  double latency_s{10.0};          // a plan from the state at t is activated no earlier than t + latency
+  double first_plan_s{300.0};      // identification on the D+PD reference at least this long
+  double first_plan_max_s{600.0};  // first plan then even without a confident model
+  double period_s{600.0};          // periodic re-plan (<= 0: off)
+  double error_fraction{0.1};      // re-plan when |omega_hat - omega_d| > this |omega_d| (+ floor)
+  bool on_model_update{true};      // re-plan when the flight adopts an identified model
+  double min_interval_s{120.0};    // between two plans
+  double horizon_factor{8.0};      // plan horizon, in shortest despins from the current state,
+  double min_horizon_s{0.0};       // and at least this long
+};
+
+// One plan of the re-planner, and what the flight did with it.
+struct ReplanEvent {
+  std::string trigger;       // first | periodic | tracking_error | model_update
+  double t_state_s{0.0};     // the state it was planned from
+  double t_due_s{0.0};       // t_state + latency
+  double t_delivered_s{-1.0};  // uplinked (< 0: never)
+  bool ok{false};
+  std::string error;
+  bool identified{false};    // planned for the identified model
+  double planned_fuel_kg{0.0};
+  double t_final_s{0.0};
+  int nodes{0};
+  int iterations{0};
+  double wall_s{0.0};
+  int upload_id{-1};
+};
+
+struct ReplanReport {
+  bool enabled{false};
+  int plans{0};      // solved and verified
+  int failed{0};     // planner, validation or flight refusals
+  int delivered{0};  // uplinked and loaded
+  int switched{0};   // trajectory_switched at a boundary (re-plans while tracking)
+  int refused{0};    // trajectory_stale at a boundary
+  std::vector<ReplanEvent> events;
+};
+
 enum class RunStatus { kOk, kNoReference, kError };
 const char* to_string(RunStatus s);
 
@@ -105,6 +146,7 @@ struct RunResult {
   double plan_wall_s{0.0};
   EstimationReport estimation;
   FdiReport fdi;
+  ReplanReport replan;
   std::vector<TimeRow> series;  // decimated
   std::string timeseries_path;
   std::string plot_path;
@@ -117,6 +159,7 @@ struct RunOptions {
   // Called once before the first tick with the plant as built (after the flight side's setup), so
   // a caller can read back the models actually flown.
   std::function<void(const plant::Plant&)> on_start;
+  ReplanOptions replan;  // the replan strategies' policy and planning latency
 };
 
 // Runs one case with one strategy. `trajectory` is required for fuel_optimal strategies; pass null

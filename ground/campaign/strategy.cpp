@@ -16,6 +16,9 @@ std::optional<Strategy> parse_base(const std::string& name) {
     s.reference = ReferenceKind::kDpdRef;
   } else if (ref == "fuel_optimal") {
     s.reference = ReferenceKind::kFuelOptimal;
+  } else if (ref == "replan") {
+    s.reference = ReferenceKind::kReplan;
+    s.identify = true;  // the re-planner plans for the identified model
   } else if (ref == "fuel_optimal_study") {
     s.reference = ReferenceKind::kFuelOptimal;
     s.horizon = PlanHorizon::kStudy;
@@ -40,11 +43,13 @@ std::optional<Strategy> parse_strategy(const std::string& name) {
   if (!s) return std::nullopt;
   s->name = name;
   std::size_t at = colon;
+  bool id_given = false;  // ":id" given (replan implies it; it may still be written once)
   while (at != std::string::npos) {
     const std::size_t next = name.find(':', at + 1);
     const std::string mod = name.substr(at + 1, next == std::string::npos ? next : next - at - 1);
-    bool& flag = mod == "mekf" ? s->mekf : mod == "id" ? s->identify : s->fdi;
+    bool& flag = mod == "mekf" ? s->mekf : mod == "id" ? id_given : s->fdi;
     if ((mod != "mekf" && mod != "id" && mod != "fdi") || flag) return std::nullopt;
+    if (mod == "id") s->identify = true;
     flag = true;
     at = next;
   }

@@ -10,7 +10,9 @@
 
 namespace rocksteady::campaign {
 
-enum class ReferenceKind { kDpdRef, kFuelOptimal };
+// kReplan: identify on the D+PD reference first, then plan from the current state with the
+// identified model and TRACK, re-planning on a policy (ground/planner/replanner.hpp).
+enum class ReferenceKind { kDpdRef, kFuelOptimal, kReplan };
 
 // The fuel-optimal plan's final time: the planner's default (8x the shortest despin), or the study's
 // (ground/planner kStudyHorizon, the option "study-horizon": reference name fuel_optimal_study).
@@ -27,11 +29,15 @@ struct Strategy {
   bool mekf{false};
   bool identify{false};
   bool fdi{false};  // ":fdi": thruster fault detection and isolation on
+  // A plan before the run (uplinked before the first tick).
   bool needs_trajectory() const { return reference == ReferenceKind::kFuelOptimal; }
+  // Plans made during the run by the re-planner, in simulated time.
+  bool replans() const { return reference == ReferenceKind::kReplan; }
 };
 
 // Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal,
-// fuel_optimal_study (the fuel-optimal plan with the study's horizon); optional suffixes ":mekf",
+// fuel_optimal_study (the fuel-optimal plan with the study's horizon), replan (identification on
+// the D+PD reference, then on-line fuel-optimal re-planning; implies ":id"); optional suffixes ":mekf",
 // ":id" and ":fdi" in any order ("ntcl+dpd_ref:mekf:id", "dpd:id:fdi").
 std::optional<Strategy> parse_strategy(const std::string& name);
 // The six columns of the study's results table, in its order.

@@ -53,7 +53,8 @@ const std::vector<CommandHelp> kHelp{
     {"reset-counters", "reset-counters",
      "reset the command/health counters (cycle counts are kept)"},
     {"load-trajectory", "load-trajectory UPLOAD_ID",
-     "hand a completely uplinked trajectory to the flight core (not in TRACK)"},
+     "hand a completely uplinked trajectory to the flight core (in TRACK: switched to at the next "
+     "tick boundary)"},
     {"abort-uplink", "abort-uplink UPLOAD_ID", "discard a trajectory uplink in progress"},
     {"key-rotate", "key-rotate KEY_ID",
      "make command key KEY_ID (higher than the active one) active at the next tick; then send "

@@ -230,6 +230,7 @@ DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfi
       campaign::RunOptions opt;
       opt.duration_s = spec.duration_s;
       opt.log_interval_s = options.log_interval_s;
+      opt.replan = spec.replan;
       Readback seen;
       bool have = false;
       opt.on_start = [&](const plant::Plant& p) {

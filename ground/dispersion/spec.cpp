@@ -366,6 +366,24 @@ DispersionSpec load_spec(const std::string& path) {
     }
   }
 
+  if (doc.has("replan")) {
+    // The replan strategies' policy (runner.hpp ReplanOptions); every key optional.
+    config::MapReader r = doc.map("replan");
+    if (r.has("latency_s")) s.replan.latency_s = r.non_negative("latency_s");
+    if (r.has("first_plan_s")) s.replan.first_plan_s = r.non_negative("first_plan_s");
+    if (r.has("first_plan_max_s")) s.replan.first_plan_max_s = r.non_negative("first_plan_max_s");
+    if (r.has("period_s")) s.replan.period_s = r.non_negative("period_s");
+    if (r.has("error_fraction")) s.replan.error_fraction = r.non_negative("error_fraction");
+    if (r.has("on_model_update")) s.replan.on_model_update = r.boolean("on_model_update");
+    if (r.has("min_interval_s")) s.replan.min_interval_s = r.non_negative("min_interval_s");
+    if (r.has("horizon_factor")) s.replan.horizon_factor = r.positive("horizon_factor");
+    if (r.has("min_horizon_s")) s.replan.min_horizon_s = r.non_negative("min_horizon_s");
+    if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
+      r.fail("first_plan_max_s", "must not be below first_plan_s");
+    }
+    r.finish();
+  }
+
   if (doc.has("faults")) load_faults(doc.map("faults"), path, s.faults);
   if (!s.faults.case_files.empty()) {
     // Each draw flies a study case file: no dispersed parameters.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "ground/campaign/runner.hpp"
 #include "ground/campaign/strategy.hpp"
 #include "ground/plant/plant.hpp"
 
@@ -85,6 +86,8 @@ struct DispersionSpec {
   Sampling sampling{Sampling::kRandom};
   double duration_s{1e5};
   std::vector<campaign::Strategy> strategies;
+  // The replan strategies' policy and planning latency (optional map `replan`).
+  campaign::ReplanOptions replan;
   // The flight allocator for every run (optional key; default: the GNC file's).
   bool override_allocator{false};
   gnc::AllocatorKind allocator{gnc::AllocatorKind::kPseudoInverse};

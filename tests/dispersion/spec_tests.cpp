@@ -27,6 +27,22 @@ TEST(DispersionFiles, ShippedFilesLoad) {
   EXPECT_EQ(b.allocator, gnc::AllocatorKind::kL1);
 }
 
+// The re-planning strategy and its policy (optional map `replan`).
+TEST(DispersionFiles, ReplanStrategyAndItsPolicyLoad) {
+  const std::string text =
+      replace_line(replace_line(base_spec(), "[dpd, ntcl+dpd_ref]", "[ntcl+dpd_ref, ntcl+replan]"),
+                   "sampling: random",
+                   "sampling: random\nreplan: {latency_s: 25, period_s: 0, min_horizon_s: 1400}");
+  const DispersionSpec s = load_spec(test::write_temp("replan.yaml", text));
+  ASSERT_EQ(s.strategies.size(), 2u);
+  EXPECT_TRUE(s.strategies[1].replans());
+  EXPECT_TRUE(s.strategies[1].identify);
+  EXPECT_EQ(s.replan.latency_s, 25.0);
+  EXPECT_EQ(s.replan.period_s, 0.0);
+  EXPECT_EQ(s.replan.min_horizon_s, 1400.0);
+  EXPECT_EQ(s.replan.first_plan_s, campaign::ReplanOptions{}.first_plan_s);  // default kept
+}
+
 struct Bad {
   const char* what;
   std::string from, to;
@@ -73,6 +89,13 @@ TEST(DispersionFiles, EachMalformedClassNamesFileKeyAndReason) {
       {"bad name", "name: t", "name: a b", "name: must be a non-empty word"},
       {"bad allocator", "sampling: random", "sampling: random\nallocator: l2",
        "allocator: expected pinv or l1"},
+      {"negative replan latency", "sampling: random", "sampling: random\nreplan: {latency_s: -1}",
+       "replan.latency_s: must not be negative"},
+      {"unknown replan key", "sampling: random", "sampling: random\nreplan: {latency: 5}",
+       "replan.latency"},
+      {"first plan deadline before the first plan", "sampling: random",
+       "sampling: random\nreplan: {first_plan_s: 500, first_plan_max_s: 100}",
+       "replan.first_plan_max_s: must not be below first_plan_s"},
   };
   for (const Bad& b : cases) {
     const std::string text = b.to.empty() && b.what == std::string("missing key")

@@ -78,5 +78,54 @@ TEST(FlightAppAllocation, TheFlightLoopAllocatesNothingAfterInit) {
   EXPECT_EQ(h.cmd_rejected, 3u);
 }
 
+// A re-plan while tracking: chunks, LOAD_TRAJECTORY in TRACK, the switch at the boundary and a
+// stale plan refused there, all without the heap.
+TEST(FlightAppAllocation, ReplanInTrackSwitchesAtTheBoundaryWithoutTheHeap) {
+  test::AppFixture f;
+  const test::V3 w0(0.05, -0.02, 0.01);
+  f.loop.truth.omega = w0;
+  f.ticks(2);
+  auto first = std::make_unique<gnc::TrajectoryTable>();
+  test::linear_despin_table(w0, 20.0, 70, *first);
+  for (const auto& c : test::chunks_of(*first, 1)) f.app->receive_chunk(c);
+  ASSERT_TRUE(f.app->submit(test::command(1, Opcode::kLoadTrajectory, {1.0})).accepted);
+  ASSERT_TRUE(f.app->submit(test::command(2, Opcode::kSetMode, {3.0})).accepted);
+  f.ticks(2);
+  ASSERT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  auto replan = std::make_unique<gnc::TrajectoryTable>();
+  test::linear_despin_table(f.app->core_output().telemetry.omega_hat, 40.0, 91, *replan);
+  auto stale = std::make_unique<gnc::TrajectoryTable>();
+  test::linear_despin_table(-w0, 40.0, 91, *stale);
+  const std::vector<TrajectoryChunk> c_replan = test::chunks_of(*replan, 2);
+  const std::vector<TrajectoryChunk> c_stale = test::chunks_of(*stale, 3);
+  const GroundCommand load_replan = test::command(3, Opcode::kLoadTrajectory, {2.0});
+  const GroundCommand load_stale = test::command(4, Opcode::kLoadTrajectory, {3.0});
+  Event e;
+  int switched = 0;
+  int refused = 0;
+  long allocations = -1;
+  {
+    const Armed armed;
+    for (int i = 0; i < 60; ++i) {
+      if (i < static_cast<int>(c_replan.size())) f.app->receive_chunk(c_replan[i]);
+      if (i == 5) f.app->submit(load_replan);
+      if (i >= 10 && i < 10 + static_cast<int>(c_stale.size())) f.app->receive_chunk(c_stale[i - 10]);
+      if (i == 20) f.app->submit(load_stale);
+      f.loop.tick(*f.app, f.out);
+      while (f.app->pop_event(e)) {
+        switched += e.id == EventId::kTrajectorySwitched ? 1 : 0;
+        refused += e.id == EventId::kTrajectoryStale ? 1 : 0;
+      }
+      f.clock.advance(50000000);
+    }
+    allocations = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(switched, 1);
+  EXPECT_EQ(refused, 1);
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  EXPECT_EQ(f.app->core().trajectories().active().checksum, replan->checksum);
+}
+
 }  // namespace
 }  // namespace rocksteady::fsw

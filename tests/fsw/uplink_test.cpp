@@ -2,6 +2,7 @@
 // headers, and the hand-over to the flight core at the tick boundary.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 
 #include "fsw/uplink/trajectory_uplink.hpp"
@@ -176,33 +177,121 @@ TEST(TrajectoryUplinkApp, OnlyAnAbortEndsAnUnfinishedUploadAndAnotherUploadIsRef
   EXPECT_EQ(test::count_events(ev, EventId::kUplinkAbandoned), 1);  // the abort
 }
 
-TEST(TrajectoryUplinkApp, TrackCannotHaveItsTableReplaced) {
+// A re-plan while tracking: LOAD_TRAJECTORY in TRACK validates the uplinked table into the standby
+// buffer and the core switches to it at the tick boundary (trajectory_switched), re-synchronising
+// the reference to the estimate; TRACK never stops and the target stays locked.
+TEST(TrajectoryUplinkApp, TrackSwitchesToAnUplinkedReplanAtTheTickBoundary) {
   AppFixture f;
+  const V3 w0(0.05, -0.02, 0.01);
+  f.loop.truth.omega = w0;
   f.ticks(2);
-  Plan plan(70);
-  for (const auto& c : test::chunks_of(*plan.table, 1)) f.app->receive_chunk(c);
+  Plan first(70, 20.0);
+  for (const auto& c : test::chunks_of(*first.table, 1)) f.app->receive_chunk(c);
   ASSERT_TRUE(f.send(Opcode::kLoadTrajectory, {1.0}).accepted);
   ASSERT_TRUE(f.send(Opcode::kSetMode, {3.0}).accepted);
   f.ticks(1);
   ASSERT_EQ(f.app->mode(), gnc::Mode::kTrack);
-  // A second plan can be uplinked while tracking, but not loaded.
-  for (const auto& c : test::chunks_of(*plan.table, 2)) {
+  f.ticks(20);  // 1 s into the plan
+  test::drain(*f.app);
+  const int index_before = f.app->core().trajectories().active_index();
+
+  // The re-plan: from the rate now, a slower despin (40 s), 91 samples.
+  const V3 w_now = f.app->core_output().telemetry.omega_hat;
+  gnc::TrajectoryTable replan{};
+  test::linear_despin_table(w_now, 40.0, 91, replan);
+  for (const auto& c : test::chunks_of(replan, 2)) {
     EXPECT_EQ(f.app->receive_chunk(c), ChunkStatus::kStored);
   }
-  EXPECT_EQ(f.send(Opcode::kLoadTrajectory, {2.0}).reason, RejectReason::kNotAllowedInMode);
+  EXPECT_GT((f.app->core_output().telemetry.q_d - f.app->core_output().telemetry.q_hat).norm(),
+            0.0);
+  const CommandAck a = f.send(Opcode::kLoadTrajectory, {2.0});
+  ASSERT_TRUE(a.accepted) << a.text;
+  // Still the first table until the boundary.
+  EXPECT_EQ(f.app->core().trajectories().active_index(), index_before);
+  EXPECT_EQ(f.app->core().trajectories().active().count, 70);
+  f.ticks(1);
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  EXPECT_NE(f.app->core().trajectories().active_index(), index_before);
+  EXPECT_EQ(f.app->core().trajectories().active().count, 91);
+  EXPECT_EQ(f.app->core().trajectories().active().samples[90].t, 40.0);
+  EXPECT_FALSE(f.app->core().trajectories().switch_pending());
+  EXPECT_EQ(f.app->health().trajectories_loaded, 2u);
+  const auto ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryLoaded), 1);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectorySwitched), 1);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryStale), 0);
+  // The reference re-synchronised to the estimate at the switch: q_d restarts at q_hat (before it,
+  // q_d had been propagated along the first plan for a second and differed from q_hat).
+  EXPECT_LT((f.app->core_output().telemetry.q_d - f.app->core_output().telemetry.q_hat).norm(),
+            1e-12);
+  // Still tracking afterwards, and the rate keeps falling along the new plan.
+  f.ticks(200);
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  EXPECT_LT(f.loop.truth.omega.norm(), w_now.norm());
+  // Other rules of TRACK are unchanged: the target stays, D+PD cannot track.
   EXPECT_EQ(f.send(Opcode::kSetTarget, {0.1, 0.0, 0.0}).reason, RejectReason::kNotAllowedInMode);
   const CommandAck dpd = f.send(Opcode::kSetLaw, {5.0});
   EXPECT_EQ(dpd.reason, RejectReason::kNotAllowedInMode);
   EXPECT_EQ(dpd.detail, static_cast<std::int32_t>(gnc::TransitionCheck::kLawCannotTrack));
-  // D+PD with its own reference: leave TRACK for DETUMBLE first, the law follows a tick later.
-  ASSERT_TRUE(f.send(Opcode::kSetLaw, {5.0, 1.0}).accepted);
+}
+
+// A stale re-plan (no sample near the rate estimate: planned for another state) is loaded, refused
+// at the boundary (trajectory_stale), and TRACK keeps following the table it had; a failed one
+// (bad CRC) is refused at the command and changes nothing.
+TEST(TrajectoryUplinkApp, StaleOrFailedReplanInTrackIsRefusedAndTheActiveTableKept) {
+  AppFixture f;
+  const V3 w0(0.05, -0.02, 0.01);
+  f.loop.truth.omega = w0;
+  f.ticks(2);
+  Plan first(70, 20.0);
+  for (const auto& c : test::chunks_of(*first.table, 1)) f.app->receive_chunk(c);
+  ASSERT_TRUE(f.send(Opcode::kLoadTrajectory, {1.0}).accepted);
+  ASSERT_TRUE(f.send(Opcode::kSetMode, {3.0}).accepted);
   f.ticks(1);
-  // At rest, DETUMBLE hands over to HOLD in the same tick (auto-hold at omega_switch).
-  EXPECT_TRUE(f.app->mode() == gnc::Mode::kDetumble || f.app->mode() == gnc::Mode::kHold);
-  EXPECT_EQ(f.app->active_params().law, gnc::LawId::kNtcl);
+  ASSERT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  test::drain(*f.app);
+  const int index_before = f.app->core().trajectories().active_index();
+
+  // Failed: one corrupted value under the original CRC.
+  gnc::TrajectoryTable bad{};
+  const V3 w_now = f.app->core_output().telemetry.omega_hat;
+  test::linear_despin_table(w_now, 30.0, 50, bad);
+  auto chunks = test::chunks_of(bad, 2);
+  chunks[0].samples[3].omega_d.y() += 1e-6;
+  for (const auto& c : chunks) f.app->receive_chunk(c);
+  const CommandAck a = f.send(Opcode::kLoadTrajectory, {2.0});
+  EXPECT_EQ(a.reason, RejectReason::kTrajectoryRejected);
+  EXPECT_EQ(a.detail, static_cast<std::int32_t>(gnc::TrajectoryError::kBadChecksum));
   f.ticks(1);
-  EXPECT_EQ(f.app->active_params().law, gnc::LawId::kDpd);
-  EXPECT_TRUE(f.send(Opcode::kLoadTrajectory, {2.0}).accepted);
+  EXPECT_EQ(f.app->core().trajectories().active_index(), index_before);
+  EXPECT_EQ(f.app->core().trajectories().active().count, 70);
+
+  // Stale: a valid despin from the opposite rate. Its samples (1 - s)(-w) are at least |w| from
+  // the estimate w, above the 20 % tolerance; it validates, loads, and is refused at the boundary.
+  const V3 w = f.app->core_output().telemetry.omega_hat;
+  gnc::TrajectoryTable stale{};
+  test::linear_despin_table(-w, 30.0, 50, stale);
+  double nearest = 1e9;
+  for (int i = 0; i < stale.count; ++i) {
+    nearest = std::min(nearest, (stale.samples[i].omega_d - w).norm());
+  }
+  ASSERT_GT(nearest, gnc::stale_tolerance(w) * 1.5);  // independent check: it really is stale
+  for (const auto& c : test::chunks_of(stale, 3)) {
+    EXPECT_EQ(f.app->receive_chunk(c), ChunkStatus::kStored);
+  }
+  ASSERT_TRUE(f.send(Opcode::kLoadTrajectory, {3.0}).accepted);
+  f.ticks(1);
+  EXPECT_EQ(f.app->mode(), gnc::Mode::kTrack);
+  EXPECT_EQ(f.app->core().trajectories().active_index(), index_before);
+  EXPECT_EQ(f.app->core().trajectories().active().count, 70);
+  EXPECT_EQ(f.app->core().trajectories().active().checksum, first.table->checksum);
+  EXPECT_FALSE(f.app->core().trajectories().switch_pending());
+  const auto ev = test::drain(*f.app);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryRejected), 1);  // the bad CRC
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectoryStale), 1);
+  EXPECT_EQ(test::count_events(ev, EventId::kTrajectorySwitched), 0);
+  // The uplink path is free again for the next re-plan.
+  EXPECT_FALSE(f.app->uplink().active());
 }
 
 // The finding: a table with omega_d_dot = +-1 rad/s^2 and a recomputed CRC loaded, and TRACK drove

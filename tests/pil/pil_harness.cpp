@@ -23,6 +23,11 @@ namespace rocksteady::pil {
 
 std::string fsw_exe() { return ROCKSTEADY_FSW_EXE; }
 std::string plant_exe() { return ROCKSTEADY_PLANT_EXE; }
+#ifdef ROCKSTEADY_PLANNER_EXE
+std::string planner_exe() { return ROCKSTEADY_PLANNER_EXE; }
+#else
+std::string planner_exe() { return "rocksteady-planner"; }
+#endif
 std::string config_dir() { return ROCKSTEADY_CONFIG_DIR; }
 
 std::string scratch_dir(const std::string& name) {

@@ -23,6 +23,7 @@ namespace rocksteady::pil {
 // Paths of the built programs and the configuration folder (from CMake).
 std::string fsw_exe();
 std::string plant_exe();
+std::string planner_exe();  // rocksteady-planner (when built)
 std::string config_dir();
 // A fresh scratch folder for one test.
 std::string scratch_dir(const std::string& name);

@@ -1,0 +1,146 @@
+// The re-planning strategy in the in-process closed loop (plant + flight application): the
+// re-planner plans from the flight's telemetry in simulated time and uplinks through the flight
+// software's chunked uplink and LOAD_TRAJECTORY; the flight switches tables at tick boundaries.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "ground/campaign/fsw_flight_side.hpp"
+#include "ground/campaign/runner.hpp"
+#include "ground/campaign/strategy.hpp"
+#include "ground/campaign/trajectory_source.hpp"
+#include "ground/config/config.hpp"
+
+namespace rocksteady::campaign {
+namespace {
+
+const std::string kConfigs = std::string(ROCKSTEADY_SOURCE_DIR) + "/configs";
+
+config::RunSetup case1() {
+  return config::load_run(kConfigs + "/mission.yaml", kConfigs + "/gnc.yaml",
+                          kConfigs + "/cases/case1.yaml");
+}
+
+// A short, fast policy: the first plan after 100 s on the D+PD reference, then a re-plan every
+// 200 s (each plan takes ~1 s of CPU).
+ReplanOptions fast_policy(double latency_s) {
+  ReplanOptions o;
+  o.latency_s = latency_s;
+  o.first_plan_s = 100.0;
+  o.first_plan_max_s = 100.0;
+  o.period_s = 200.0;
+  o.min_interval_s = 100.0;
+  o.error_fraction = 0.0;  // periodic only: a predictable number of plans
+  o.on_model_update = false;
+  return o;
+}
+
+RunResult fly(const config::RunSetup& s, const ReplanOptions& policy, double duration,
+              double log_interval) {
+  FswFlightSide flight;
+  RunOptions opt;
+  opt.duration_s = duration;
+  opt.log_interval_s = log_interval;
+  opt.replan = policy;
+  return run_closed_loop(s, *parse_strategy("ntcl+replan"), flight, nullptr, opt);
+}
+
+TEST(ReplanStrategy, NameParsesWithIdentificationImplied) {
+  const auto s = parse_strategy("ntcl+replan");
+  ASSERT_TRUE(s.has_value());
+  EXPECT_TRUE(s->replans());
+  EXPECT_FALSE(s->needs_trajectory());  // nothing is planned before the run
+  EXPECT_TRUE(s->identify);
+  EXPECT_EQ(s->law, gnc::LawId::kNtcl);
+  EXPECT_TRUE(parse_strategy("ntcl+replan:id").has_value());
+  EXPECT_TRUE(parse_strategy("ntcl+replan:mekf").has_value());
+  EXPECT_FALSE(parse_strategy("ntcl+replan:id:id").has_value());
+  EXPECT_FALSE(parse_strategy("dpd+replan").has_value());  // D+PD cannot track
+}
+
+// The latency: every plan made from the telemetry at t reaches the flight no earlier than
+// t + latency, and the flight's own mode telemetry (not the re-planner's bookkeeping) shows TRACK
+// starting only after the first plan's delivery. Later plans are switched in during TRACK through
+// the flight software (trajectory_switched), none refused.
+TEST(ReplanStrategy, PlansAreActivatedNoEarlierThanTheLatencyAndSwitchedInDuringTrack) {
+  ASSERT_TRUE(have_planner());
+  const config::RunSetup s = case1();
+  const double latency = 30.0;
+  const RunResult r = fly(s, fast_policy(latency), 800.0, 0.1);
+  ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
+  const ReplanReport& rep = r.replan;
+  ASSERT_TRUE(rep.enabled);
+  ASSERT_GE(rep.events.size(), 3u) << r.note;
+  EXPECT_EQ(rep.failed, 0) << r.note;
+  EXPECT_EQ(rep.delivered, static_cast<int>(rep.events.size()));
+  for (const ReplanEvent& e : rep.events) {
+    ASSERT_TRUE(e.ok) << e.error;
+    EXPECT_GE(e.t_delivered_s, e.t_state_s + latency - 1e-9);
+    EXPECT_LE(e.t_delivered_s, e.t_state_s + latency + s.truth.control_period_s + 1e-9);
+    EXPECT_GT(e.planned_fuel_kg, 0.0);
+  }
+  EXPECT_EQ(rep.events.front().trigger, "first");
+  EXPECT_NEAR(rep.events.front().t_state_s, 100.0, s.truth.control_period_s);
+  // Every plan after the first was switched in while tracking, and none was stale.
+  EXPECT_EQ(rep.switched, rep.delivered - 1);
+  EXPECT_EQ(rep.refused, 0);
+  // The flight's telemetry: DETUMBLE (the D+PD reference) until the first delivery, then TRACK.
+  double first_track = -1.0;
+  for (const TimeRow& row : r.series) {
+    if (row.mode == gnc::Mode::kTrack) {
+      first_track = row.t;
+      break;
+    }
+    if (row.t > 1.0) {
+      EXPECT_EQ(row.mode, gnc::Mode::kDetumble) << row.t;
+    }
+  }
+  ASSERT_GT(first_track, 0.0);
+  EXPECT_GE(first_track, rep.events.front().t_state_s + latency);
+  EXPECT_EQ(r.final_mode, "TRACK");
+  // The re-plans despin: the true rate fell while tracking.
+  EXPECT_LT(r.final_rate_rad_s, 0.8 * s.truth.omega0.norm());
+}
+
+// In simulated time the re-planner is deterministic: the same run twice gives the same plans,
+// bit for bit, and the same fuel.
+TEST(ReplanStrategy, RunIsDeterministic) {
+  ASSERT_TRUE(have_planner());
+  const config::RunSetup s = case1();
+  const RunResult a = fly(s, fast_policy(10.0), 500.0, 0.0);
+  const RunResult b = fly(s, fast_policy(10.0), 500.0, 0.0);
+  ASSERT_EQ(a.status, RunStatus::kOk) << a.note;
+  ASSERT_EQ(b.status, RunStatus::kOk) << b.note;
+  ASSERT_GE(a.replan.events.size(), 2u);
+  ASSERT_EQ(a.replan.events.size(), b.replan.events.size());
+  for (std::size_t i = 0; i < a.replan.events.size(); ++i) {
+    EXPECT_EQ(a.replan.events[i].t_state_s, b.replan.events[i].t_state_s);
+    EXPECT_EQ(a.replan.events[i].t_delivered_s, b.replan.events[i].t_delivered_s);
+    EXPECT_EQ(a.replan.events[i].planned_fuel_kg, b.replan.events[i].planned_fuel_kg);
+    EXPECT_EQ(a.replan.events[i].iterations, b.replan.events[i].iterations);
+  }
+  EXPECT_EQ(a.total_fuel_kg, b.total_fuel_kg);
+  EXPECT_EQ(a.final_rate_rad_s, b.final_rate_rad_s);
+  EXPECT_EQ(a.ticks, b.ticks);
+}
+
+// The bare flight core has no uplink: the replan strategy says so instead of flying half a plan.
+TEST(ReplanStrategy, CoreOnlyFlightSideRefusesTheUplinkAndTheRunSaysWhy) {
+  ASSERT_TRUE(have_planner());
+  const config::RunSetup s = case1();
+  GncFlightSide core;
+  RunOptions opt;
+  opt.duration_s = 150.0;
+  opt.log_interval_s = 0.0;
+  opt.replan = fast_policy(10.0);
+  const RunResult r = run_closed_loop(s, *parse_strategy("ntcl+replan"), core, nullptr, opt);
+  ASSERT_EQ(r.status, RunStatus::kOk);
+  EXPECT_EQ(r.replan.delivered, 0);
+  EXPECT_GE(r.replan.failed, 1);
+  EXPECT_NE(r.note.find("re-planning needs the flight application"), std::string::npos) << r.note;
+  EXPECT_EQ(r.final_mode, "DETUMBLE");
+}
+
+}  // namespace
+}  // namespace rocksteady::campaign
