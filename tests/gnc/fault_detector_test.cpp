@@ -78,7 +78,7 @@ FaultDetector make_detector(const Truth& t, double gyro_sigma) {
   m.j = t.body.j;
   m.r = t.r;
   m.j_rel_sigma = 1e-4;  // an identified model (case 1 reaches ~3e-5 by 300 s)
-  m.r_sigma = 1e-3;
+  m.r_cov = Mat3::Identity() * 1e-6;  // 1 mm
   m.k_sigma = 1e-3;
   d.set_model(m);
   return d;
@@ -229,7 +229,7 @@ TEST(FaultDetector, ScoresAreTheLikelihoodRatioOfTheSignatures) {
   m.j = t.body.j;
   m.r = t.r;
   m.j_rel_sigma = 0.0;
-  m.r_sigma = 0.0;
+  m.r_cov = Mat3::Zero();
   m.k_sigma = 0.0;
   d.set_model(m);
   fly(t, d, 11, 0, 9, -1);  // one window, thruster 9 stuck on from the start
