@@ -193,13 +193,20 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
     sum_cr_[k] += c_[k] * r;
     sum_cr_[h] += c_[h] * r;
   }
-  // (F8) cross sums of every pair of hypotheses.
-  int idx = 0;
-  for (int h = 0; h < kHypotheses; ++h) {
-    const double ch = c_[static_cast<std::size_t>(h)];
-    for (int g = h + 1; g < kHypotheses; ++g) {
-      sum_cg_[static_cast<std::size_t>(idx++)] += ch * c_[static_cast<std::size_t>(g)];
-    }
+  // (F8) cross sums of the basis ramps (the hypotheses' pairs follow from them).
+  std::array<double, kBasis> x{};
+  for (int i = 0; i < kThrusters; ++i) {
+    x[static_cast<std::size_t>(i)] = c_[static_cast<std::size_t>(i + kThrusters)];
+  }
+  for (int q = 0; q < kPods; ++q) {
+    const auto pq = static_cast<std::size_t>(q);
+    if (in.valve_open[pq]) tp_[pq] += dt_;
+    x[static_cast<std::size_t>(kThrusters + q)] = tp_[pq];
+  }
+  std::size_t idx = 0;
+  for (std::size_t a = 0; a < x.size(); ++a) {
+    const double xa = x[a];
+    for (std::size_t b = a; b < x.size(); ++b) sum_xx_[idx++] += xa * x[b];
   }
   omega_prev_ = in.omega;
   if (n_ >= p_.window_ticks) {
@@ -226,7 +233,8 @@ void FaultDetector::start_window(const Vec3& omega) {
   sum_c_.fill(0.0);
   sum_cc_.fill(0.0);
   for (Vec3& v : sum_cr_) v.setZero();
-  sum_cg_.fill(0.0);
+  tp_.fill(0.0);
+  sum_xx_.fill(0.0);
 }
 
 void FaultDetector::close_window() {
@@ -289,12 +297,21 @@ void FaultDetector::close_window() {
       runner_up = h;
     }
   }
-  int idx = 0;
+  // Cross sums of the hypotheses' ramps from the basis: c_h = alpha_h x_{pod} + x_i with
+  // alpha = u_max for stuck-on, 0 for stuck-off.
+  std::size_t idx = 0;
   for (int h = 0; h < kHypotheses; ++h) {
     const double ch = sum_c_[static_cast<std::size_t>(h)];
+    const int ih = h % kThrusters;
+    const int ph = kThrusters + pod_[static_cast<std::size_t>(ih)];
+    const double ah = h < kThrusters ? u_max_ : 0.0;
     for (int g = h + 1; g < kHypotheses; ++g) {
-      const auto i = static_cast<std::size_t>(idx++);
-      cross_[i] += (sum_cg_[i] - ch * sum_c_[static_cast<std::size_t>(g)] / n) / var;
+      const int ig = g % kThrusters;
+      const int pg = kThrusters + pod_[static_cast<std::size_t>(ig)];
+      const double ag = g < kThrusters ? u_max_ : 0.0;
+      const double s = ah * ag * basis_cross(ph, pg) + ah * basis_cross(ph, ig) +
+                       ag * basis_cross(ih, pg) + basis_cross(ih, ig);
+      cross_[idx++] += (s - ch * sum_c_[static_cast<std::size_t>(g)] / n) / var;
     }
   }
   st_.best = best;

@@ -188,7 +188,19 @@ class FaultDetector {
   std::array<double, kHypotheses> lambda_{};
   std::array<double, kHypotheses> info_{};
   std::array<double, kPairs> cross_{};
-  std::array<double, kPairs> sum_cg_{};
+  // Every c_h is a combination of 20 basis ramps (F4): x_i = c of "i stuck off" (16) and the open
+  // time of each pod (4), c_{i on} = u_max x_{16+pod(i)} + x_i. Per tick only the basis's cross
+  // sums are accumulated (210, not the 496 pairs of hypotheses).
+  static constexpr int kBasis = kThrusters + kPods;
+  static constexpr int kBasisPairs = kBasis * (kBasis + 1) / 2;
+  static constexpr int basis_index(int a, int b) {  // a <= b
+    return a * (2 * kBasis - a + 1) / 2 + (b - a);
+  }
+  double basis_cross(int a, int b) const {
+    return sum_xx_[static_cast<std::size_t>(a <= b ? basis_index(a, b) : basis_index(b, a))];
+  }
+  std::array<double, kPods> tp_{};  // open time of each pod since the window's start
+  std::array<double, kBasisPairs> sum_xx_{};
   int ambiguous_windows_{0};
   int probe_left_{0};
   FaultDetectorStatus st_{};
