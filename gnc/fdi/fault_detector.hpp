@@ -50,7 +50,7 @@ struct FaultDetectorParams {
   double model_sigmas{3.0};
   // (F9) Isolation test: when the leader stays ambiguous against a hypothesis on another pod for
   // this many windows, its pod's valve is closed for probe_windows windows (0: never).
-  int probe_after_windows{2};
+  int probe_after_windows{1};
   int probe_windows{3};
 };
 
