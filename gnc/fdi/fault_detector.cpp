@@ -64,7 +64,7 @@ bool FaultDetector::suspecting() const {
 void FaultDetector::reset_episode() {
   lambda_.fill(0.0);
   info_.fill(0.0);
-  cross_.fill(0.0);
+  cross_xx_.fill(0.0);
   ambiguous_windows_ = 0;
   st_.ambiguous_with = -1;
 }
@@ -201,11 +201,16 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   for (int q = 0; q < kPods; ++q) {
     const auto pq = static_cast<std::size_t>(q);
     if (in.valve_open[pq]) tp_[pq] += dt_;
+    sum_tp_[pq] += tp_[pq];
     x[static_cast<std::size_t>(kThrusters + q)] = tp_[pq];
   }
   std::size_t idx = 0;
   for (std::size_t a = 0; a < x.size(); ++a) {
     const double xa = x[a];
+    if (xa == 0.0) {  // a jet not fired in this window so far: its row stays zero
+      idx += x.size() - a;
+      continue;
+    }
     for (std::size_t b = a; b < x.size(); ++b) sum_xx_[idx++] += xa * x[b];
   }
   omega_prev_ = in.omega;
@@ -234,6 +239,7 @@ void FaultDetector::start_window(const Vec3& omega) {
   sum_cc_.fill(0.0);
   for (Vec3& v : sum_cr_) v.setZero();
   tp_.fill(0.0);
+  sum_tp_.fill(0.0);
   sum_xx_.fill(0.0);
 }
 
@@ -297,21 +303,21 @@ void FaultDetector::close_window() {
       runner_up = h;
     }
   }
-  // Cross sums of the hypotheses' ramps from the basis: c_h = alpha_h x_{pod} + x_i with
-  // alpha = u_max for stuck-on, 0 for stuck-off.
-  std::size_t idx = 0;
-  for (int h = 0; h < kHypotheses; ++h) {
-    const double ch = sum_c_[static_cast<std::size_t>(h)];
-    const int ih = h % kThrusters;
-    const int ph = kThrusters + pod_[static_cast<std::size_t>(ih)];
-    const double ah = h < kThrusters ? u_max_ : 0.0;
-    for (int g = h + 1; g < kHypotheses; ++g) {
-      const int ig = g % kThrusters;
-      const int pg = kThrusters + pod_[static_cast<std::size_t>(ig)];
-      const double ag = g < kThrusters ? u_max_ : 0.0;
-      const double s = ah * ag * basis_cross(ph, pg) + ah * basis_cross(ph, ig) +
-                       ag * basis_cross(ih, pg) + basis_cross(ih, ig);
-      cross_[idx++] += (s - ch * sum_c_[static_cast<std::size_t>(g)] / n) / var;
+  // The episode's mean-centred cross sums of the basis ramps, weighted by the window's 1 / var.
+  {
+    std::array<double, kBasis> sx{};
+    for (int i = 0; i < kThrusters; ++i) {
+      sx[static_cast<std::size_t>(i)] = sum_c_[static_cast<std::size_t>(i + kThrusters)];
+    }
+    for (int q = 0; q < kPods; ++q) {
+      sx[static_cast<std::size_t>(kThrusters + q)] = sum_tp_[static_cast<std::size_t>(q)];
+    }
+    std::size_t idx = 0;
+    for (std::size_t a = 0; a < sx.size(); ++a) {
+      const double sa = sx[a] / n;
+      for (std::size_t b = a; b < sx.size(); ++b, ++idx) {
+        cross_xx_[idx] += (sum_xx_[idx] - sa * sx[b]) / var;
+      }
     }
   }
   st_.best = best;
@@ -379,6 +385,20 @@ void FaultDetector::close_window() {
   }
 }
 
+double FaultDetector::cross(int h, int g) const {
+  // c_h = alpha_h x_{16+pod} + x_i, alpha = u_max for stuck-on and 0 for stuck-off (F4).
+  const auto at = [this](int a, int b) {
+    return cross_xx_[static_cast<std::size_t>(a <= b ? basis_index(a, b) : basis_index(b, a))];
+  };
+  const int ih = h % kThrusters;
+  const int ig = g % kThrusters;
+  const int ph = kThrusters + pod_[static_cast<std::size_t>(ih)];
+  const int pg = kThrusters + pod_[static_cast<std::size_t>(ig)];
+  const double ah = h < kThrusters ? u_max_ : 0.0;
+  const double ag = g < kThrusters ? u_max_ : 0.0;
+  return ah * ag * at(ph, pg) + ah * at(ph, ig) + ag * at(ih, pg) + at(ih, ig);
+}
+
 int FaultDetector::blocking_alternative(int h) const {
   // (F8) Under h, the model's error d of h's signature b_i (constant over the episode) gives the
   // pairwise LLR Lambda_h - Lambda_g the bias V . d with V = b_h A_h - b_g C_hg. Its variance,
@@ -398,7 +418,7 @@ int FaultDetector::blocking_alternative(int h) const {
     const int tg = g % kThrusters;
     if ((((st_.confirmed_on | st_.confirmed_off) >> tg) & 1u) != 0) continue;
     const Vec3& bg = b_[kg % static_cast<std::size_t>(kThrusters)];
-    const double c = cross_[static_cast<std::size_t>(h < g ? pair_index(h, g) : pair_index(g, h))];
+    const double c = cross(h, g);
     const Vec3 v = bh * info_[kh] - bg * c;
     const Vec3 w = j_inv_.transpose() * v;
     const Vec3 wxe = kk * w.cross(dir_[ih]);

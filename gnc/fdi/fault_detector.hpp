@@ -138,10 +138,6 @@ class FaultDetector {
   // The alternative that the leader h cannot yet be told from under (F6)/(F8), or -1 (exposed to
   // close_window only).
   int blocking_alternative(int h) const;
-  static constexpr int kPairs = kHypotheses * (kHypotheses - 1) / 2;
-  static constexpr int pair_index(int h, int g) {  // h < g
-    return h * (2 * kHypotheses - h - 1) / 2 + (g - h - 1);
-  }
 
   FaultDetectorParams p_{};
   double u_max_{200.0};
@@ -184,10 +180,10 @@ class FaultDetector {
   std::array<double, kHypotheses> score_{};
   // (F8) Since the current episode began (the last window with every score at zero): the
   // unfloored cumulative LLR of each hypothesis, its information A_h = sum |c~_h|^2 / var, and the
-  // cross terms C_hg = sum c~_h c~_g / var; per window the cross sums of c_h c_g.
+  // cross terms C_hg = sum c~_h c~_g / var, kept as the basis's (cross_basis()).
   std::array<double, kHypotheses> lambda_{};
   std::array<double, kHypotheses> info_{};
-  std::array<double, kPairs> cross_{};
+  double cross(int h, int g) const;
   // Every c_h is a combination of 20 basis ramps (F4): x_i = c of "i stuck off" (16) and the open
   // time of each pod (4), c_{i on} = u_max x_{16+pod(i)} + x_i. Per tick only the basis's cross
   // sums are accumulated (210, not the 496 pairs of hypotheses).
@@ -196,11 +192,10 @@ class FaultDetector {
   static constexpr int basis_index(int a, int b) {  // a <= b
     return a * (2 * kBasis - a + 1) / 2 + (b - a);
   }
-  double basis_cross(int a, int b) const {
-    return sum_xx_[static_cast<std::size_t>(a <= b ? basis_index(a, b) : basis_index(b, a))];
-  }
-  std::array<double, kPods> tp_{};  // open time of each pod since the window's start
-  std::array<double, kBasisPairs> sum_xx_{};
+  std::array<double, kPods> tp_{};      // open time of each pod since the window's start
+  std::array<double, kPods> sum_tp_{};  // its sum over the window's samples
+  std::array<double, kBasisPairs> sum_xx_{};   // per window: sum_j x_a x_b
+  std::array<double, kBasisPairs> cross_xx_{};  // per episode: sum_w (sum x~_a x~_b) / var
   int ambiguous_windows_{0};
   int probe_left_{0};
   FaultDetectorStatus st_{};
