@@ -312,11 +312,12 @@ void FaultDetector::close_window() {
     for (int q = 0; q < kPods; ++q) {
       sx[static_cast<std::size_t>(kThrusters + q)] = sum_tp_[static_cast<std::size_t>(q)];
     }
+    const double inv_var = 1.0 / var;
     std::size_t idx = 0;
     for (std::size_t a = 0; a < sx.size(); ++a) {
       const double sa = sx[a] / n;
       for (std::size_t b = a; b < sx.size(); ++b, ++idx) {
-        cross_xx_[idx] += (sum_xx_[idx] - sa * sx[b]) / var;
+        cross_xx_[idx] += (sum_xx_[idx] - sa * sx[b]) * inv_var;
       }
     }
   }
