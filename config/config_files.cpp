@@ -207,6 +207,9 @@ GncConfig load_gnc(const std::string& path) {
     fd.margin_llr = r.non_negative("margin_llr");
     fd.suspect_chi2 = r.positive("suspect_chi2");
     fd.auto_isolate = r.boolean("auto_isolate");
+    fd.model_sigmas = r.non_negative("model_sigmas");
+    fd.probe_after_windows = r.integer("probe_after_windows");
+    fd.probe_windows = r.integer("probe_windows");
     p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
     r.finish();
   }

@@ -122,14 +122,15 @@ void Gnc::refresh_fault_model() {
     // The 1 sigma from the identifier's covariances as they are now (a re-inflation shows at
     // once); directions of r the firings have not shown stay at their prior: uncertain.
     m.j_rel_sigma = std::sqrt(ident_.inertia_covariance().diagonal().maxCoeff()) / e.j.norm();
-    m.r_sigma = std::sqrt(ident_.offset_covariance().diagonal().maxCoeff());
+    m.r_cov = ident_.offset_covariance();
     m.k_sigma = std::sqrt(ident_.strength_covariance().diagonal().maxCoeff());
   } else {
     m.j = total_inertia(params_.mass_hat);
     m.r = params_.mass_hat.r_so_bcm;
     m.k = params_.rcs.strength;
     m.j_rel_sigma = params_.fdi_table_rel_sigma;
-    m.r_sigma = params_.identification.config.r_prior_sigma;
+    const double rs = params_.identification.config.r_prior_sigma;
+    m.r_cov = Mat3::Identity() * (rs * rs);
     m.k_sigma = params_.identification.config.k_prior_sigma;
   }
   fdi_.set_model(m);
@@ -178,6 +179,9 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
   }
   in.valve_open = last_valve_;
   const FaultEvents fe = fdi_.update(in);
+  // (F9) The detector's isolation test closes a pod for a few windows; it is an isolation
+  // action, so the ground's inhibit and auto_isolate govern it as they govern the confirmation's.
+  probe_pod_ = params_.fdi.auto_isolate && !isolation_inhibited_ ? fdi_.probe_pod() : -1;
   const Mode mode = modes_.mode();
   if (fe.suspected && !fe.confirmed) {
     ModeEvent e{EventId::kFaultSuspected, mode, mode, TransitionCheck::kOk};
@@ -211,6 +215,12 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
   }
 }
 
+std::array<bool, kPods> Gnc::commanded_valves() const {
+  std::array<bool, kPods> v = valve_open_;
+  if (probe_pod_ >= 0 && probe_pod_ < kPods) v[static_cast<std::size_t>(probe_pod_)] = false;
+  return v;
+}
+
 AllocatorLimits Gnc::allocation_limits() const {
   // In produced force (B_hat's units): a thruster of strength k reaches k u_max. A thruster is
   // usable when its pod's valve is open and no fault is latched on it; a latched stuck-on thruster
@@ -221,8 +231,9 @@ AllocatorLimits Gnc::allocation_limits() const {
   const std::uint16_t on = fdi_.confirmed_on();
   const std::uint16_t off = fdi_.confirmed_off();
   const Mat38& b = alloc_.b_hat();
+  const std::array<bool, kPods> valves = commanded_valves();
   for (int c = 0; c < kChannels; ++c) {
-    const bool open = valve_open_[static_cast<std::size_t>(params_.rcs.channel_pod[c])];
+    const bool open = valves[static_cast<std::size_t>(params_.rcs.channel_pod[c])];
     const int tp = 2 * c;
     const int tm = 2 * c + 1;
     const bool plus_ok = open && !(((on | off) >> tp) & 1u);
@@ -360,6 +371,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     in.omega = mekf ? Vec3(m.omega - id_bias_) : m.omega;
     in.omega_valid = m.omega_valid && (!mekf || mekf_.initialised());
     in.force = last_force_;
+    // While the detector suspects a fault it has not isolated, the identifier does not fit it
+    // into J, r and k: those windows are discarded (gnc/fdi/README.md (F7)).
+    in.force_valid = !(params_.fdi.enabled && fdi_.suspecting());
     // The identifier's step blocks stay off the fault detector's window-close ticks.
     const bool fdi_busy = params_.fdi.enabled && fdi_.window_closes_next();
     ident_.update(in, !fdi_busy);
@@ -460,8 +474,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
 
   out.command.force = force;
   out.command.enabled = enabled;
-  out.command.valve_open = valve_open_;
-  last_valve_ = valve_open_;
+  out.command.valve_open = commanded_valves();
+  last_valve_ = out.command.valve_open;
   GncTelemetry& tl = out.telemetry;
   tl.t = t;
   tl.tick = tick_++;
@@ -493,7 +507,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   f.suspected_off = fs.suspected_off;
   f.confirmed_on = fs.confirmed_on;
   f.confirmed_off = fs.confirmed_off;
-  f.valve_open = valve_open_;
+  f.valve_open = commanded_valves();
   f.isolation_inhibited = isolation_inhibited_;
   f.windows = fs.windows;
   f.suspicions = fs.suspicions;

@@ -60,6 +60,9 @@ class Gnc {
   const Identifier& identifier() const { return ident_; }
   const FaultDetector& fault_detector() const { return fdi_; }
   const std::array<bool, kPods>& valve_open() const { return valve_open_; }
+  // The valves as commanded this tick: valve_open() with the detector's isolation test applied
+  // (gnc/fdi/README.md (F9)).
+  std::array<bool, kPods> commanded_valves() const;
   std::uint32_t model_adoptions() const { return adoptions_; }
 
  private:
@@ -82,6 +85,7 @@ class Gnc {
   std::array<bool, kPods> valve_open_{{true, true, true, true}};  // commanded this tick
   std::array<bool, kPods> last_valve_{{true, true, true, true}};  // over the previous tick
   bool isolation_inhibited_{false};
+  int probe_pod_{-1};  // pod closed for the detector's isolation test this tick, -1 none
   bool reduced_reported_{false};
   ModeManager modes_{};
   References refs_{};

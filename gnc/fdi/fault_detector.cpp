@@ -23,6 +23,13 @@ Check validate(const FaultDetectorParams& p) {
   if (!finite_non_negative(p.margin_llr)) return bad("fdi.margin_llr", "must be >= 0");
   if (!finite_positive(p.suspect_chi2)) return bad("fdi.suspect_chi2", "must be positive");
   if (!finite_non_negative(p.min_signature)) return bad("fdi.min_signature", "must be >= 0");
+  if (!finite_non_negative(p.model_sigmas)) return bad("fdi.model_sigmas", "must be >= 0");
+  if (p.probe_after_windows < 0 || p.probe_after_windows > 1000) {
+    return bad("fdi.probe_after_windows", "must be in [0, 1000]");
+  }
+  if (p.probe_windows < 0 || p.probe_windows > 1000) {
+    return bad("fdi.probe_windows", "must be in [0, 1000]");
+  }
   return Check{};
 }
 
@@ -40,16 +47,34 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
     }
   }
   st_ = FaultDetectorStatus{};
+  score_.fill(0.0);  // before set_model: nothing suspected, the model is taken (F7)
   FaultModel m;
   m.j = Mat3::Identity();
   set_model(m);
   reset();
 }
 
+bool FaultDetector::suspecting() const {
+  for (double s : score_) {
+    if (s > 0.5 * p_.confirm_llr) return true;
+  }
+  return false;
+}
+
+void FaultDetector::reset_episode() {
+  lambda_.fill(0.0);
+  info_.fill(0.0);
+  cross_xx_.fill(0.0);
+  ambiguous_windows_ = 0;
+  st_.ambiguous_with = -1;
+}
+
 void FaultDetector::reset() {
   have_start_ = false;
   n_ = 0;
   score_.fill(0.0);
+  reset_episode();
+  probe_left_ = 0;
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   st_ = FaultDetectorStatus{};
@@ -58,7 +83,15 @@ void FaultDetector::reset() {
 }
 
 void FaultDetector::set_model(const FaultModel& m) {
+  // (F7) While a hypothesis is suspected, the model it is tested against is held: the identifier
+  // is fitting the unmodelled fault into J, r and k, and a model that has absorbed part of the
+  // fault moves the signatures of the other hypotheses towards it.
+  if (suspecting()) {
+    ++st_.models_held;
+    return;
+  }
   m_ = m;
+  r_sigma_ = std::sqrt(std::fmax(0.0, m.r_cov.diagonal().maxCoeff()));
   j_inv_ = m.j.inverse();
   // Spectral norms of J and J^-1 from J's eigenvalues (symmetric 3x3, fixed size: no heap).
   const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (m.j + m.j.transpose()), Eigen::EigenvaluesOnly);
@@ -81,6 +114,9 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   if (kind == FaultKind::kStuckOn) st_.confirmed_on |= bit;
   if (kind == FaultKind::kStuckOff) st_.confirmed_off |= bit;
   score_.fill(0.0);
+  reset_episode();
+  probe_left_ = 0;
+  st_.probe_pod = -1;
 }
 
 void FaultDetector::clear(int thruster) {
@@ -93,6 +129,9 @@ void FaultDetector::clear(int thruster) {
     st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
   }
   score_.fill(0.0);
+  reset_episode();
+  probe_left_ = 0;
+  st_.probe_pod = -1;
 }
 
 FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
@@ -154,6 +193,26 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
     sum_cr_[k] += c_[k] * r;
     sum_cr_[h] += c_[h] * r;
   }
+  // (F8) cross sums of the basis ramps (the hypotheses' pairs follow from them).
+  std::array<double, kBasis> x{};
+  for (int i = 0; i < kThrusters; ++i) {
+    x[static_cast<std::size_t>(i)] = c_[static_cast<std::size_t>(i + kThrusters)];
+  }
+  for (int q = 0; q < kPods; ++q) {
+    const auto pq = static_cast<std::size_t>(q);
+    if (in.valve_open[pq]) tp_[pq] += dt_;
+    sum_tp_[pq] += tp_[pq];
+    x[static_cast<std::size_t>(kThrusters + q)] = tp_[pq];
+  }
+  std::size_t idx = 0;
+  for (std::size_t a = 0; a < x.size(); ++a) {
+    const double xa = x[a];
+    if (xa == 0.0) {  // a jet not fired in this window so far: its row stays zero
+      idx += x.size() - a;
+      continue;
+    }
+    for (std::size_t b = a; b < x.size(); ++b) sum_xx_[idx++] += xa * x[b];
+  }
   omega_prev_ = in.omega;
   if (n_ >= p_.window_ticks) {
     close_window();
@@ -179,6 +238,9 @@ void FaultDetector::start_window(const Vec3& omega) {
   sum_c_.fill(0.0);
   sum_cc_.fill(0.0);
   for (Vec3& v : sum_cr_) v.setZero();
+  tp_.fill(0.0);
+  sum_tp_.fill(0.0);
+  sum_xx_.fill(0.0);
 }
 
 void FaultDetector::close_window() {
@@ -190,7 +252,7 @@ void FaultDetector::close_window() {
   const double model = rel * motion_;
   // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
   // r_sigma times the jets' force, and k_sigma times their torque.
-  const double offset = m_.r_sigma * j_inv_.norm() * force_impulse_;
+  const double offset = r_sigma_ * j_inv_.norm() * force_impulse_;
   const double strength = m_.k_sigma * thrust_motion_;
   const double var = 2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model +
                      offset * offset + strength * strength + 1e-30;
@@ -204,8 +266,10 @@ void FaultDetector::close_window() {
   st_.residual = slope * n;  // rate change over the window that the model does not explain
   st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
   ++st_.windows;
-  // (F6) sequential log-likelihood ratios, CUSUM with exoneration at zero.
+  // (F6) sequential log-likelihood ratios, CUSUM with exoneration at zero; (F8) the episode's
+  // unfloored sums, every window, observable or not (their differences are exact pairwise LLRs).
   int best = -1;
+  int runner_up = -1;
   double best_s = 0.0;
   double second = 0.0;
   for (int h = 0; h < kHypotheses; ++h) {
@@ -221,17 +285,40 @@ void FaultDetector::close_window() {
     // Mean-centred sums: sum S~ r~ = b.(sum c r) - (b.r_mean) sum c; sum |S~|^2 = |b|^2 (sum c^2 -
     // (sum c)^2 / n).
     const double sr = b.dot(sum_cr_[k]) - b.dot(r_mean) * sum_c_[k];
-    const double ss = b.squaredNorm() * (sum_cc_[k] - sum_c_[k] * sum_c_[k] / n);
+    const double cc = sum_cc_[k] - sum_c_[k] * sum_c_[k] / n;
+    const double ss = b.squaredNorm() * cc;
+    const double llr = (sr - 0.5 * ss) / var;
+    lambda_[k] += llr;
+    info_[k] += cc / var;
     if (ss / var >= p_.min_signature) {  // else not observable in this window: no evidence
-      const double llr = (sr - 0.5 * ss) / var;
       score_[k] = std::fmax(0.0, score_[k] + llr);
     }
     if (score_[k] > best_s) {
       second = best_s;
+      runner_up = best;
       best_s = score_[k];
       best = h;
     } else if (score_[k] > second) {
       second = score_[k];
+      runner_up = h;
+    }
+  }
+  // The episode's mean-centred cross sums of the basis ramps, weighted by the window's 1 / var.
+  {
+    std::array<double, kBasis> sx{};
+    for (int i = 0; i < kThrusters; ++i) {
+      sx[static_cast<std::size_t>(i)] = sum_c_[static_cast<std::size_t>(i + kThrusters)];
+    }
+    for (int q = 0; q < kPods; ++q) {
+      sx[static_cast<std::size_t>(kThrusters + q)] = sum_tp_[static_cast<std::size_t>(q)];
+    }
+    const double inv_var = 1.0 / var;
+    std::size_t idx = 0;
+    for (std::size_t a = 0; a < sx.size(); ++a) {
+      const double sa = sx[a] / n;
+      for (std::size_t b = a; b < sx.size(); ++b, ++idx) {
+        cross_xx_[idx] += (sum_xx_[idx] - sa * sx[b]) * inv_var;
+      }
     }
   }
   st_.best = best;
@@ -251,14 +338,101 @@ void FaultDetector::close_window() {
     ++st_.suspicions;
     pending_.suspected = true;
   }
-  if (best >= 0 && best_s > p_.confirm_llr && best_s - second > p_.margin_llr) {
+  // An isolation test runs its course; the valve reopens after it unless a confirmation closes it.
+  if (probe_left_ > 0 && --probe_left_ == 0) st_.probe_pod = -1;
+  if (best < 0) {
+    reset_episode();  // every hypothesis exonerated: the next episode starts afresh
+    return;
+  }
+  if (best_s <= p_.confirm_llr) {
+    ambiguous_windows_ = 0;
+    st_.ambiguous_with = -1;
+    return;
+  }
+  // (F6) clearly ahead of the runner-up, and (F8) of every alternative beyond the model's error.
+  const int blocking = best_s - second > p_.margin_llr ? blocking_alternative(best) : runner_up;
+  if (blocking < 0) {
     const int thruster = best % kThrusters;
     const FaultKind kind = best < kThrusters ? FaultKind::kStuckOn : FaultKind::kStuckOff;
     declare(thruster, kind);
     pending_.confirmed = true;
     pending_.thruster = thruster;
     pending_.kind = kind;
+    return;
   }
+  // (F9) A fault is evident but the leader cannot be told from `blocking`. When one of the two is
+  // a stuck-on jet on a pod the other does not use, closing that pod's valve for a few windows
+  // separates them: the stuck-on signature stops there and only there.
+  st_.ambiguous_with = blocking;
+  const int tb = best % kThrusters;
+  const int tg = blocking % kThrusters;
+  const int pod_b = pod_[static_cast<std::size_t>(tb)];
+  const int pod_g = pod_[static_cast<std::size_t>(tg)];
+  int pod = -1;
+  if (pod_b != pod_g) {
+    if (best < kThrusters) {
+      pod = pod_b;
+    } else if (blocking < kThrusters) {
+      pod = pod_g;
+    }
+  }
+  if (pod < 0 || p_.probe_windows == 0) return;
+  ++ambiguous_windows_;
+  if (probe_left_ == 0 && ambiguous_windows_ >= p_.probe_after_windows) {
+    st_.probe_pod = pod;
+    probe_left_ = p_.probe_windows;
+    ++st_.probes;
+    ambiguous_windows_ = 0;
+  }
+}
+
+double FaultDetector::cross(int h, int g) const {
+  // c_h = alpha_h x_{16+pod} + x_i, alpha = u_max for stuck-on and 0 for stuck-off (F4).
+  const auto at = [this](int a, int b) {
+    return cross_xx_[static_cast<std::size_t>(a <= b ? basis_index(a, b) : basis_index(b, a))];
+  };
+  const int ih = h % kThrusters;
+  const int ig = g % kThrusters;
+  const int ph = kThrusters + pod_[static_cast<std::size_t>(ih)];
+  const int pg = kThrusters + pod_[static_cast<std::size_t>(ig)];
+  const double ah = h < kThrusters ? u_max_ : 0.0;
+  const double ag = g < kThrusters ? u_max_ : 0.0;
+  return ah * ag * at(ph, pg) + ah * at(ph, ig) + ag * at(ih, pg) + at(ih, ig);
+}
+
+int FaultDetector::blocking_alternative(int h) const {
+  // (F8) Under h, the model's error d of h's signature b_i (constant over the episode) gives the
+  // pairwise LLR Lambda_h - Lambda_g the bias V . d with V = b_h A_h - b_g C_hg. Its variance,
+  // from the identifier's: strength (d = b dk / k), centre of mass (d = J^-1 k dr x e_i) and
+  // inertia (d = -J^-1 dJ b, |V . d| <= |J^-1 V| ||dJ|| |b|).
+  const auto kh = static_cast<std::size_t>(h);
+  const auto ih = kh % static_cast<std::size_t>(kThrusters);
+  const Vec3& bh = b_[ih];
+  const double kk = m_.k(static_cast<int>(ih));
+  const double rel_k = kk != 0.0 ? m_.k_sigma / std::fabs(kk) : 0.0;
+  const double dj = m_.j_rel_sigma * m_.j.norm() * bh.norm();
+  int worst = -1;
+  double worst_lead = 0.0;
+  for (int g = 0; g < kHypotheses; ++g) {
+    if (g == h) continue;
+    const auto kg = static_cast<std::size_t>(g);
+    const int tg = g % kThrusters;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> tg) & 1u) != 0) continue;
+    const Vec3& bg = b_[kg % static_cast<std::size_t>(kThrusters)];
+    const double c = cross(h, g);
+    const Vec3 v = bh * info_[kh] - bg * c;
+    const Vec3 w = j_inv_.transpose() * v;
+    const Vec3 wxe = kk * w.cross(dir_[ih]);
+    const double vk = rel_k * v.dot(bh);
+    const double vj = dj * w.norm();
+    const double sd = std::sqrt(vk * vk + wxe.dot(m_.r_cov * wxe) + vj * vj);
+    const double lead = lambda_[kh] - lambda_[kg] - p_.model_sigmas * sd;
+    if (lead <= p_.margin_llr && (worst < 0 || lead < worst_lead)) {
+      worst = g;
+      worst_lead = lead;
+    }
+  }
+  return worst;
 }
 
 }  // namespace rocksteady::gnc

@@ -45,6 +45,13 @@ struct FaultDetectorParams {
   double min_signature{4.0};
   // true: a confirmed stuck-on closes its pod's latch valve (automatic isolation).
   bool auto_isolate{true};
+  // (F8) The lead over each alternative must also exceed what an error of the model could have
+  // produced: this many 1 sigma of the signature's model uncertainty.
+  double model_sigmas{3.0};
+  // (F9) Isolation test: when the leader stays ambiguous against a hypothesis on another pod for
+  // this many windows, its pod's valve is closed for probe_windows windows (0: never).
+  int probe_after_windows{1};
+  int probe_windows{3};
 };
 
 Check validate(const FaultDetectorParams& p);
@@ -66,7 +73,9 @@ struct FaultModel {
   Vec3 r{Vec3::Zero()};
   Vec16 k{Vec16::Ones()};
   double j_rel_sigma{1.0};  // largest 1 sigma of J relative to ||J|| (the identifier's)
-  double r_sigma{1.0};      // m, largest 1 sigma of r: a torque error of r_sigma x the net force
+  // m^2, covariance of r: its largest 1 sigma r_sigma gives a torque error of r_sigma x the net
+  // force (F5); the isolation test (F8) projects the whole matrix.
+  Mat3 r_cov{Mat3::Identity()};
   double k_sigma{0.05};     // largest 1 sigma of the strengths: k_sigma x each jet's torque
 };
 
@@ -83,6 +92,10 @@ struct FaultDetectorStatus {
   double runner_up_llr{0.0};
   std::uint32_t windows{0};
   std::uint32_t suspicions{0};  // windows whose chi-square exceeded suspect_chi2
+  std::uint32_t models_held{0};  // model refreshes not applied while a hypothesis was suspected
+  int probe_pod{-1};              // (F9) pod whose valve the detector asks closed for a test, -1 none
+  std::uint32_t probes{0};        // isolation tests started
+  int ambiguous_with{-1};         // the alternative the leader could not be told from, -1 none
 };
 
 // Raised by update(); the caller turns them into events.
@@ -112,6 +125,11 @@ class FaultDetector {
   std::uint16_t confirmed_on() const { return st_.confirmed_on; }
   std::uint16_t confirmed_off() const { return st_.confirmed_off; }
   const FaultDetectorParams& params() const { return p_; }
+  // A hypothesis is suspected (its score above half the confirmation level): the model it is
+  // tested against is held (F7), and the identifier should not absorb the fault either.
+  bool suspecting() const;
+  // (F9) The pod whose latch valve the detector asks to be closed for an isolation test (-1 none).
+  int probe_pod() const { return st_.probe_pod; }
 
   // Rate change signature of hypothesis h over the last window (exposed for tests): 0..15
   // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
@@ -121,6 +139,10 @@ class FaultDetector {
  private:
   void close_window();
   void start_window(const Vec3& omega);
+  void reset_episode();
+  // The alternative that the leader h cannot yet be told from under (F6)/(F8), or -1 (exposed to
+  // close_window only).
+  int blocking_alternative(int h) const;
 
   FaultDetectorParams p_{};
   double u_max_{200.0};
@@ -130,6 +152,7 @@ class FaultDetector {
   std::array<Vec3, kThrusters> dir_{};
   std::array<int, kThrusters> pod_{};
   FaultModel m_{};
+  double r_sigma_{1.0};  // sqrt of the largest diagonal element of m_.r_cov
   Mat3 j_inv_{Mat3::Identity()};
   double j_inv_norm_{1.0};
   double j_norm_{1.0};
@@ -156,9 +179,30 @@ class FaultDetector {
   std::array<double, kHypotheses> sum_cc_{};
   std::array<Vec3, kHypotheses> sum_cr_{};
   std::array<Vec3, kHypotheses> sig_{};  // b c of the last window, for signature()
-  std::array<Vec3, kThrusters> b_{};  // J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i
+  std::array<Vec3, kThrusters> b_{};
+  std::array<double, kThrusters> sigma_b_{};  // (F8) 1 sigma of b_i per axis from the model's  // J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i
 
   std::array<double, kHypotheses> score_{};
+  // (F8) Since the current episode began (the last window with every score at zero): the
+  // unfloored cumulative LLR of each hypothesis, its information A_h = sum |c~_h|^2 / var, and the
+  // cross terms C_hg = sum c~_h c~_g / var, kept as the basis's (cross_basis()).
+  std::array<double, kHypotheses> lambda_{};
+  std::array<double, kHypotheses> info_{};
+  double cross(int h, int g) const;
+  // Every c_h is a combination of 20 basis ramps (F4): x_i = c of "i stuck off" (16) and the open
+  // time of each pod (4), c_{i on} = u_max x_{16+pod(i)} + x_i. Per tick only the basis's cross
+  // sums are accumulated (210, not the 496 pairs of hypotheses).
+  static constexpr int kBasis = kThrusters + kPods;
+  static constexpr int kBasisPairs = kBasis * (kBasis + 1) / 2;
+  static constexpr int basis_index(int a, int b) {  // a <= b
+    return a * (2 * kBasis - a + 1) / 2 + (b - a);
+  }
+  std::array<double, kPods> tp_{};      // open time of each pod since the window's start
+  std::array<double, kPods> sum_tp_{};  // its sum over the window's samples
+  std::array<double, kBasisPairs> sum_xx_{};   // per window: sum_j x_a x_b
+  std::array<double, kBasisPairs> cross_xx_{};  // per episode: sum_w (sum x~_a x~_b) / var
+  int ambiguous_windows_{0};
+  int probe_left_{0};
   FaultDetectorStatus st_{};
   FaultEvents pending_{};
 };

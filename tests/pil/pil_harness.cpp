@@ -135,11 +135,14 @@ bool Process::wait(double timeout_s, int* status) {
 TestBus::TestBus(const std::string& url) {
   lcm_ = lcm_create(url.c_str());
   if (lcm_ == nullptr) throw std::runtime_error("lcm_create failed for " + url);
-  lcm_subscribe(lcm_, channels::kGncTelemetry, &TestBus::on_tlm, this);
+  lcm_subscription_set_queue_capacity(
+      lcm_subscribe(lcm_, channels::kGncTelemetry, &TestBus::on_tlm, this), 1000);
   lcm_subscribe(lcm_, channels::kCmdAck, &TestBus::on_ack, this);
   lcm_subscription_set_queue_capacity(
       lcm_subscribe(lcm_, channels::kEvents, &TestBus::on_event, this), 1000);
   lcm_subscribe(lcm_, channels::kThrusterCmd, &TestBus::on_thruster, this);
+  lcm_subscription_set_queue_capacity(
+      lcm_subscribe(lcm_, channels::kPlantTruth, &TestBus::on_truth, this), 1000);
 }
 
 TestBus::~TestBus() {
@@ -153,6 +156,7 @@ void TestBus::on_tlm(const lcm_recv_buf_t* rbuf, const char*, void* self) {
     b.tlm = m;
     b.have_tlm = true;
     ++b.tlm_count;
+    if (b.on_each_tlm) b.on_each_tlm(m);
   }
 }
 void TestBus::on_ack(const lcm_recv_buf_t* rbuf, const char*, void* self) {
@@ -164,6 +168,11 @@ void TestBus::on_event(const lcm_recv_buf_t* rbuf, const char*, void* self) {
   auto& b = *static_cast<TestBus*>(self);
   rocksteady::event_t m;
   if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) b.events.push_back(m);
+}
+void TestBus::on_truth(const lcm_recv_buf_t* rbuf, const char*, void* self) {
+  auto& b = *static_cast<TestBus*>(self);
+  rocksteady::plant_truth_t m;
+  if (wire::safe_decode(rbuf->data, static_cast<int>(rbuf->data_size), m)) b.truths.push_back(m);
 }
 void TestBus::on_thruster(const lcm_recv_buf_t* rbuf, const char*, void* self) {
   auto& b = *static_cast<TestBus*>(self);

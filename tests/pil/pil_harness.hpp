@@ -16,6 +16,7 @@
 #include "rocksteady/cmd_ack_t.hpp"
 #include "rocksteady/event_t.hpp"
 #include "rocksteady/gnc_telemetry_t.hpp"
+#include "rocksteady/plant_truth_t.hpp"
 #include "rocksteady/thruster_cmd_t.hpp"
 
 namespace rocksteady::pil {
@@ -82,6 +83,9 @@ class TestBus {
   rocksteady::thruster_cmd_t thruster{};  // newest thruster command
   std::uint64_t thruster_count{0};
   std::uint64_t thruster_firing_count{0};  // commands with at least one thruster on
+  std::vector<rocksteady::plant_truth_t> truths;  // every RS_PLANT_TRUTH received, in order
+  // Called with each telemetry message as it arrives (unset: only the newest is kept in tlm).
+  std::function<void(const rocksteady::gnc_telemetry_t&)> on_each_tlm;
 
   bool has_event(std::int32_t id) const;
   const rocksteady::cmd_ack_t* ack_for(std::int64_t seq, std::int32_t sender = 1) const;
@@ -91,6 +95,7 @@ class TestBus {
   static void on_ack(const lcm_recv_buf_t* rbuf, const char* ch, void* self);
   static void on_event(const lcm_recv_buf_t* rbuf, const char* ch, void* self);
   static void on_thruster(const lcm_recv_buf_t* rbuf, const char* ch, void* self);
+  static void on_truth(const lcm_recv_buf_t* rbuf, const char* ch, void* self);
   lcm_t* lcm_{nullptr};
 };
 
