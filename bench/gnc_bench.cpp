@@ -2,8 +2,11 @@
 // and each control law alone. Measures and prints; never asserts a time.
 #include <benchmark/benchmark.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <random>
 #include <vector>
 
 #include "gnc/control/laws.hpp"
@@ -170,6 +173,47 @@ void BM_AllocateL1(benchmark::State& state) {
   state.counters["simplex_iterations"] = st.l1_iterations;
 }
 BENCHMARK(BM_AllocateL1);
+
+// The L1 solve over a torque history, cold (every solve from u = 0) or warm (from the previous
+// basis): arg 0 warm 0/1, arg 1 history 0 random directions and magnitudes (HOLD answering noise),
+// 1 a request turning by 1 degree per tick (a despin).
+void BM_L1Sequence(benchmark::State& state) {
+  const GncParams p = study_gnc_params(200.0);
+  const Mat38 b = torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
+  L1Allocation l1;
+  l1.configure(b, p.rcs.u_max);
+  l1.set_warm_start(state.range(0) != 0);
+  std::vector<Vec3> taus;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Eigen::AngleAxisd step(M_PI / 180.0, Vec3(0.3, -0.5, 0.8).normalized());
+  Vec3 turning = Vec3(300.0, -150.0, 800.0);
+  for (int k = 0; k < 1024; ++k) {
+    if (state.range(1) == 0) {
+      Vec8 f;
+      for (int i = 0; i < 8; ++i) f(i) = 0.3 * p.rcs.u_max * std::tanh(n(rng));
+      taus.push_back(b * f);
+    } else {
+      turning = step * turning;
+      taus.push_back(turning);
+    }
+  }
+  std::size_t k = 0;
+  long iterations = 0;
+  long solves = 0;
+  for (auto _ : state) {
+    const L1Solution s = l1.solve(taus[k]);
+    benchmark::DoNotOptimize(s.u);
+    iterations += s.iterations;
+    ++solves;
+    k = (k + 1) % taus.size();
+  }
+  state.counters["mean_iterations"] = static_cast<double>(iterations) / static_cast<double>(solves);
+  state.counters["warm_share"] =
+      static_cast<double>(l1.start_counts().warm) /
+      static_cast<double>(l1.start_counts().warm + l1.start_counts().cold);
+}
+BENCHMARK(BM_L1Sequence)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1});
 
 // Allocation under failure limits (arg 0: pinv, 1: L1): thruster 2 (channel 1 "+") stuck on with
 // its bias torque, and pod 3's latch valve closed.

@@ -374,8 +374,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // While the detector suspects a fault it has not isolated, the identifier does not fit it
     // into J, r and k: those windows are discarded (gnc/fdi/README.md (F7)).
     in.force_valid = !(params_.fdi.enabled && fdi_.suspecting());
-    // The identifier's step blocks stay off the fault detector's window-close ticks.
-    const bool fdi_busy = params_.fdi.enabled && fdi_.window_closes_next();
+    // The identifier's step blocks stay off the fault detector's heavy evaluation steps
+    // (gnc/fdi/README.md (F10)).
+    const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
     ident_.update(in, !fdi_busy);
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       candidate_windows_ = ident_.counters().windows;
@@ -383,8 +384,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       if (mekf) id_bias_ = mekf_.bias();
       fault_model_stale_ = true;
     }
-    // The detector predicts with the latest identified model, refreshed on a tick that does not
-    // close its window (never inside one: it only rescales the next window's prediction).
+    // The detector predicts with the latest identified model; one that arrives while a closed
+    // window is evaluated is held by the detector until the evaluation ends (F10).
     if (fault_model_stale_ && !fdi_busy) {
       refresh_fault_model();
       fault_model_stale_ = false;

@@ -23,6 +23,7 @@ constexpr double kTieTol = 1e-12;   // ratios this close are ties (Bland: smalle
 constexpr double kFeasTol = 1e-9;   // bound and residual tolerance of the certified solution
 constexpr double kDetTol = 1e-12;   // |det B_b| below this: the basis is treated as singular
 constexpr int kDegenerateBeforeBland = 2;  // degenerate steps in a row before Bland's rule
+constexpr int kMaxDualSteps = 12;  // dual simplex steps of a warm start before starting cold
 
 struct Lp {
   const Mat38* a{nullptr};
@@ -148,12 +149,91 @@ bool run_phase(Lp& lp, const Vec3& tau) {
   }
 }
 
+
+// Largest bound violation of the basic variables, 0 when the basis is primal feasible.
+double infeasibility(const Lp& lp, const Vec3& xb, int* row) {
+  double worst = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    const double ub = lp.ub[static_cast<std::size_t>(lp.basis[static_cast<std::size_t>(r)])];
+    const double v = std::max(-xb(r), xb(r) - ub);
+    if (v > worst) {
+      worst = v;
+      if (row != nullptr) *row = r;
+    }
+  }
+  return worst > kFeasTol ? worst : 0.0;
+}
+
+// Bounded dual simplex (phase-2 costs) from a dual-feasible basis to a primal-feasible one: the
+// most violated basic variable leaves to the bound it violates; the entering variable keeps every
+// reduced cost's sign (smallest |d_j / alpha_j|, ties to the lowest index). True: primal feasible
+// (phase 2 then certifies optimality). False: no entering variable (this basis proves the bounds
+// cannot meet the torque), a singular basis or the iteration cap: the caller starts cold.
+bool run_dual(Lp& lp, const Vec3& tau, int max_steps) {
+  for (int step = 0;; ++step) {
+    Mat3 binv;
+    Vec3 xb;
+    if (!basic_solution(lp, tau, binv, xb)) return false;
+    int r = -1;
+    if (infeasibility(lp, xb, &r) == 0.0) return true;
+    if (step >= max_steps || lp.iterations >= L1Allocation::kMaxIterations) return false;
+    const auto kr = static_cast<std::size_t>(r);
+    const int leaving = lp.basis[kr];
+    const bool to_upper = xb(r) > lp.ub[static_cast<std::size_t>(leaving)];
+    Vec3 cb;
+    for (int i = 0; i < 3; ++i) cb(i) = lp.cost(lp.basis[static_cast<std::size_t>(i)]);
+    const Vec3 y = binv.transpose() * cb;
+    const Vec3 row = binv.row(r).transpose();
+    int enter = -1;
+    double best = kInf;
+    for (int j = 0; j < kStructural; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      if (lp.basic[k] || !(lp.ub[k] > 0.0)) continue;
+      const Vec3 a = lp.column(j);
+      const double alpha = row.dot(a);
+      const double dir = lp.upper[k] ? -1.0 : 1.0;
+      // x_r moves by -dir theta alpha: up (towards 0) when it is negative, down when above ub.
+      const double move = -dir * alpha;
+      if (!(to_upper ? move < -kPivotTol : move > kPivotTol)) continue;
+      const double d = std::fabs(lp.cost(j) - y.dot(a));
+      const double ratio = d / std::fabs(alpha);
+      if (ratio < best - kTieTol) {
+        best = ratio;
+        enter = j;
+      }
+    }
+    if (enter < 0) return false;
+    ++lp.iterations;
+    const auto ke = static_cast<std::size_t>(enter);
+    lp.basic[static_cast<std::size_t>(leaving)] = false;
+    lp.upper[static_cast<std::size_t>(leaving)] = to_upper;
+    lp.basis[kr] = enter;
+    lp.basic[ke] = true;
+    lp.upper[ke] = false;
+  }
+}
+
+// The basis in ascending variable order: the final solution is computed from the same matrix
+// whichever path (cold or warm) reached the basis, so both give the same numbers.
+void sort_basis(Lp& lp) {
+  auto& b = lp.basis;
+  if (b[0] > b[1]) std::swap(b[0], b[1]);
+  if (b[1] > b[2]) std::swap(b[1], b[2]);
+  if (b[0] > b[1]) std::swap(b[0], b[1]);
+}
+
+// The index of variable j in the problem for -tau: u+ and u- swap (their columns are each
+// other's negatives), so a basis optimal for tau is, mirrored, optimal for -tau.
+int mirrored(int j) { return j < kChannels ? j + kChannels : j - kChannels; }
+
 }  // namespace
 
 bool L1Allocation::configure(const Mat38& b_hat, double u_max, Pricing pricing) {
   const double s = b_hat.cwiseAbs().maxCoeff();
   if (!b_hat.allFinite() || !(s > 0.0) || !std::isfinite(u_max) || !(u_max > 0.0)) return false;
   b_scale_ = s;
+  hint_.valid = false;
+  stats_ = L1StartCounts{};
   b_scaled_ = b_hat / s;
   u_max_ = u_max;
   pricing_ = pricing;
@@ -179,34 +259,80 @@ L1Solution L1Allocation::solve(const Vec3& tau, const Vec8& lo, const Vec8& hi) 
   Lp lp;
   lp.a = &b_scaled_;
   lp.bland_only = pricing_ == Pricing::kBland;
-  for (int i = 0; i < 3; ++i) lp.art_sign(i) = tau_s(i) < 0.0 ? -1.0 : 1.0;
-  for (int j = 0; j < kVars; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    lp.basic[k] = j >= kStructural;
-    lp.upper[k] = false;
-    lp.ub[k] = j < kStructural ? bound[k] : kInf;
-  }
-  lp.basis = {kStructural, kStructural + 1, kStructural + 2};
-
-  // Phase 1: from u = 0 with the artificials carrying the torque, to a feasible vertex.
-  lp.phase = 1;
-  const bool phase1 = run_phase(lp, tau_s);
-  out.iterations = static_cast<std::uint16_t>(lp.iterations);
-  if (!phase1) return out;
   Mat3 binv;
   Vec3 xb;
-  if (!basic_solution(lp, tau_s, binv, xb)) return out;
-  for (int r = 0; r < 3; ++r) {
-    if (lp.basis[static_cast<std::size_t>(r)] >= kStructural && xb(r) > kFeasTol) return out;
+
+  // Warm start: the previous solution's basis, or its mirror. The costs and B_hat are the same
+  // from one solve to the next (only the torque and the bounds change), so that basis is still
+  // dual feasible and the dual simplex takes it to a feasible one in a few steps; phase 2 then
+  // certifies it exactly as it certifies a cold start.
+  bool warm = false;
+  if (warm_start_ && hint_.valid) {
+    auto load = [&](bool mirror) {
+      for (int j = 0; j < kVars; ++j) {
+        const auto k = static_cast<std::size_t>(j);
+        lp.basic[k] = false;
+        lp.upper[k] = false;
+        lp.ub[k] = j < kStructural ? bound[k] : 0.0;
+      }
+      for (int j = 0; j < kStructural; ++j) {
+        const auto k = static_cast<std::size_t>(mirror ? mirrored(j) : j);
+        lp.upper[k] = hint_.upper[static_cast<std::size_t>(j)] && lp.ub[k] > 0.0;
+      }
+      for (int r = 0; r < 3; ++r) {
+        const int j = hint_.basis[static_cast<std::size_t>(r)];
+        const int v = mirror ? mirrored(j) : j;
+        lp.basis[static_cast<std::size_t>(r)] = v;
+        lp.basic[static_cast<std::size_t>(v)] = true;
+        lp.upper[static_cast<std::size_t>(v)] = false;
+      }
+      lp.phase = 2;
+      return basic_solution(lp, tau_s, binv, xb) ? infeasibility(lp, xb, nullptr) : kInf;
+    };
+    const double as_is = load(false);
+    bool mirror = false;
+    if (as_is > 0.0) {
+      const double flipped = load(true);
+      mirror = flipped < as_is;
+      if (!mirror) load(false);
+    }
+    warm = (mirror || as_is < kInf) && run_dual(lp, tau_s, kMaxDualSteps);
+    ++(warm ? stats_.warm : stats_.cold);
+  } else {
+    ++stats_.cold;
   }
-  // Artificials still basic (at zero: redundant-looking rows) are fixed at zero from now on.
-  for (int j = kStructural; j < kVars; ++j) lp.ub[static_cast<std::size_t>(j)] = 0.0;
+
+  if (!warm) {
+    for (int i = 0; i < 3; ++i) lp.art_sign(i) = tau_s(i) < 0.0 ? -1.0 : 1.0;
+    for (int j = 0; j < kVars; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      lp.basic[k] = j >= kStructural;
+      lp.upper[k] = false;
+      lp.ub[k] = j < kStructural ? bound[k] : kInf;
+    }
+    lp.basis = {kStructural, kStructural + 1, kStructural + 2};
+
+    // Phase 1: from u = 0 with the artificials carrying the torque, to a feasible vertex.
+    lp.phase = 1;
+    const bool phase1 = run_phase(lp, tau_s);
+    out.iterations = static_cast<std::uint16_t>(lp.iterations);
+    if (!phase1) return out;
+    if (!basic_solution(lp, tau_s, binv, xb)) return out;
+    for (int r = 0; r < 3; ++r) {
+      if (lp.basis[static_cast<std::size_t>(r)] >= kStructural && xb(r) > kFeasTol) return out;
+    }
+    // Artificials still basic (at zero: redundant-looking rows) are fixed at zero from now on.
+    for (int j = kStructural; j < kVars; ++j) lp.ub[static_cast<std::size_t>(j)] = 0.0;
+  }
 
   // Phase 2: Eq. (52).
   lp.phase = 2;
   const bool phase2 = run_phase(lp, tau_s);
   out.iterations = static_cast<std::uint16_t>(lp.iterations);
-  if (!phase2 || !basic_solution(lp, tau_s, binv, xb)) return out;
+  out.warm = warm;
+  if (!phase2) return out;
+  sort_basis(lp);
+  if (!basic_solution(lp, tau_s, binv, xb)) return out;
 
   std::array<double, kVars> x{};
   for (int j = 0; j < kVars; ++j) {
@@ -229,6 +355,15 @@ L1Solution L1Allocation::solve(const Vec3& tau, const Vec8& lo, const Vec8& hi) 
   if ((b_scaled_ * v - tau_s).lpNorm<Eigen::Infinity>() > kFeasTol) return out;
   out.u = u_max_ * v;
   out.ok = true;
+  hint_.valid = true;
+  for (int r = 0; r < 3; ++r) {
+    const int j = lp.basis[static_cast<std::size_t>(r)];
+    hint_.basis[static_cast<std::size_t>(r)] = j;
+    if (j >= kStructural) hint_.valid = false;  // an artificial at zero: no basis to keep
+  }
+  for (int j = 0; j < kStructural; ++j) {
+    hint_.upper[static_cast<std::size_t>(j)] = lp.upper[static_cast<std::size_t>(j)];
+  }
   return out;
 }
 

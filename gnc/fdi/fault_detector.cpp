@@ -47,19 +47,14 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
     }
   }
   st_ = FaultDetectorStatus{};
-  score_.fill(0.0);  // before set_model: nothing suspected, the model is taken (F7)
+  score_.fill(0.0);
+  suspecting_ = false;  // before set_model: nothing suspected, the model is taken (F7)
   FaultModel m;
   m.j = Mat3::Identity();
   set_model(m);
   reset();
 }
 
-bool FaultDetector::suspecting() const {
-  for (double s : score_) {
-    if (s > 0.5 * p_.confirm_llr) return true;
-  }
-  return false;
-}
 
 void FaultDetector::reset_episode() {
   lambda_.fill(0.0);
@@ -69,10 +64,20 @@ void FaultDetector::reset_episode() {
   st_.ambiguous_with = -1;
 }
 
+void FaultDetector::cancel_evaluation() {
+  // A declaration or a clearance changes what is predicted: the window being evaluated and the
+  // one open (partly predicted without it) are dropped; the next valid sample starts afresh. A
+  // staged model is taken on the next update.
+  eval_phase_ = 0;
+  have_start_ = false;
+}
+
 void FaultDetector::reset() {
   have_start_ = false;
   n_ = 0;
+  cancel_evaluation();
   score_.fill(0.0);
+  suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
   const std::uint16_t on = st_.confirmed_on;
@@ -90,6 +95,17 @@ void FaultDetector::set_model(const FaultModel& m) {
     ++st_.models_held;
     return;
   }
+  // (F10) The closed window under evaluation is scored with the model its prediction used; a
+  // new one waits for the end of the evaluation (a copy, no heap).
+  if (eval_phase_ != 0) {
+    staged_ = m;
+    model_staged_ = true;
+    return;
+  }
+  apply_model(m);
+}
+
+void FaultDetector::apply_model(const FaultModel& m) {
   m_ = m;
   r_sigma_ = std::sqrt(std::fmax(0.0, m.r_cov.diagonal().maxCoeff()));
   j_inv_ = m.j.inverse();
@@ -113,7 +129,9 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
   if (kind == FaultKind::kStuckOn) st_.confirmed_on |= bit;
   if (kind == FaultKind::kStuckOff) st_.confirmed_off |= bit;
+  cancel_evaluation();  // that window was scored without the fault in the model
   score_.fill(0.0);
+  suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
   st_.probe_pod = -1;
@@ -128,7 +146,9 @@ void FaultDetector::clear(int thruster) {
     st_.confirmed_on = static_cast<std::uint16_t>(st_.confirmed_on & ~bit);
     st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
   }
+  cancel_evaluation();
   score_.fill(0.0);
+  suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
   st_.probe_pod = -1;
@@ -137,6 +157,14 @@ void FaultDetector::clear(int thruster) {
 FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   pending_ = FaultEvents{};
   if (!p_.enabled) return pending_;
+  // (F10) One step of the closed window's evaluation per tick, whatever this tick's data; a model
+  // that arrived meanwhile is taken once it is done (before this tick's sample, like any other).
+  if (eval_phase_ != 0) {
+    evaluate_step();
+  } else if (model_staged_) {
+    model_staged_ = false;
+    set_model(staged_);
+  }
   if (!in.omega_valid || !in.thrust_valid || !in.omega.allFinite() || !in.thrust.allFinite()) {
     have_start_ = false;  // a gap breaks the window; the next valid sample starts another
     return pending_;
@@ -161,57 +189,21 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
     thrust_rate += b_[k] * f;
   }
   predicted_ += (thrust_rate - gyro) * dt_;
+  WindowSums& acc = win_[static_cast<std::size_t>(acc_)];
   // Model-uncertainty scale (F5): the thrust term, and the gyroscopic term's sensitivity to J,
   // |J^-1 (w x dJ w)| + |dJ^-1 (w x J w)| <= 2 ||J^-1|| ||dJ|| |w|^2 (not |J^-1 (w x J w)|, which
   // vanishes near a principal axis while its error does not).
-  motion_ += (thrust_rate.norm() + 2.0 * j_inv_norm_ * j_norm_ * w.squaredNorm()) * dt_;
+  const double thrust_norm = thrust_rate.norm();
+  acc.motion += (thrust_norm + 2.0 * j_inv_norm_ * j_norm_ * w.squaredNorm()) * dt_;
   // (the relative 1 sigma multiplies this: ||dJ||_2 = rel ||J||_2)
-  thrust_motion_ += thrust_rate.norm() * dt_;
-  force_impulse_ += in.thrust.sum() * dt_;
+  acc.thrust_motion += thrust_norm * dt_;
+  acc.force_impulse += in.thrust.sum() * dt_;
   ++n_;
-  const double t = static_cast<double>(n_);
   const Vec3 r = in.omega - omega_start_ - predicted_;  // (F3) residual of sample j
-  sum_r_ += r;
-  sum_rr_ += r.squaredNorm();
-  sum_t_ += t;
-  sum_tt_ += t * t;
-  sum_tr_ += t * r;
-  // (F4) signatures: stuck-on adds (u_max - f) of its thrust, stuck-off removes f; both only
-  // while the pod's valve is open (a closed pod produces nothing under any hypothesis).
-  for (int i = 0; i < kThrusters; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const auto h = k + static_cast<std::size_t>(kThrusters);
-    if (in.valve_open[static_cast<std::size_t>(pod_[k])]) {
-      const double f = in.thrust(i);
-      c_[k] += (u_max_ - f) * dt_;
-      c_[h] -= f * dt_;
-    }
-    sum_c_[k] += c_[k];
-    sum_c_[h] += c_[h];
-    sum_cc_[k] += c_[k] * c_[k];
-    sum_cc_[h] += c_[h] * c_[h];
-    sum_cr_[k] += c_[k] * r;
-    sum_cr_[h] += c_[h] * r;
-  }
-  // (F8) cross sums of the basis ramps (the hypotheses' pairs follow from them).
-  std::array<double, kBasis> x{};
-  for (int i = 0; i < kThrusters; ++i) {
-    x[static_cast<std::size_t>(i)] = c_[static_cast<std::size_t>(i + kThrusters)];
-  }
-  for (int q = 0; q < kPods; ++q) {
-    const auto pq = static_cast<std::size_t>(q);
-    if (in.valve_open[pq]) tp_[pq] += dt_;
-    sum_tp_[pq] += tp_[pq];
-    x[static_cast<std::size_t>(kThrusters + q)] = tp_[pq];
-  }
-  std::size_t idx = 0;
-  for (std::size_t a = 0; a < x.size(); ++a) {
-    const double xa = x[a];
-    if (xa == 0.0) {  // a jet not fired in this window so far: its row stays zero
-      idx += x.size() - a;
-      continue;
-    }
-    for (std::size_t b = a; b < x.size(); ++b) sum_xx_[idx++] += xa * x[b];
+  if (n_ == 1) {
+    accumulate<true>(acc, in, r);
+  } else {
+    accumulate<false>(acc, in, r);
   }
   omega_prev_ = in.omega;
   if (n_ >= p_.window_ticks) {
@@ -221,58 +213,168 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   return pending_;
 }
 
+template <bool kFirst>
+void FaultDetector::accumulate(WindowSums& w, const FaultDetectorInput& in, const Vec3& r) {
+  // A window's first sample assigns every sum (the set was last used two windows ago).
+  const double t = static_cast<double>(n_);
+  if (kFirst) {
+    w.sum_r = r;
+    w.sum_t = t;
+    w.sum_tt = t * t;
+    w.sum_tr = t * r;
+  } else {
+    w.sum_r += r;
+    w.sum_t += t;
+    w.sum_tt += t * t;
+    w.sum_tr += t * r;
+  }
+  // (F4) signatures: stuck-on adds (u_max - f) of its thrust, stuck-off removes f; both only
+  // while the pod's valve is open (a closed pod produces nothing under any hypothesis).
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto h = k + static_cast<std::size_t>(kThrusters);
+    double on = 0.0;
+    double off = 0.0;
+    if (in.valve_open[static_cast<std::size_t>(pod_[k])]) {
+      const double f = in.thrust(i);
+      on = (u_max_ - f) * dt_;
+      off = -f * dt_;
+    }
+    if (kFirst) {
+      w.c[k] = on;
+      w.c[h] = off;
+      w.sum_c[k] = on;
+      w.sum_c[h] = off;
+      w.sum_cc[k] = on * on;
+      w.sum_cc[h] = off * off;
+      w.sum_cr[k] = on * r;
+      w.sum_cr[h] = off * r;
+    } else {
+      const double ck = (w.c[k] += on);
+      const double ch = (w.c[h] += off);
+      w.sum_c[k] += ck;
+      w.sum_c[h] += ch;
+      w.sum_cc[k] += ck * ck;
+      w.sum_cc[h] += ch * ch;
+      w.sum_cr[k] += ck * r;
+      w.sum_cr[h] += ch * r;
+    }
+  }
+  // (F8) cross sums of the basis ramps (the hypotheses' pairs follow from them).
+  std::array<double, kBasis> x{};
+  for (int i = 0; i < kThrusters; ++i) {
+    x[static_cast<std::size_t>(i)] = w.c[static_cast<std::size_t>(i + kThrusters)];
+  }
+  for (int q = 0; q < kPods; ++q) {
+    const auto pq = static_cast<std::size_t>(q);
+    const double open = in.valve_open[pq] ? dt_ : 0.0;
+    if (kFirst) {
+      w.tp[pq] = open;
+      w.sum_tp[pq] = open;
+    } else {
+      w.tp[pq] += open;
+      w.sum_tp[pq] += w.tp[pq];
+    }
+    x[static_cast<std::size_t>(kThrusters + q)] = w.tp[pq];
+  }
+  if (kFirst) w.live = 0;
+  std::size_t idx = 0;
+  for (std::size_t a = 0; a < x.size(); ++a) {
+    const double xa = x[a];
+    const std::uint32_t bit = 1u << a;
+    if (xa == 0.0) {  // ramp a still zero: nothing to add (its row is not live yet, or adds 0)
+      idx += x.size() - a;
+      continue;
+    }
+    if ((w.live & bit) == 0) {  // ramp a starts: its row is assigned (no clearing needed)
+      w.live |= bit;
+      for (std::size_t b = a; b < x.size(); ++b) w.sum_xx[idx++] = xa * x[b];
+    } else {
+      for (std::size_t b = a; b < x.size(); ++b) w.sum_xx[idx++] += xa * x[b];
+    }
+  }
+}
+
 void FaultDetector::start_window(const Vec3& omega) {
   have_start_ = true;
   n_ = 0;
   omega_start_ = omega;
   omega_prev_ = omega;
   predicted_.setZero();
-  motion_ = 0.0;
-  force_impulse_ = 0.0;
-  thrust_motion_ = 0.0;
-  sum_r_.setZero();
-  sum_rr_ = 0.0;
-  sum_t_ = sum_tt_ = 0.0;
-  sum_tr_.setZero();
-  c_.fill(0.0);
-  sum_c_.fill(0.0);
-  sum_cc_.fill(0.0);
-  for (Vec3& v : sum_cr_) v.setZero();
-  tp_.fill(0.0);
-  sum_tp_.fill(0.0);
-  sum_xx_.fill(0.0);
+  WindowSums& w = win_[static_cast<std::size_t>(acc_)];
+  w.motion = 0.0;
+  w.force_impulse = 0.0;
+  w.thrust_motion = 0.0;
+  w.live = 0;
 }
 
 void FaultDetector::close_window() {
-  const double n = static_cast<double>(n_);
+  // (F10) The closed set is evaluated over the next kEvaluationSteps updates while the other set
+  // accumulates the next window. An evaluation still running (a window shorter than the steps:
+  // not with window_ticks >= 4) is finished first.
+  while (eval_phase_ != 0) evaluate_step();
+  win_[static_cast<std::size_t>(acc_)].n = n_;
+  acc_ ^= 1;
+  eval_phase_ = 1;
+}
+
+void FaultDetector::evaluate_step() {
+  const WindowSums& w = win_[static_cast<std::size_t>(acc_ ^ 1)];
+  switch (eval_phase_) {
+    case 1:
+      evaluate_noise(w);
+      evaluate_scores(w, 0, kThrusters);
+      eval_phase_ = 2;
+      break;
+    case 2:
+      evaluate_scores(w, kThrusters, kHypotheses);
+      rank_hypotheses();
+      eval_phase_ = 3;
+      break;
+    case 3:
+      evaluate_cross(w);
+      eval_phase_ = 4;
+      break;
+    default:
+      eval_phase_ = 0;
+      decide();
+      break;
+  }
+}
+
+void FaultDetector::evaluate_noise(const WindowSums& w) {
+  const double n = static_cast<double>(w.n);
   // (F5) noise of a residual sample: the gyro (start and sample), the disturbance over the window,
   // and the model's relative uncertainty times the motion it predicts.
   const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
   const double dist = p_.disturbance_sigma * j_inv_.norm() * n * dt_;
-  const double model = rel * motion_;
+  const double model = rel * w.motion;
   // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
   // r_sigma times the jets' force, and k_sigma times their torque.
-  const double offset = r_sigma_ * j_inv_.norm() * force_impulse_;
-  const double strength = m_.k_sigma * thrust_motion_;
+  const double offset = r_sigma_ * j_inv_.norm() * w.force_impulse;
+  const double strength = m_.k_sigma * w.thrust_motion;
   const double var = 2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model +
                      offset * offset + strength * strength + 1e-30;
+  eval_var_ = var;
   st_.noise_sigma = std::sqrt(var);
   // The unknown offset (the start sample's own noise) is removed: mean-centred sums.
-  const Vec3 r_mean = sum_r_ / n;
+  const Vec3 r_mean = w.sum_r / n;
   // Slope test (no fault): least-squares rate of change of the residual, chi-square with 3 dof.
-  const double stt = sum_tt_ - sum_t_ * sum_t_ / n;
-  const Vec3 str = sum_tr_ - sum_t_ * r_mean;
+  const double stt = w.sum_tt - w.sum_t * w.sum_t / n;
+  const Vec3 str = w.sum_tr - w.sum_t * r_mean;
   const Vec3 slope = stt > 0.0 ? Vec3(str / stt) : Vec3::Zero();
   st_.residual = slope * n;  // rate change over the window that the model does not explain
   st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
   ++st_.windows;
+}
+
+void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
   // (F6) sequential log-likelihood ratios, CUSUM with exoneration at zero; (F8) the episode's
   // unfloored sums, every window, observable or not (their differences are exact pairwise LLRs).
-  int best = -1;
-  int runner_up = -1;
-  double best_s = 0.0;
-  double second = 0.0;
-  for (int h = 0; h < kHypotheses; ++h) {
+  const double n = static_cast<double>(w.n);
+  const double var = eval_var_;
+  const Vec3 r_mean = w.sum_r / n;
+  for (int h = first; h < last; ++h) {
     const auto k = static_cast<std::size_t>(h);
     const int thruster = h % kThrusters;
     const bool latched = (((st_.confirmed_on | st_.confirmed_off) >> thruster) & 1u) != 0;
@@ -281,11 +383,11 @@ void FaultDetector::close_window() {
       continue;
     }
     const Vec3& b = b_[k % static_cast<std::size_t>(kThrusters)];
-    sig_[k] = b * c_[k];
+    sig_[k] = b * w.c[k];
     // Mean-centred sums: sum S~ r~ = b.(sum c r) - (b.r_mean) sum c; sum |S~|^2 = |b|^2 (sum c^2 -
     // (sum c)^2 / n).
-    const double sr = b.dot(sum_cr_[k]) - b.dot(r_mean) * sum_c_[k];
-    const double cc = sum_cc_[k] - sum_c_[k] * sum_c_[k] / n;
+    const double sr = b.dot(w.sum_cr[k]) - b.dot(r_mean) * w.sum_c[k];
+    const double cc = w.sum_cc[k] - w.sum_c[k] * w.sum_c[k] / n;
     const double ss = b.squaredNorm() * cc;
     const double llr = (sr - 0.5 * ss) / var;
     lambda_[k] += llr;
@@ -293,6 +395,16 @@ void FaultDetector::close_window() {
     if (ss / var >= p_.min_signature) {  // else not observable in this window: no evidence
       score_[k] = std::fmax(0.0, score_[k] + llr);
     }
+  }
+}
+
+void FaultDetector::rank_hypotheses() {
+  int best = -1;
+  int runner_up = -1;
+  double best_s = 0.0;
+  double second = 0.0;
+  for (int h = 0; h < kHypotheses; ++h) {
+    const auto k = static_cast<std::size_t>(h);
     if (score_[k] > best_s) {
       second = best_s;
       runner_up = best;
@@ -303,27 +415,10 @@ void FaultDetector::close_window() {
       runner_up = h;
     }
   }
-  // The episode's mean-centred cross sums of the basis ramps, weighted by the window's 1 / var.
-  {
-    std::array<double, kBasis> sx{};
-    for (int i = 0; i < kThrusters; ++i) {
-      sx[static_cast<std::size_t>(i)] = sum_c_[static_cast<std::size_t>(i + kThrusters)];
-    }
-    for (int q = 0; q < kPods; ++q) {
-      sx[static_cast<std::size_t>(kThrusters + q)] = sum_tp_[static_cast<std::size_t>(q)];
-    }
-    const double inv_var = 1.0 / var;
-    std::size_t idx = 0;
-    for (std::size_t a = 0; a < sx.size(); ++a) {
-      const double sa = sx[a] / n;
-      for (std::size_t b = a; b < sx.size(); ++b, ++idx) {
-        cross_xx_[idx] += (sum_xx_[idx] - sa * sx[b]) * inv_var;
-      }
-    }
-  }
   st_.best = best;
   st_.best_llr = best_s;
   st_.runner_up_llr = second;
+  runner_up_ = runner_up;
   st_.suspected_on = 0;
   st_.suspected_off = 0;
   if (best >= 0 && best_s > 0.5 * p_.confirm_llr) {
@@ -334,6 +429,39 @@ void FaultDetector::close_window() {
       st_.suspected_off = bit;
     }
   }
+  suspecting_ = best_s > 0.5 * p_.confirm_llr;
+}
+
+void FaultDetector::evaluate_cross(const WindowSums& w) {
+  // The episode's mean-centred cross sums of the basis ramps, weighted by the window's 1 / var.
+  // A ramp that stayed zero (its row not live) adds nothing: its sums are zero.
+  const double n = static_cast<double>(w.n);
+  std::array<double, kBasis> sx{};
+  for (int i = 0; i < kThrusters; ++i) {
+    sx[static_cast<std::size_t>(i)] = w.sum_c[static_cast<std::size_t>(i + kThrusters)];
+  }
+  for (int q = 0; q < kPods; ++q) {
+    sx[static_cast<std::size_t>(kThrusters + q)] = w.sum_tp[static_cast<std::size_t>(q)];
+  }
+  const double inv_var = 1.0 / eval_var_;
+  std::size_t idx = 0;
+  for (std::size_t a = 0; a < sx.size(); ++a) {
+    if ((w.live & (1u << a)) == 0) {
+      idx += sx.size() - a;
+      continue;
+    }
+    const double sa = sx[a] / n;
+    for (std::size_t b = a; b < sx.size(); ++b, ++idx) {
+      cross_xx_[idx] += (w.sum_xx[idx] - sa * sx[b]) * inv_var;
+    }
+  }
+}
+
+void FaultDetector::decide() {
+  const int best = st_.best;
+  const double best_s = st_.best_llr;
+  const double second = st_.runner_up_llr;
+  const int runner_up = runner_up_;
   if (st_.chi2 > p_.suspect_chi2) {
     ++st_.suspicions;
     pending_.suspected = true;

@@ -111,11 +111,20 @@ class FaultDetector {
   void configure(const FaultDetectorParams& p, const RcsLayout& rcs, double u_max, double dt);
   void reset();  // scores and windows; latched faults are kept (clear() removes them)
   void set_model(const FaultModel& m);
-  // Whether the next valid update closes a window (the executive keeps other periodic work off
-  // that tick).
+  // Whether the next valid update closes a window.
   bool window_closes_next() const {
     return p_.enabled && have_start_ && n_ + 1 >= p_.window_ticks;
   }
+  // (F10) A closed window is being evaluated: the next update runs one step of it.
+  bool evaluating() const { return eval_phase_ != 0; }
+  // The next update runs one of the evaluation's heavy steps: the two scoring steps, and the
+  // decision when a hypothesis is past the confirmation level (the bias-bounded margins (F8)
+  // against every alternative). The executive keeps other periodic work off those ticks.
+  bool heavy_step_next() const {
+    return eval_phase_ == 1 || eval_phase_ == 2 ||
+           (eval_phase_ == 4 && st_.best_llr > p_.confirm_llr);
+  }
+  static constexpr int kEvaluationSteps = 4;
   FaultEvents update(const FaultDetectorInput& in);
 
   // Ground overrides and what the flight does after isolation.
@@ -127,7 +136,7 @@ class FaultDetector {
   const FaultDetectorParams& params() const { return p_; }
   // A hypothesis is suspected (its score above half the confirmation level): the model it is
   // tested against is held (F7), and the identifier should not absorb the fault either.
-  bool suspecting() const;
+  bool suspecting() const { return suspecting_; }
   // (F9) The pod whose latch valve the detector asks to be closed for an isolation test (-1 none).
   int probe_pod() const { return st_.probe_pod; }
 
@@ -139,6 +148,7 @@ class FaultDetector {
  private:
   void close_window();
   void start_window(const Vec3& omega);
+  void cancel_evaluation();
   void reset_episode();
   // The alternative that the leader h cannot yet be told from under (F6)/(F8), or -1 (exposed to
   // close_window only).
@@ -147,7 +157,6 @@ class FaultDetector {
   FaultDetectorParams p_{};
   double u_max_{200.0};
   double dt_{0.1};
-  std::array<Vec3, kThrusters> arm_x_e_{};  // (p_i + r) x e_i with the model's r (recomputed)
   std::array<Vec3, kThrusters> pos_{};
   std::array<Vec3, kThrusters> dir_{};
   std::array<int, kThrusters> pod_{};
@@ -157,38 +166,6 @@ class FaultDetector {
   double j_inv_norm_{1.0};
   double j_norm_{1.0};
 
-  // Window accumulation (F2)-(F5): samples j = 1..n after the window's first sample.
-  int n_{0};
-  bool have_start_{false};
-  Vec3 omega_start_{Vec3::Zero()};  // rate at the window's first sample
-  Vec3 omega_prev_{Vec3::Zero()};
-  Vec3 predicted_{Vec3::Zero()};    // cumulative predicted rate change since the start
-  double motion_{0.0};              // cumulative |predicted terms| * dt (model-uncertainty scale)
-  double force_impulse_{0.0};       // cumulative sum of thrust * dt over the jets, N s
-  double thrust_motion_{0.0};       // cumulative |thrust rate change| * dt
-  Vec3 sum_r_{Vec3::Zero()};        // sum of residuals r_j
-  double sum_rr_{0.0};
-  double sum_t_{0.0};               // sum of j (sample index), for the slope test
-  double sum_tt_{0.0};
-  Vec3 sum_tr_{Vec3::Zero()};
-  // The signature of hypothesis h is S_h(j) = b_i c_h(j) with the scalar c_h(j) = sum of the
-  // extra (stuck-on: u_max - f) or missing (stuck-off: -f) thrust times dt up to sample j, so
-  // the window's sums need only scalars and one vector per hypothesis (F5).
-  std::array<double, kHypotheses> c_{};
-  std::array<double, kHypotheses> sum_c_{};
-  std::array<double, kHypotheses> sum_cc_{};
-  std::array<Vec3, kHypotheses> sum_cr_{};
-  std::array<Vec3, kHypotheses> sig_{};  // b c of the last window, for signature()
-  std::array<Vec3, kThrusters> b_{};
-  std::array<double, kThrusters> sigma_b_{};  // (F8) 1 sigma of b_i per axis from the model's  // J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i
-
-  std::array<double, kHypotheses> score_{};
-  // (F8) Since the current episode began (the last window with every score at zero): the
-  // unfloored cumulative LLR of each hypothesis, its information A_h = sum |c~_h|^2 / var, and the
-  // cross terms C_hg = sum c~_h c~_g / var, kept as the basis's (cross_basis()).
-  std::array<double, kHypotheses> lambda_{};
-  std::array<double, kHypotheses> info_{};
-  double cross(int h, int g) const;
   // Every c_h is a combination of 20 basis ramps (F4): x_i = c of "i stuck off" (16) and the open
   // time of each pod (4), c_{i on} = u_max x_{16+pod(i)} + x_i. Per tick only the basis's cross
   // sums are accumulated (210, not the 496 pairs of hypotheses).
@@ -197,9 +174,69 @@ class FaultDetector {
   static constexpr int basis_index(int a, int b) {  // a <= b
     return a * (2 * kBasis - a + 1) / 2 + (b - a);
   }
-  std::array<double, kPods> tp_{};      // open time of each pod since the window's start
-  std::array<double, kPods> sum_tp_{};  // its sum over the window's samples
-  std::array<double, kBasisPairs> sum_xx_{};   // per window: sum_j x_a x_b
+
+  // Window accumulation (F2)-(F5): samples j = 1..n after the window's first sample. Two sets:
+  // one accumulates the open window while the other, closed, is evaluated over the next ticks
+  // (F10). The arrays are assigned on a window's first sample, never cleared.
+  struct WindowSums {
+    int n{0};
+    double motion{0.0};         // cumulative |predicted terms| * dt (model-uncertainty scale)
+    double force_impulse{0.0};  // cumulative sum of thrust * dt over the jets, N s
+    double thrust_motion{0.0};  // cumulative |thrust rate change| * dt
+    Vec3 sum_r{Vec3::Zero()};   // sum of residuals r_j
+    double sum_t{0.0};          // sum of j (sample index), for the slope test
+    double sum_tt{0.0};
+    Vec3 sum_tr{Vec3::Zero()};
+    // The signature of hypothesis h is S_h(j) = b_i c_h(j) with the scalar c_h(j) = sum of the
+    // extra (stuck-on: u_max - f) or missing (stuck-off: -f) thrust times dt up to sample j, so
+    // the window's sums need only scalars and one vector per hypothesis (F5).
+    std::array<double, kHypotheses> c{};
+    std::array<double, kHypotheses> sum_c{};
+    std::array<double, kHypotheses> sum_cc{};
+    std::array<Vec3, kHypotheses> sum_cr{};
+    std::array<double, kPods> tp{};      // open time of each pod since the window's start
+    std::array<double, kPods> sum_tp{};  // its sum over the window's samples
+    // sum_j x_a x_b; row a is written only once ramp a is non-zero (bit a of `live`): a ramp
+    // that stays zero all window contributes nothing and its row is not read.
+    std::array<double, kBasisPairs> sum_xx{};
+    std::uint32_t live{0};
+  };
+  template <bool kFirst>
+  void accumulate(WindowSums& w, const FaultDetectorInput& in, const Vec3& r);
+  // (F10) One step of the closed window's evaluation: 1 the noise and the stuck-on scores, 2 the
+  // stuck-off scores and the ranking, 3 the episode's cross sums, 4 the decision.
+  void evaluate_step();
+  void evaluate_noise(const WindowSums& w);
+  void evaluate_scores(const WindowSums& w, int first, int last);
+  void rank_hypotheses();
+  void evaluate_cross(const WindowSums& w);
+  void decide();
+  void apply_model(const FaultModel& m);
+
+  int n_{0};
+  bool have_start_{false};
+  Vec3 omega_start_{Vec3::Zero()};  // rate at the window's first sample
+  Vec3 omega_prev_{Vec3::Zero()};
+  Vec3 predicted_{Vec3::Zero()};    // cumulative predicted rate change since the start
+  std::array<WindowSums, 2> win_{};
+  int acc_{0};         // the set the open window accumulates into
+  int eval_phase_{0};  // next step of the closed window's evaluation (1..4), 0 none
+  double eval_var_{1.0};  // the closed window's residual variance (F5)
+  bool model_staged_{false};  // a model that arrived during an evaluation, applied after it
+  FaultModel staged_{};
+  std::array<Vec3, kHypotheses> sig_{};  // b c of the last window, for signature()
+  // (F1) J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i.
+  std::array<Vec3, kThrusters> b_{};
+
+  std::array<double, kHypotheses> score_{};
+  bool suspecting_{false};  // some score above half the confirmation level (F7)
+  int runner_up_{-1};       // the runner-up of the last scored window
+  // (F8) Since the current episode began (the last window with every score at zero): the
+  // unfloored cumulative LLR of each hypothesis, its information A_h = sum |c~_h|^2 / var, and the
+  // cross terms C_hg = sum c~_h c~_g / var, kept as the basis's (cross_basis()).
+  std::array<double, kHypotheses> lambda_{};
+  std::array<double, kHypotheses> info_{};
+  double cross(int h, int g) const;
   std::array<double, kBasisPairs> cross_xx_{};  // per episode: sum_w (sum x~_a x~_b) / var
   int ambiguous_windows_{0};
   int probe_left_{0};

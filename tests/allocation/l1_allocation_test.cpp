@@ -377,3 +377,121 @@ TEST(L1Allocation, ManyRequestsNoFallbackAndBoundedIterations) {
 }
 
 }  // namespace
+
+namespace {
+
+// Warm start: the same optimum as a cold start (and as the enumeration), from far fewer steps.
+// Three torque histories: a slowly turning request (a despin), one whose sign flips every solve
+// (HOLD answering noise), and random directions with random per-channel bounds (faults).
+TEST(L1Allocation, WarmStartReachesTheColdOptimumFromThePreviousBasisOrItsMirror) {
+  const Mat38 b = study_b(Vec3(0.05, -0.1, 0.2));
+  const double u_max = 200.0;
+  L1Allocation warm, cold;
+  ASSERT_TRUE(warm.configure(b, u_max));
+  ASSERT_TRUE(cold.configure(b, u_max));
+  cold.set_warm_start(false);
+  const double cap = u_max * b.norm();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+
+  struct Totals {
+    long warm_it{0}, cold_it{0};
+    int warm_starts{0}, solves{0};
+  };
+  auto check = [&](const Vec3& tau, const Vec8& lo, const Vec8& hi, Totals& t, bool brute) {
+    const L1Solution w = warm.solve(tau, lo, hi);
+    const L1Solution c = cold.solve(tau, lo, hi);
+    ASSERT_TRUE(c.ok) << tau.transpose();
+    ASSERT_TRUE(w.ok) << tau.transpose();
+    EXPECT_FALSE(c.warm);
+    ASSERT_NEAR(w.u.lpNorm<1>(), c.u.lpNorm<1>(), 1e-9 * u_max);
+    ASSERT_LE((b * w.u - tau).norm(), 1e-9 * (tau.norm() + 1.0));
+    for (int i = 0; i < 8; ++i) {
+      ASSERT_GE(w.u(i), lo(i) - 1e-9 * u_max);
+      ASSERT_LE(w.u(i), hi(i) + 1e-9 * u_max);
+    }
+    if (brute) {
+      const BruteForce bf = brute_force_l1(b, u_max, tau);
+      ASSERT_GT(bf.feasible, 0);
+      ASSERT_NEAR(w.u.lpNorm<1>(), bf.l1, 1e-7 * u_max);
+    }
+    t.warm_it += w.iterations;
+    t.cold_it += c.iterations;
+    t.warm_starts += w.warm ? 1 : 0;
+    ++t.solves;
+  };
+  const Vec8 lo = Vec8::Constant(-u_max);
+  const Vec8 hi = Vec8::Constant(u_max);
+
+  // 1. A slowly turning request (1 degree per solve about a tilted axis), within the envelope.
+  Totals turning;
+  const Eigen::AngleAxisd step(M_PI / 180.0, Vec3(0.3, -0.5, 0.8).normalized());
+  Vec3 tau = 0.2 * cap * Vec3(1.0, 0.4, -0.2).normalized();
+  for (int k = 0; k < 720; ++k) {
+    tau = step * tau;
+    check(tau, lo, hi, turning, k % 40 == 0);
+  }
+  // 2. Alternating sign with a small random wander: the mirrored basis is optimal as it is.
+  Totals flipping;
+  Vec3 base = 0.05 * cap * Vec3(-0.2, 0.9, 0.4).normalized();
+  for (int k = 0; k < 400; ++k) {
+    base += 1e-3 * cap * Vec3(n(rng), n(rng), n(rng));
+    check((k % 2 == 0 ? 1.0 : -1.0) * base, lo, hi, flipping, k % 40 == 0);
+  }
+  // 3. Random directions and magnitudes with random asymmetric bounds (some channels out).
+  Totals faults;
+  for (int k = 0; k < 600; ++k) {
+    Vec8 l, h;
+    for (int i = 0; i < 8; ++i) {
+      const double r = uni(rng);
+      l(i) = r < 0.1 ? 0.0 : -u_max * (r < 0.2 ? uni(rng) : 1.0);
+      h(i) = r > 0.9 ? 0.0 : u_max * (r > 0.8 ? uni(rng) : 1.0);
+    }
+    // An attainable torque: one that some allowed forces produce.
+    Vec8 f;
+    for (int i = 0; i < 8; ++i) f(i) = l(i) + (h(i) - l(i)) * uni(rng);
+    check(b * f, l, h, faults, false);
+  }
+  std::printf("warm starts / solves, mean steps warm vs cold: turning %d/%d %.2f vs %.2f; "
+              "flipping %d/%d %.2f vs %.2f; random bounds %d/%d %.2f vs %.2f\n",
+              turning.warm_starts, turning.solves, double(turning.warm_it) / turning.solves,
+              double(turning.cold_it) / turning.solves, flipping.warm_starts, flipping.solves,
+              double(flipping.warm_it) / flipping.solves, double(flipping.cold_it) / flipping.solves,
+              faults.warm_starts, faults.solves, double(faults.warm_it) / faults.solves,
+              double(faults.cold_it) / faults.solves);
+  // Every solve after the first starts warm when the request turns or flips, and takes fewer
+  // steps than from u = 0 (a flip needs none: the mirrored basis is already optimal).
+  EXPECT_EQ(turning.warm_starts, turning.solves - 1);
+  EXPECT_EQ(flipping.warm_starts, flipping.solves);
+  EXPECT_LT(turning.warm_it * 3, turning.cold_it);
+  EXPECT_LT(flipping.warm_it * 10, flipping.cold_it);
+  EXPECT_GT(faults.warm_starts, faults.solves / 2);
+  EXPECT_EQ(warm.start_counts().warm + warm.start_counts().cold,
+            static_cast<std::uint32_t>(turning.solves + flipping.solves + faults.solves));
+  EXPECT_EQ(cold.start_counts().warm, 0u);
+}
+
+// The mirrored basis: after solving tau, solving -tau needs no step at all and gives exactly the
+// negated forces (the final solution is computed from the basis in ascending order).
+TEST(L1Allocation, MirroredWarmStartSolvesTheOppositeTorqueWithoutAStep) {
+  const Mat38 b = study_b(Vec3(0.3, -0.2, 0.5));
+  L1Allocation l1;
+  ASSERT_TRUE(l1.configure(b, 200.0));
+  Vec8 f;
+  f << 120.0, -40.0, 10.0, 0.0, -150.0, 60.0, 30.0, -90.0;
+  const Vec3 tau = b * f;  // attainable
+  const L1Solution a = l1.solve(tau);
+  const L1Solution m = l1.solve(-tau);
+  ASSERT_TRUE(a.ok);
+  ASSERT_TRUE(m.ok);
+  EXPECT_FALSE(a.warm);
+  EXPECT_TRUE(m.warm);
+  EXPECT_EQ(m.iterations, 0);
+  EXPECT_LE((m.u + a.u).lpNorm<Eigen::Infinity>(), 1e-12 * 200.0);
+  // configure() forgets the basis.
+  ASSERT_TRUE(l1.configure(b, 200.0));
+  EXPECT_FALSE(l1.solve(tau).warm);
+}
+
+}  // namespace

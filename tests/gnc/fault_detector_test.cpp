@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "gnc/fdi/fault_detector.hpp"
 #include "gnc/model/mass_properties.hpp"
@@ -232,7 +233,9 @@ TEST(FaultDetector, ScoresAreTheLikelihoodRatioOfTheSignatures) {
   m.r_cov = Mat3::Zero();
   m.k_sigma = 0.0;
   d.set_model(m);
-  fly(t, d, 11, 0, 9, -1);  // one window, thruster 9 stuck on from the start
+  // One window (11 samples) and its evaluation (F10), thruster 9 stuck on from the start.
+  fly(t, d, 11 + FaultDetector::kEvaluationSteps, 0, 9, -1);
+  EXPECT_EQ(d.status().windows, 1u);
   EXPECT_EQ(d.status().best, 9);
   EXPECT_GT(d.status().best_llr, 100.0);
   EXPECT_GT(d.status().chi2, p.suspect_chi2);
@@ -361,6 +364,102 @@ TEST(FaultDetector, TheModelIsHeldWhileAFaultIsSuspected) {
   d.set_model(absorbed);
   EXPECT_EQ(d.status().models_held, 1u);
   EXPECT_FALSE(d.suspecting());
+}
+
+// (F10) A closed window is scored over the next kEvaluationSteps updates from its own set of sums,
+// while the next window accumulates in the other: the scores of that window do not depend on what
+// arrives during its evaluation (a gap in the gyro, a new model), a model that arrives then is
+// taken exactly when the evaluation ends, and nothing is lost or double counted.
+TEST(FaultDetector, AClosedWindowIsScoredOverTheNextTicksWithTheModelItWasPredictedWith) {
+  Truth t;
+  t.stuck_on = 6;  // a fault, so the scores carry information
+  std::vector<FaultDetectorInput> inputs;
+  {
+    std::mt19937_64 rng(3);
+    Vec16 prev = Vec16::Zero();
+    for (int k = 0; k < 60; ++k) {
+      FaultDetectorInput in;
+      in.omega = t.gyro();
+      in.omega_valid = true;
+      in.thrust = prev;
+      inputs.push_back(in);
+      const Vec16 cmd = random_firing(rng);
+      t.advance(cmd);
+      prev = cmd;
+    }
+  }
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = t.gyro_sigma;
+  p.disturbance_sigma = 0.0;
+  p.confirm_llr = 1e30;  // never confirm: compare the scores
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 1e-6;
+  m.k_sigma = 1e-3;
+  FaultModel other = m;
+  other.r += V3(0.05, -0.02, 0.03);
+  other.k(6) = 0.9;
+  auto make = [&] {
+    FaultDetector d;
+    d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+    d.set_model(m);
+    return d;
+  };
+  // The first window closes on update 10 (samples 1..10 after the start at update 0); its
+  // evaluation runs on updates 11, 12, 13.
+  const int close = 10;
+  FaultDetector plain = make();
+  FaultDetector staged = make();   // the other model arrives during the evaluation
+  FaultDetector later = make();    // the other model arrives right after it
+  FaultDetector gap = make();      // the gyro drops out right after the close
+  for (int k = 0; k < static_cast<int>(inputs.size()); ++k) {
+    if (k == close + 1) {
+      staged.set_model(other);
+      EXPECT_TRUE(staged.evaluating());
+    }
+    if (k == close + 1 + FaultDetector::kEvaluationSteps) later.set_model(other);
+    plain.update(inputs[static_cast<std::size_t>(k)]);
+    staged.update(inputs[static_cast<std::size_t>(k)]);
+    later.update(inputs[static_cast<std::size_t>(k)]);
+    FaultDetectorInput g = inputs[static_cast<std::size_t>(k)];
+    if (k == close + 1) g.omega_valid = false;
+    gap.update(g);
+    if (k == close) {
+      EXPECT_TRUE(plain.evaluating());
+      EXPECT_EQ(plain.status().windows, 0u);  // nothing scored on the close itself
+    }
+    if (k == close + FaultDetector::kEvaluationSteps) {
+      EXPECT_FALSE(plain.evaluating());
+      ASSERT_EQ(plain.status().windows, 1u);
+      // The same scores whatever arrived during the evaluation.
+      for (const FaultDetector* d : {&staged, &later, &gap}) {
+        EXPECT_EQ(d->status().windows, 1u);
+        EXPECT_EQ(d->status().best, plain.status().best);
+        EXPECT_EQ(d->status().best_llr, plain.status().best_llr);
+        EXPECT_EQ(d->status().chi2, plain.status().chi2);
+        EXPECT_EQ(d->status().residual, plain.status().residual);
+        for (int h = 0; h < FaultDetector::kHypotheses; ++h) {
+          EXPECT_EQ(d->signature(h), plain.signature(h)) << h;
+        }
+      }
+      EXPECT_GT(plain.status().best_llr, 0.0);
+    }
+  }
+  // The staged model was taken on the first update after the evaluation: from then on the run is
+  // the one that received it then, bit for bit; and it differs from the run that never did.
+  EXPECT_EQ(staged.status().windows, later.status().windows);
+  EXPECT_EQ(staged.status().best_llr, later.status().best_llr);
+  EXPECT_EQ(staged.status().chi2, later.status().chi2);
+  EXPECT_EQ(staged.status().residual, later.status().residual);
+  EXPECT_NE(staged.status().chi2, plain.status().chi2);
+  // The gap broke only the open window, which restarted on the next sample: windows closed on
+  // updates 10, 22, 32, 42, 52 against 10, 20, ..., 50.
+  EXPECT_EQ(gap.status().windows, plain.status().windows);
+  EXPECT_NE(gap.status().chi2, plain.status().chi2);
 }
 
 }  // namespace
