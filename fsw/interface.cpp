@@ -178,6 +178,8 @@ const char* to_string(EventId id) {
       return "trajectory_switched";
     case EventId::kTrajectoryStale:
       return "trajectory_stale";
+    case EventId::kIsolationTest:
+      return "isolation_test";
   }
   return "?";
 }

@@ -170,6 +170,8 @@ enum class EventId : std::int32_t {
   kReducedAuthority = 136, // arg0 = rank, arg1 = usable channels
   kTrajectorySwitched = 137,  // the staged trajectory became active at the tick boundary
   kTrajectoryStale = 138,     // the staged trajectory was stale: refused, the active one kept
+  kIsolationTest = 139,       // arg0 = pod whose valve the detector closed for an isolation test,
+                              // arg1 = 1 started / 0 ended (the valve reopens unless confirmed)
 };
 const char* to_string(EventId id);
 

@@ -181,8 +181,23 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
   const FaultEvents fe = fdi_.update(in);
   // (F9) The detector's isolation test closes a pod for a few windows; it is an isolation
   // action, so the ground's inhibit and auto_isolate govern it as they govern the confirmation's.
+  const int probe_before = probe_pod_;
   probe_pod_ = params_.fdi.auto_isolate && !isolation_inhibited_ ? fdi_.probe_pod() : -1;
   const Mode mode = modes_.mode();
+  if (probe_pod_ != probe_before) {  // a test starts or ends (or another pod is tested)
+    if (probe_before >= 0) {
+      ModeEvent e{EventId::kIsolationTest, mode, mode, TransitionCheck::kOk};
+      e.arg0 = static_cast<std::int16_t>(probe_before);
+      e.arg1 = 0;
+      events.push(e);
+    }
+    if (probe_pod_ >= 0) {
+      ModeEvent e{EventId::kIsolationTest, mode, mode, TransitionCheck::kOk};
+      e.arg0 = static_cast<std::int16_t>(probe_pod_);
+      e.arg1 = 1;
+      events.push(e);
+    }
+  }
   if (fe.suspected && !fe.confirmed) {
     ModeEvent e{EventId::kFaultSuspected, mode, mode, TransitionCheck::kOk};
     const int best = fdi_.status().best;
@@ -512,6 +527,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   f.isolation_inhibited = isolation_inhibited_;
   f.windows = fs.windows;
   f.suspicions = fs.suspicions;
+  f.probe_pod = static_cast<std::int8_t>(probe_pod_);
+  f.probes = fs.probes;
 }
 
 void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {

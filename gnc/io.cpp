@@ -67,6 +67,7 @@ const char* to_string(EventId e) {
     case EventId::kValveClosed: return "valve_closed";
     case EventId::kFaultOverride: return "fault_override";
     case EventId::kReducedAuthority: return "reduced_authority";
+    case EventId::kIsolationTest: return "isolation_test";
   }
   return "?";
 }

@@ -67,6 +67,8 @@ enum class EventId : std::uint8_t {
   kValveClosed,      // a pod's latch valve closed to isolate a stuck-on thruster (arg0 = pod)
   kFaultOverride,    // a ground override applied (arg0 = thruster or pod, arg1 = what)
   kReducedAuthority, // the remaining thrusters cannot produce every torque direction
+  kIsolationTest,    // (F9) a pod's valve closed for an isolation test, or reopened after it
+                     // (arg0 = pod, arg1 = 1 started / 0 ended)
 };
 
 // Thruster fault kinds the flight software declares (gnc/fdi).
@@ -185,6 +187,8 @@ struct FdiTelemetry {
   bool isolation_inhibited{false};
   std::uint32_t windows{0};
   std::uint32_t suspicions{0};
+  std::int8_t probe_pod{-1};    // (F9) pod closed for an isolation test this tick, -1 none
+  std::uint32_t probes{0};      // isolation tests started
 };
 
 struct GncTelemetry {

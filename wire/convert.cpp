@@ -142,6 +142,8 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   for (int p = 0; p < gnc::kPods; ++p) m.valve_open[p] = f.valve_open[static_cast<std::size_t>(p)] ? 1 : 0;
   m.isolation_inhibited = f.isolation_inhibited ? 1 : 0;
   m.fdi_windows = f.windows;
+  m.fdi_probe_pod = f.probe_pod;
+  m.fdi_probes = f.probes;
   m.reduced_authority = g.alloc.reduced_authority ? 1 : 0;
   m.alloc_rank = static_cast<std::int8_t>(g.alloc.rank);
 }

@@ -46,10 +46,10 @@ std::optional<ParamEntry> find_param(const std::string& name_or_id);
 std::string reason_name(int reason);
 inline constexpr int kReasonCount = 14;
 
-// fsw::EventId names (100..138), gnc-level event names are not on the bus; "event N" otherwise.
+// fsw::EventId names (100..139), gnc-level event names are not on the bus; "event N" otherwise.
 std::string event_name(int id);
 inline constexpr int kFirstEventId = 100;
-inline constexpr int kLastEventId = 138;
+inline constexpr int kLastEventId = 139;
 // The plant's (simulator's) event ids start here (event_t.id); they carry no flight authenticator.
 inline constexpr int kFirstPlantEventId = 1000;
 // Event ids the uplink procedure listens to.

@@ -139,6 +139,12 @@ struct ProbeRun {
   bool other_pod_closed{false};
   bool force_on_closed_pod{false};
   std::uint32_t probes{0};
+  int tests_started{0};        // isolation_test events with arg1 = 1 (pod 1)
+  int tests_ended{0};          // ... with arg1 = 0
+  int tests_on_other_pods{0};
+  int tlm_probe_ticks{0};      // ticks whose telemetry names pod 1 as under test, before the
+                               // confirmation
+  std::uint32_t tlm_probes{0};
 };
 
 ProbeRun fly_axial_stuck_on(bool inhibit) {
@@ -164,6 +170,13 @@ ProbeRun fly_axial_stuck_on(bool inhibit) {
         if ((gnc.fault_detector().confirmed_on() >> i) & 1u) run.thruster = i;
       }
     }
+    for (int e = 0; e < out.events.count; ++e) {
+      const ModeEvent& ev = out.events.items[static_cast<std::size_t>(e)];
+      if (ev.id != EventId::kIsolationTest) continue;
+      if (ev.arg0 != 1) ++run.tests_on_other_pods;
+      (ev.arg1 == 1 ? run.tests_started : run.tests_ended) += 1;
+    }
+    if (out.telemetry.fdi.probe_pod == 1 && run.confirmed_tick < 0) ++run.tlm_probe_ticks;
     for (int pod = 0; pod < 4; ++pod) {
       if (out.command.valve_open[static_cast<std::size_t>(pod)]) continue;
       if (pod != 1) run.other_pod_closed = true;
@@ -176,6 +189,7 @@ ProbeRun fly_axial_stuck_on(bool inhibit) {
     t += p.dt;
   }
   run.probes = gnc.fault_detector().status().probes;
+  run.tlm_probes = out.telemetry.fdi.probes;
   return run;
 }
 
@@ -188,9 +202,18 @@ TEST(GncFdi, AnAmbiguousAxialJetIsSettledByClosingItsPodForATest) {
   EXPECT_FALSE(run.other_pod_closed);
   EXPECT_FALSE(run.force_on_closed_pod);
   EXPECT_LE(run.confirmed_tick - 1000, 100) << "isolated within 10 s of onset";
+  // The test is visible on its own: an event when it starts and when it ends, and the pod under
+  // test in the telemetry on exactly the ticks it is closed for it.
+  EXPECT_EQ(run.tests_started, static_cast<int>(run.probes));
+  EXPECT_EQ(run.tests_ended, run.tests_started);
+  EXPECT_EQ(run.tests_on_other_pods, 0);
+  EXPECT_EQ(run.tlm_probe_ticks, run.probe_ticks);
+  EXPECT_EQ(run.tlm_probes, run.probes);
 
   const ProbeRun inhibited = fly_axial_stuck_on(true);
   EXPECT_EQ(inhibited.probe_ticks, 0);
+  EXPECT_EQ(inhibited.tests_started, 0);
+  EXPECT_EQ(inhibited.tlm_probe_ticks, 0);
   EXPECT_FALSE(inhibited.other_pod_closed);
   EXPECT_NE(inhibited.thruster, 15) << "never the mirror jet";
 }
