@@ -607,7 +607,41 @@ Verification verify_samples(const PlanModel& model, const std::vector<PlanSample
 
 namespace {
 
-PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end);
+PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end, SolveSpec* grid_out = nullptr);
+
+// The grid-refinement check of a plan solved on `spec`'s grid: re-solved on every interval halved
+// (2N-1 nodes), warm-started from the plan, the fuel must change by less than refinement_limit.
+// Fills r.verification's refinement fields; false (with r.error) when the check fails.
+bool check_refinement(const PlanModel& model, const PlanSettings& settings, const SolveSpec& spec,
+                      PlanResult& r) {
+  SolveSpec fine_spec = spec;
+  fine_spec.grid = bisected(spec.grid);  // every interval halved: 2N-1 nodes
+  fine_spec.nodes = static_cast<int>(fine_spec.grid.size());
+  fine_spec.warm = &r.samples;
+  fine_spec.warm_mu = kWarmMu;
+  const SolveOutcome fine = solve(model, settings, fine_spec);
+  r.verification.refined_iterations = fine.iterations;
+  r.verification.refined_seconds = fine.seconds;
+  if (!fine.ok) {
+    r.error = "verification failed: refined grid: " + fine.error;
+    return false;
+  }
+  r.verification.refinement_checked = true;
+  r.verification.refined_fuel_kg = fine.cost_ns / (kIsp * kG0);
+  r.verification.refinement_change =
+      std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
+  if (!(r.verification.refinement_change < settings.refinement_limit)) {
+    std::ostringstream msg;
+    msg << "grid refinement (" << r.nodes << " -> " << fine_spec.nodes
+        << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
+        << " % (limit " << 100.0 * settings.refinement_limit << " %)";
+    r.verification.passed = false;
+    r.verification.failure = msg.str();
+    r.error = "verification failed: " + msg.str();
+    return false;
+  }
+  return true;
+}
 
 // Long horizon [Rocksteady choice] (PlanSettings::active_horizon_max): the least-fuel verified plan
 // among the horizons t_auto, 2 t_auto, ... and `active` (each solved cold: a warm start from the
@@ -618,30 +652,57 @@ PlanResult plan_long(const PlanProblem& problem, double t_auto, double active, d
   std::vector<double> horizons;  // doubling from t_auto; none within 25 % below `active`
   for (double h = t_auto; h < active / 1.25; h *= 2.0) horizons.push_back(h);
   horizons.push_back(active);
-  PlanResult best;
+  // Every candidate is solved and verified (verify_samples) without the grid-refinement re-solve;
+  // then the cheapest is refinement-checked, and, should that fail, the next cheapest, and so on:
+  // the re-solves of the candidates that lose are saved.
+  struct Candidate {
+    PlanResult result;
+    SolveSpec spec;
+  };
+  std::vector<Candidate> candidates;
   int iterations = 0;
   int refined_iterations = 0;
   double seconds = 0.0;
   double refined_seconds = 0.0;
   std::string failures;
+  const auto note = [&failures](double h, const std::string& why) {
+    std::ostringstream msg;
+    msg << (failures.empty() ? "" : "; ") << h << " s: " << why;
+    failures += msg.str();
+  };
   for (const double h : horizons) {
     PlanProblem sub = problem;
     sub.settings.t_final_max = h;
     sub.settings.active_horizon_max = -1.0;  // this horizon in full
-    PlanResult c = plan_impl(sub, true);
-    iterations += c.iterations;
-    refined_iterations += c.verification.refined_iterations;
-    seconds += c.solve_seconds;
-    refined_seconds += c.verification.refined_seconds;
-    if (c.ok && (!best.ok || c.fuel_kg < best.fuel_kg)) {
-      best = std::move(c);
-    } else if (!c.ok) {
-      std::ostringstream msg;
-      msg << (failures.empty() ? "" : "; ") << h << " s: " << c.error;
-      failures += msg.str();
+    sub.settings.verify_refinement = false;
+    Candidate c;
+    c.result = plan_impl(sub, true, &c.spec);
+    iterations += c.result.iterations;
+    seconds += c.result.solve_seconds;
+    if (c.result.ok) {
+      candidates.push_back(std::move(c));
+    } else {
+      note(h, c.result.error);
     }
   }
-  PlanResult r = std::move(best);
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.result.fuel_kg < b.result.fuel_kg;
+  });
+  PlanResult r;
+  for (Candidate& c : candidates) {
+    if (!problem.settings.verify_refinement) {
+      r = std::move(c.result);
+      break;
+    }
+    const bool passed = check_refinement(problem.model, problem.settings, c.spec, c.result);
+    refined_iterations += c.result.verification.refined_iterations;
+    refined_seconds += c.result.verification.refined_seconds;
+    if (passed) {
+      r = std::move(c.result);
+      break;
+    }
+    note(c.result.t_final, c.result.error);
+  }
   r.iterations = iterations;
   r.solve_seconds = seconds;
   r.verification.refined_iterations = refined_iterations;
@@ -687,7 +748,7 @@ PlanResult plan(const PlanProblem& problem) { return plan_impl(problem, false); 
 
 namespace {
 
-PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end) {
+PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end, SolveSpec* grid_out) {
   PlanResult r;
   const PlanModel& model = problem.model;
   const PlanSettings& settings = problem.settings;
@@ -805,35 +866,8 @@ PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end) {
     r.error = "verification failed: " + r.verification.failure;
     return r;
   }
-  if (settings.verify_refinement) {
-    SolveSpec fine_spec = spec;
-    fine_spec.grid = bisected(spec.grid);  // every interval halved: 2N-1 nodes
-    fine_spec.nodes = static_cast<int>(fine_spec.grid.size());
-    fine_spec.warm = &r.samples;
-    fine_spec.warm_mu = kWarmMu;
-    const SolveOutcome fine = solve(model, settings, fine_spec);
-    if (!fine.ok) {
-      r.verification.refined_iterations = fine.iterations;
-      r.error = "verification failed: refined grid: " + fine.error;
-      return r;
-    }
-    r.verification.refinement_checked = true;
-    r.verification.refined_iterations = fine.iterations;
-    r.verification.refined_seconds = fine.seconds;
-    r.verification.refined_fuel_kg = fine.cost_ns / (kIsp * kG0);
-    r.verification.refinement_change =
-        std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
-    if (!(r.verification.refinement_change < settings.refinement_limit)) {
-      std::ostringstream msg;
-      msg << "grid refinement (" << r.nodes << " -> " << fine_spec.nodes
-          << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
-          << " % (limit " << 100.0 * settings.refinement_limit << " %)";
-      r.verification.passed = false;
-      r.verification.failure = msg.str();
-      r.error = "verification failed: " + msg.str();
-      return r;
-    }
-  }
+  if (grid_out != nullptr) *grid_out = spec;
+  if (settings.verify_refinement && !check_refinement(model, settings, spec, r)) return r;
   r.ok = true;
   return r;
 }
