@@ -22,10 +22,13 @@ if [[ "${1:-}" == "--cross" ]]; then
   cross=1
   # aarch64 target libraries are Debian multiarch (:arm64, needs `dpkg --add-architecture arm64`,
   # which scripts/cross.sh does); LCM is not multi-arch and is unpacked into a private sysroot.
+  # IPOPT (rocksteady-planner) is not multi-arch either (cmake/toolchains/arm64-sysroot.sh); its
+  # run-time libraries MUMPS (sequential), BLAS, LAPACK and gfortran are, and come from here.
   packages+=(g++-aarch64-linux-gnu qemu-user gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib
              qemu-system-arm
              libstdc++6:arm64 libgtest-dev:arm64 libgmock-dev:arm64 libglib2.0-dev:arm64
-             libsodium-dev:arm64)
+             libsodium-dev:arm64
+             libmumps-seq-5.5:arm64 libblas3:arm64 liblapack3:arm64 libgfortran5:arm64)
 fi
 
 missing=()

@@ -4,7 +4,8 @@
 # CMAKE_CROSSCOMPILING_EMULATOR, so plain `ctest` works on an x86-64 host.
 #
 # Libraries that are not multi-arch in Debian (LCM: installing liblcm-dev:arm64 would remove the
-# host's lcm-gen and lcm.jar; yaml-cpp: libyaml-cpp-dev:arm64 would remove the host's) come from a private sysroot unpacked inside the build tree
+# host's lcm-gen and lcm.jar; yaml-cpp: libyaml-cpp-dev:arm64 would remove the host's; IPOPT, in
+# /usr/lib, likewise) come from a private sysroot unpacked inside the build tree
 # (scripts/cross.sh: `apt-get download` + `dpkg -x`). Point ROCKSTEADY_TARGET_SYSROOT at it; it is
 # searched in addition to the multiarch directories, by find_* and by pkg-config.
 #
@@ -52,8 +53,9 @@ if(ROCKSTEADY_TARGET_SYSROOT AND IS_DIRECTORY "${ROCKSTEADY_TARGET_SYSROOT}")
   # pkg-config: only target .pc files, never the host's x86-64 ones. The sysroot's .pc files have
   # their prefix rewritten to the sysroot when it is unpacked.
   set(ENV{PKG_CONFIG_LIBDIR}
-      "${ROCKSTEADY_TARGET_SYSROOT}/usr/lib/aarch64-linux-gnu/pkgconfig:${_rs_multiarch_pc}")
-  set(_rs_guest_env -E "LD_LIBRARY_PATH=${ROCKSTEADY_TARGET_SYSROOT}/usr/lib/aarch64-linux-gnu")
+      "${ROCKSTEADY_TARGET_SYSROOT}/usr/lib/aarch64-linux-gnu/pkgconfig:${ROCKSTEADY_TARGET_SYSROOT}/usr/lib/pkgconfig:${_rs_multiarch_pc}")
+  set(_rs_guest_env -E
+      "LD_LIBRARY_PATH=${ROCKSTEADY_TARGET_SYSROOT}/usr/lib/aarch64-linux-gnu:${ROCKSTEADY_TARGET_SYSROOT}/usr/lib")
 else()
   set(ENV{PKG_CONFIG_LIBDIR} "${_rs_multiarch_pc}")
   set(_rs_guest_env)

@@ -29,6 +29,9 @@ void report(const planner::PlanResult& r) {
               r.t_final_max);
   std::printf("grid            %d nodes, %zu samples (Hermite-Simpson)\n", r.nodes,
               r.samples.size());
+  if (r.t_active < r.t_final) {
+    std::printf("despin          until %.2f s, at rest after it\n", r.t_active);
+  }
   std::printf("iterations      %d\n", r.iterations);
   std::printf("solve time      %.3f s\n", r.solve_seconds);
   std::printf("max defect      %.3g rad/s\n", v.max_defect);
@@ -91,6 +94,9 @@ int main(int argc, char** argv) {
   bool study_horizon = false;
   app.add_flag("--study-horizon", study_horizon,
                "final time like the study's fuel-optimal trackers (44000 s)");
+  app.add_option("--active-horizon", settings.active_horizon_max,
+                 "longest despin, s: a longer final time rests after it (0 = automatic, "
+                 "max(5600 s, the automatic horizon); < 0 = plan every horizon in full)");
   app.add_flag("--free-final-time", settings.free_final_time, "let t_f float in [min, max]");
   app.add_option("--tolerance", settings.tolerance, "IPOPT convergence tolerance (scaled NLP)")
       ->check(CLI::PositiveNumber);

@@ -229,6 +229,7 @@ struct SolveSpec {
   double t_max{0.0};
   const std::vector<PlanSample>* warm{nullptr};
   double warm_mu{0.0};  // > 0: warm-start the barrier at this mu (needs warm)
+  bool rest_at_end{false};  // u_d(t_final) = 0 too (a rest tail follows)
 };
 
 SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
@@ -248,6 +249,7 @@ SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
   tm.grid = spec.grid;
   tm.t_final_min = t_min;
   tm.t_final_max = t_max;
+  tm.rest_at_end = spec.rest_at_end;
   const HermiteSimpsonNlp nlp(tm);
   std::vector<double> x0 =
       warm != nullptr ? guess_from_samples(nlp, *warm) : momentum_ramp_guess(nlp, model);
@@ -603,7 +605,150 @@ Verification verify_samples(const PlanModel& model, const std::vector<PlanSample
   return v;
 }
 
-PlanResult plan(const PlanProblem& problem) {
+namespace {
+
+PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end, SolveSpec* grid_out = nullptr);
+
+// The grid-refinement check of a plan solved on `spec`'s grid: re-solved on every interval halved
+// (2N-1 nodes), warm-started from the plan, the fuel must change by less than refinement_limit.
+// Fills r.verification's refinement fields; false (with r.error) when the check fails.
+bool check_refinement(const PlanModel& model, const PlanSettings& settings, const SolveSpec& spec,
+                      PlanResult& r) {
+  SolveSpec fine_spec = spec;
+  fine_spec.grid = bisected(spec.grid);  // every interval halved: 2N-1 nodes
+  fine_spec.nodes = static_cast<int>(fine_spec.grid.size());
+  fine_spec.warm = &r.samples;
+  fine_spec.warm_mu = kWarmMu;
+  const SolveOutcome fine = solve(model, settings, fine_spec);
+  r.verification.refined_iterations = fine.iterations;
+  r.verification.refined_seconds = fine.seconds;
+  if (!fine.ok) {
+    r.error = "verification failed: refined grid: " + fine.error;
+    return false;
+  }
+  r.verification.refinement_checked = true;
+  r.verification.refined_fuel_kg = fine.cost_ns / (kIsp * kG0);
+  r.verification.refinement_change =
+      std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
+  if (!(r.verification.refinement_change < settings.refinement_limit)) {
+    std::ostringstream msg;
+    msg << "grid refinement (" << r.nodes << " -> " << fine_spec.nodes
+        << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
+        << " % (limit " << 100.0 * settings.refinement_limit << " %)";
+    r.verification.passed = false;
+    r.verification.failure = msg.str();
+    r.error = "verification failed: " + msg.str();
+    return false;
+  }
+  return true;
+}
+
+// Long horizon [Rocksteady choice] (PlanSettings::active_horizon_max): the least-fuel verified plan
+// among the horizons t_auto, 2 t_auto, ... and `active` (each solved cold: a warm start from the
+// shorter plan extended by rest stays in its local minimum, measured on cases 4 and 7), ending with
+// u_d = 0, then rest to t_final: two more samples, omega_d = 0 and u_d = 0 (Eq. 41 holds exactly
+// there). The whole plan is verified again, rest tail included.
+PlanResult plan_long(const PlanProblem& problem, double t_auto, double active, double t_final) {
+  std::vector<double> horizons;  // doubling from t_auto; none within 25 % below `active`
+  for (double h = t_auto; h < active / 1.25; h *= 2.0) horizons.push_back(h);
+  horizons.push_back(active);
+  // Every candidate is solved and verified (verify_samples) without the grid-refinement re-solve;
+  // then the cheapest is refinement-checked, and, should that fail, the next cheapest, and so on:
+  // the re-solves of the candidates that lose are saved.
+  struct Candidate {
+    PlanResult result;
+    SolveSpec spec;
+  };
+  std::vector<Candidate> candidates;
+  int iterations = 0;
+  int refined_iterations = 0;
+  double seconds = 0.0;
+  double refined_seconds = 0.0;
+  std::string failures;
+  const auto note = [&failures](double h, const std::string& why) {
+    std::ostringstream msg;
+    msg << (failures.empty() ? "" : "; ") << h << " s: " << why;
+    failures += msg.str();
+  };
+  for (const double h : horizons) {
+    PlanProblem sub = problem;
+    sub.settings.t_final_max = h;
+    sub.settings.active_horizon_max = -1.0;  // this horizon in full
+    sub.settings.verify_refinement = false;
+    Candidate c;
+    c.result = plan_impl(sub, true, &c.spec);
+    iterations += c.result.iterations;
+    seconds += c.result.solve_seconds;
+    if (c.result.ok) {
+      candidates.push_back(std::move(c));
+    } else {
+      note(h, c.result.error);
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.result.fuel_kg < b.result.fuel_kg;
+  });
+  PlanResult r;
+  for (Candidate& c : candidates) {
+    if (!problem.settings.verify_refinement) {
+      r = std::move(c.result);
+      break;
+    }
+    const bool passed = check_refinement(problem.model, problem.settings, c.spec, c.result);
+    refined_iterations += c.result.verification.refined_iterations;
+    refined_seconds += c.result.verification.refined_seconds;
+    if (passed) {
+      r = std::move(c.result);
+      break;
+    }
+    note(c.result.t_final, c.result.error);
+  }
+  r.iterations = iterations;
+  r.solve_seconds = seconds;
+  r.verification.refined_iterations = refined_iterations;
+  r.verification.refined_seconds = refined_seconds;
+  r.t_final_min = t_final;
+  r.t_final_max = t_final;
+  if (!r.ok) {
+    r.error = "no active horizon up to " + std::to_string(active) + " s gave a verified plan (" +
+              failures + ")";
+    return r;
+  }
+  if (r.samples.size() + 2 > static_cast<std::size_t>(gnc::kMaxTrajectorySamples)) {
+    r.ok = false;
+    r.error = "the active plan fills the on-board table: no room for the rest tail";
+    return r;
+  }
+  r.t_active = r.t_final;
+  PlanSample mid;
+  mid.t = 0.5 * (r.t_active + t_final);
+  PlanSample end;
+  end.t = t_final;
+  r.samples.push_back(mid);
+  r.samples.push_back(end);
+  r.t_final = t_final;
+  r.nodes += 1;
+  const Verification active_v = r.verification;
+  r.verification = verify_samples(problem.model, r.samples, problem.settings.propagation_limit);
+  r.verification.refinement_checked = active_v.refinement_checked;
+  r.verification.refined_fuel_kg = active_v.refined_fuel_kg;
+  r.verification.refinement_change = active_v.refinement_change;
+  r.verification.refined_iterations = active_v.refined_iterations;
+  r.verification.refined_seconds = active_v.refined_seconds;
+  if (!r.verification.passed) {
+    r.ok = false;
+    r.error = "verification failed (rest tail): " + r.verification.failure;
+  }
+  return r;
+}
+
+}  // namespace
+
+PlanResult plan(const PlanProblem& problem) { return plan_impl(problem, false); }
+
+namespace {
+
+PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end, SolveSpec* grid_out) {
   PlanResult r;
   const PlanModel& model = problem.model;
   const PlanSettings& settings = problem.settings;
@@ -618,9 +763,21 @@ PlanResult plan(const PlanProblem& problem) {
     r.error = "invalid problem: t_final_max < t_final_min";
     return r;
   }
+  if (!settings.free_final_time && !settings.tumble_grid && settings.nodes <= 0 &&
+      settings.active_horizon_max >= 0.0) {
+    PlanSettings automatic = settings;
+    automatic.t_final_max = 0.0;
+    double t_auto_min = 0.0;
+    double t_auto = 0.0;
+    resolve_final_time_bounds(model, automatic, t_auto_min, t_auto);
+    const double active = settings.active_horizon_max > 0.0 ? settings.active_horizon_max
+                                                            : std::max(kActiveHorizon, t_auto);
+    if (r.t_final_max > active) return plan_long(problem, t_auto, active, r.t_final_max);
+  }
   SolveSpec spec;
   spec.t_min = r.t_final_min;
   spec.t_max = r.t_final_max;
+  spec.rest_at_end = rest_at_end;
   if (problem.warm_start != nullptr && problem.warm_start->size() >= 3) {
     spec.warm = problem.warm_start;
     spec.warm_mu = kWarmMu;
@@ -702,44 +859,20 @@ PlanResult plan(const PlanProblem& problem) {
   r.cost_ns = main.cost_ns;
   r.fuel_kg = main.cost_ns / (kIsp * kG0);  // Eq. (54)
   r.t_final = main.t_final;
+  r.t_active = main.t_final;
   r.samples = std::move(main.samples);
   r.verification = verify_samples(model, r.samples, settings.propagation_limit);
   if (!r.verification.passed) {
     r.error = "verification failed: " + r.verification.failure;
     return r;
   }
-  if (settings.verify_refinement) {
-    SolveSpec fine_spec = spec;
-    fine_spec.grid = bisected(spec.grid);  // every interval halved: 2N-1 nodes
-    fine_spec.nodes = static_cast<int>(fine_spec.grid.size());
-    fine_spec.warm = &r.samples;
-    fine_spec.warm_mu = kWarmMu;
-    const SolveOutcome fine = solve(model, settings, fine_spec);
-    if (!fine.ok) {
-      r.verification.refined_iterations = fine.iterations;
-      r.error = "verification failed: refined grid: " + fine.error;
-      return r;
-    }
-    r.verification.refinement_checked = true;
-    r.verification.refined_iterations = fine.iterations;
-    r.verification.refined_seconds = fine.seconds;
-    r.verification.refined_fuel_kg = fine.cost_ns / (kIsp * kG0);
-    r.verification.refinement_change =
-        std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
-    if (!(r.verification.refinement_change < settings.refinement_limit)) {
-      std::ostringstream msg;
-      msg << "grid refinement (" << r.nodes << " -> " << fine_spec.nodes
-          << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
-          << " % (limit " << 100.0 * settings.refinement_limit << " %)";
-      r.verification.passed = false;
-      r.verification.failure = msg.str();
-      r.error = "verification failed: " + msg.str();
-      return r;
-    }
-  }
+  if (grid_out != nullptr) *grid_out = spec;
+  if (settings.verify_refinement && !check_refinement(model, settings, spec, r)) return r;
   r.ok = true;
   return r;
 }
+
+}  // namespace
 
 gnc::TrajectoryTable to_table(const std::vector<PlanSample>& samples) {
   if (samples.size() > static_cast<std::size_t>(gnc::kMaxTrajectorySamples)) {
@@ -830,7 +963,7 @@ std::uint64_t problem_hash(const PlanProblem& problem) {
   std::uint64_t h = 14695981039346656037ULL;
   const PlanModel& m = problem.model;
   const PlanSettings& s = problem.settings;
-  const char tag[] = "rocksteady-plan-v1";
+  const char tag[] = "rocksteady-plan-v2";
   hash_bytes(h, tag, sizeof tag);
   for (int i = 0; i < 9; ++i) hash_double(h, m.j_hat(i / 3, i % 3));
   for (int i = 0; i < 24; ++i) hash_double(h, m.b_hat(i / 8, i % 8));
@@ -847,6 +980,7 @@ std::uint64_t problem_hash(const PlanProblem& problem) {
   const std::int64_t flags = (s.verify_refinement ? 1 : 0) + (s.free_final_time ? 2 : 0) +
                              (s.tumble_grid ? 8 : 0) + 16 * std::int64_t{s.max_iterations};
   hash_double(h, s.intervals_per_turn);
+  hash_double(h, s.active_horizon_max);
   hash_bytes(h, &flags, sizeof flags);
   return h;
 }

@@ -178,6 +178,7 @@ std::string format_trajectory_file(const PlanProblem& problem, const PlanResult&
     << "  fuel_kg: " << num(result.fuel_kg) << "\n"
     << "  cost_ns: " << num(result.cost_ns) << "  # int |u|_1 dt\n"
     << "  t_final: " << num(result.t_final) << "  # s\n"
+    << "  t_active: " << num(result.t_active) << "  # s, end of the despin (at rest after it)\n"
     << "  iterations: " << result.iterations << "\n"
     << "  solve_seconds: " << num(result.solve_seconds) << "\n"
     << "  refined_fuel_kg: " << num(result.verification.refined_fuel_kg) << "\n"

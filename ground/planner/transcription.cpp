@@ -164,6 +164,12 @@ void HermiteSimpsonNlp::bounds(std::vector<double>& x_lo, std::vector<double>& x
     x_lo[w_index(points_ - 1) + c] = 0.0;  // omega_d(t_final) = 0
     x_hi[w_index(points_ - 1) + c] = 0.0;
   }
+  if (model_.rest_at_end) {
+    for (int c = 0; c < 8; ++c) {
+      x_hi[p_index(points_ - 1) + c] = 0.0;  // u_d(t_final) = 0
+      x_hi[n_index(points_ - 1) + c] = 0.0;
+    }
+  }
   x_lo[tau_index()] = model_.t_final_min / t_scale_;
   x_hi[tau_index()] = model_.t_final_max / t_scale_;
 

@@ -45,6 +45,9 @@ struct TranscriptionModel {
   std::vector<double> grid;
   double t_final_min{1.0};   // s
   double t_final_max{2.0};   // s (equal to t_final_min: fixed final time)
+  // u_d(t_final) = 0 as well as omega_d(t_final) = 0: the plan can be continued by rest (the
+  // long-horizon plans of planner.hpp), omega_d_dot(t_final) = 0 so the on-board cubic stays at 0.
+  bool rest_at_end{false};
 };
 
 // Sparse triplet pattern (0-based row/column).

@@ -9,6 +9,7 @@
 #include "gnc/model/mass_properties.hpp"
 #include "gnc/model/rcs.hpp"
 #include "ground/planner/planner.hpp"
+#include "ground/planner/trajectory_file.hpp"
 
 namespace rocksteady::ground::planner {
 namespace {
@@ -59,24 +60,23 @@ TEST(PlannerHorizon, LongerPlanVerifiesItselfIncludingTheRefinedGrid) {
   EXPECT_LE(kLong / (r.nodes - 1), kUniformStep);
 }
 
-TEST(PlannerHorizon, PlanSatisfiesTheDynamicsAgainstAnIndependentRk4Propagation) {
-  // Eq. (41) written out here (not the planner's helper), integrated with RK4 at 64 steps per
-  // interval under the piecewise-quadratic control through each interval's three samples.
-  const PlanModel& m = plans().model;
-  const PlanResult& r = plans().long_plan;
-  ASSERT_TRUE(r.ok) << r.error;
+// Eq. (41) written out here (not the planner's helper), integrated with RK4 at 64 steps per
+// interval under the piecewise-quadratic control through each interval's three samples. Returns the
+// largest distance to the plan's nodes; `final_rate` is the open-loop rate at the end.
+double open_loop_error(const PlanModel& m, const std::vector<PlanSample>& samples,
+                       double& final_rate) {
   const Mat3 j_inv = m.j_hat.inverse();
   const auto f = [&](const Vec3& w, const Vec8& u) -> Vec3 {
     return j_inv * ((m.j_hat * w).cross(w) + m.b_hat * u);
   };
   Vec3 w = m.omega_init;
   double worst = 0.0;
-  for (std::size_t a = 0; a + 2 < r.samples.size(); a += 2) {
-    const PlanSample& s0 = r.samples[a];
-    const PlanSample& s1 = r.samples[a + 1];
-    const PlanSample& s2 = r.samples[a + 2];
+  for (std::size_t a = 0; a + 2 < samples.size(); a += 2) {
+    const PlanSample& s0 = samples[a];
+    const PlanSample& s1 = samples[a + 1];
+    const PlanSample& s2 = samples[a + 2];
     const double h = s2.t - s0.t;
-    ASSERT_NEAR(s1.t, s0.t + 0.5 * h, 1e-9 * h);  // the midpoint sample is the midpoint
+    EXPECT_NEAR(s1.t, s0.t + 0.5 * h, 1e-9 * h);  // the midpoint sample is the midpoint
     const auto u = [&](double t) -> Vec8 {
       const double x = (t - s0.t) / h;
       return 2.0 * (x - 0.5) * (x - 1.0) * s0.u_d - 4.0 * x * (x - 1.0) * s1.u_d +
@@ -94,9 +94,19 @@ TEST(PlannerHorizon, PlanSatisfiesTheDynamicsAgainstAnIndependentRk4Propagation)
     }
     worst = std::max(worst, (w - s2.omega_d).norm());
   }
+  final_rate = w.norm();
+  return worst;
+}
+
+TEST(PlannerHorizon, PlanSatisfiesTheDynamicsAgainstAnIndependentRk4Propagation) {
+  const PlanModel& m = plans().model;
+  const PlanResult& r = plans().long_plan;
+  ASSERT_TRUE(r.ok) << r.error;
+  double final_rate = 0.0;
+  const double worst = open_loop_error(m, r.samples, final_rate);
   const double tol = 1e-3 * m.omega_init.norm();  // the planner's own limit (propagation_limit)
   EXPECT_LT(worst, tol);
-  EXPECT_LT(w.norm(), tol);  // and the open-loop motion ends near rest
+  EXPECT_LT(final_rate, tol);  // and the open-loop motion ends near rest
 }
 
 TEST(PlannerHorizon, LongerHorizonNeverCostsMoreThanTheShorterPlanExtendedByRest) {
@@ -192,15 +202,108 @@ TEST(Replan, FromAMidDespinStateVerifiesCostsNoMoreThanTheRestAndIsAcceptedOnBoa
 namespace rocksteady::ground::planner {
 namespace {
 
-TEST(PlannerHorizon, HorizonBeyondTheTableOnTheUniformGridIsRefusedWithTheReason) {
+TEST(PlannerHorizon, HorizonBeyondTheTablePlannedInFullIsRefusedWithTheReason) {
   PlanProblem p;
   p.model = study_case_model(200.0, 0.0, 0.0);
   p.settings.t_final_max = kStudyHorizon;
+  p.settings.active_horizon_max = -1.0;  // the whole horizon on the uniform grid
   const PlanResult r = plan(p);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.error.find("needs 1761 nodes"), std::string::npos) << r.error;
   EXPECT_NE(r.error.find("holds 512"), std::string::npos) << r.error;
   EXPECT_EQ(r.iterations, 0);  // refused before solving
+}
+
+// The study's horizon (44 000 s) with the default settings: a despin over at most the active
+// horizon, then rest; checked here against independent computations.
+TEST(PlannerHorizon, StudyHorizonPlanDespinsWithinTheActiveHorizonThenRestsAndVerifies) {
+  const PlanModel m = study_case_model(200.0, 0.0, 0.0);
+  PlanProblem p;
+  p.model = m;
+  p.settings.t_final_max = kStudyHorizon;
+  const PlanResult r = plan(p);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_TRUE(r.verification.passed) << r.verification.failure;
+  EXPECT_TRUE(r.verification.refinement_checked);  // the despin's own grid-refinement check
+  EXPECT_LT(r.verification.refinement_change, 0.01);
+  EXPECT_EQ(r.t_final, kStudyHorizon);
+  EXPECT_EQ(r.samples.back().t, kStudyHorizon);
+  EXPECT_GT(r.t_active, 0.0);
+  EXPECT_LE(r.t_active, kActiveHorizon);
+  EXPECT_EQ(r.samples.size(), static_cast<std::size_t>(2 * r.nodes - 1));
+  // After the despin: at rest, no control (Eq. 41 holds exactly), and the despin ends with u = 0.
+  std::size_t after = 0;
+  for (const PlanSample& s : r.samples) {
+    if (s.t < r.t_active) continue;
+    EXPECT_EQ(s.omega_d, Vec3::Zero()) << "t = " << s.t;
+    EXPECT_EQ(s.u_d, Vec8::Zero()) << "t = " << s.t;
+    EXPECT_EQ(s.omega_d_dot, Vec3::Zero()) << "t = " << s.t;
+    ++after;
+  }
+  EXPECT_EQ(after, 3u);  // the despin's last node, the rest interval's midpoint and end
+  // The dynamics by an independent propagation, rest tail included (torque-free motion of the
+  // residual rate for 38 000 s stays within the planner's limit).
+  double final_rate = 0.0;
+  const double worst = open_loop_error(m, r.samples, final_rate);
+  EXPECT_LT(worst, 1e-3 * m.omega_init.norm());
+  EXPECT_LT(final_rate, 1e-3 * m.omega_init.norm());
+  // Fuel: the Simpson integral of its own samples (Eq. 54), and no more than the plan at the
+  // automatic horizon (one of the candidates; the longer ones are kept only when cheaper).
+  EXPECT_NEAR(r.fuel_kg, simpson_cost(r.samples) / (kIsp * kG0), 1e-6 * r.fuel_kg);
+  PlanProblem automatic;
+  automatic.model = m;
+  const PlanResult a = plan(automatic);
+  ASSERT_TRUE(a.ok) << a.error;
+  EXPECT_LE(r.fuel_kg, a.fuel_kg);
+  // On board: it fits the table, validates, and the reference is exactly at rest in the tail.
+  const gnc::TrajectoryTable table = to_table(r.samples);
+  EXPECT_EQ(gnc::validate_trajectory(table, m.eps_trans), gnc::TrajectoryError::kOk);
+  for (double t : {r.t_active, 0.5 * (r.t_active + kStudyHorizon), kStudyHorizon - 1.0}) {
+    const gnc::TrajectoryPoint q = gnc::interpolate(table, t);
+    EXPECT_EQ(q.omega_d, Vec3::Zero()) << "t = " << t;
+    EXPECT_EQ(q.omega_d_dot, Vec3::Zero()) << "t = " << t;
+  }
+  // The file round trip re-verifies the whole plan against the model.
+  const LoadResult loaded =
+      parse_trajectory_file(format_trajectory_file(p, r), "study-horizon", m);
+  ASSERT_TRUE(loaded.ok) << loaded.error;
+  EXPECT_EQ(loaded.file.to_table().checksum, table.checksum);
+}
+
+// Every horizon beyond the active one gets the same despin (the same candidates, solved the same
+// way), only the rest is longer; a shorter active horizon (here 2 candidates) bounds the work.
+TEST(PlannerHorizon, HorizonsBeyondTheActiveOneShareTheSameDespin) {
+  PlanProblem p;
+  p.model = study_case_model(200.0, 0.0, 0.0);
+  p.settings.active_horizon_max = 2000.0;
+  p.settings.t_final_max = 22000.0;
+  const PlanResult a = plan(p);
+  p.settings.t_final_max = 50000.0;
+  const PlanResult b = plan(p);
+  ASSERT_TRUE(a.ok) << a.error;
+  ASSERT_TRUE(b.ok) << b.error;
+  EXPECT_EQ(a.t_active, b.t_active);
+  EXPECT_LE(a.t_active, 2000.0);
+  EXPECT_EQ(a.fuel_kg, b.fuel_kg);
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (std::size_t i = 0; i + 2 < a.samples.size(); ++i) {
+    EXPECT_EQ(a.samples[i].t, b.samples[i].t);
+    EXPECT_EQ(a.samples[i].omega_d, b.samples[i].omega_d);
+    EXPECT_EQ(a.samples[i].u_d, b.samples[i].u_d);
+  }
+  EXPECT_EQ(b.samples.back().t, 50000.0);
+  // The despin is the cheaper of the automatic horizon's and 2000 s, both ending with u = 0: it
+  // costs no more than the automatic-horizon plan with u_d(t_f) = 0, planned here on its own.
+  PlanProblem at_auto;
+  at_auto.model = p.model;
+  double t_auto_min = 0.0;
+  double t_auto = 0.0;
+  resolve_final_time_bounds(p.model, PlanSettings{}, t_auto_min, t_auto);
+  at_auto.settings.t_final_max = 50000.0;
+  at_auto.settings.active_horizon_max = t_auto;  // the automatic horizon alone, then rest
+  const PlanResult c = plan(at_auto);
+  ASSERT_TRUE(c.ok) << c.error;
+  EXPECT_LE(a.fuel_kg, c.fuel_kg);
 }
 
 }  // namespace
