@@ -186,6 +186,12 @@ GncConfig load_gnc(const std::string& path) {
     ic.r_prior_sigma = r.positive("offset_prior_sigma_m");
     ic.k_prior_sigma = r.positive("strength_prior_sigma");
     ic.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
+    if (r.has("gyro_bias_sigma_rad_s")) ic.gyro_bias_sigma = r.non_negative("gyro_bias_sigma_rad_s");
+    if (r.has("gate_chi2")) ic.gate_chi2 = r.non_negative("gate_chi2");
+    if (r.has("gate_reinflate_after")) {
+      ic.gate_reinflate_after = r.integer("gate_reinflate_after");
+      if (ic.gate_reinflate_after < 1) r.fail("gate_reinflate_after", "must be >= 1");
+    }
     ic.j_forget_s = r.non_negative("inertia_forget_s");
     ic.r_forget_s = r.non_negative("offset_forget_s");
     ic.j_confident_rel = r.positive("inertia_confident_rel");

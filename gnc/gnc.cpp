@@ -380,7 +380,12 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
-      if (mekf) id_bias_ = mekf_.bias();
+      if (mekf) {
+        // The identifier's bias state (I17) is the bias left in the rate it is given: it
+        // follows the new subtraction once the closed window's step is done.
+        ident_.shift_rate_bias(mekf_.bias() - id_bias_);
+        id_bias_ = mekf_.bias();
+      }
       fault_model_stale_ = true;
     }
     // The detector predicts with the latest identified model, refreshed on a tick that does not
