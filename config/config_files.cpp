@@ -187,6 +187,7 @@ GncConfig load_gnc(const std::string& path) {
     ic.k_prior_sigma = r.positive("strength_prior_sigma");
     ic.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
     if (r.has("gyro_bias_sigma_rad_s")) ic.gyro_bias_sigma = r.non_negative("gyro_bias_sigma_rad_s");
+    if (r.has("gyro_bias_estimated")) ic.gyro_bias_estimated = r.boolean("gyro_bias_estimated");
     if (r.has("gate_chi2")) ic.gate_chi2 = r.non_negative("gate_chi2");
     if (r.has("gate_reinflate_after")) {
       ic.gate_reinflate_after = r.integer("gate_reinflate_after");

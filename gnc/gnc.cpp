@@ -381,9 +381,14 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
       if (mekf) {
-        // The identifier's bias state (I17) is the bias left in the rate it is given: it
-        // follows the new subtraction once the closed window's step is done.
-        ident_.shift_rate_bias(mekf_.bias() - id_bias_);
+        // The identifier's bias (I17) is the bias left in the rate it is given: estimated, it
+        // follows the new subtraction; as a consider parameter, its 1 sigma is the MEKF's.
+        // Either applies once the closed window's step is done.
+        if (params_.identification.config.gyro_bias_estimated) {
+          ident_.shift_rate_bias(mekf_.bias() - id_bias_);
+        } else {
+          ident_.consider_rate_bias(mekf_.bias_sigma());
+        }
         id_bias_ = mekf_.bias();
       }
       fault_model_stale_ = true;

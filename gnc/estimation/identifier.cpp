@@ -212,6 +212,7 @@ void Identifier::reset() {
   b_.setZero();
   p_b_ = c_.gyro_bias_sigma * c_.gyro_bias_sigma * Mat3::Identity();
   bias_shift_.setZero();
+  bias_consider_pending_ = false;
   gated_in_row_ = 0;
   innovation_chi2_ = 0.0;
   p_all_.setZero();
@@ -292,11 +293,32 @@ void Identifier::reinflate_all() {
 void Identifier::shift_rate_bias(const Vec3& delta) {
   if (!delta.allFinite()) return;
   bias_shift_ += delta;
-  if (phase_ == Phase::kIdle) {  // no step running on a window that used the old rate
-    b_ -= bias_shift_;
-    bias_shift_.setZero();
-    est_.gyro_bias = b_;
+  if (phase_ == Phase::kIdle) apply_bias_changes();  // no step on a window with the old rate
+}
+
+void Identifier::consider_rate_bias(const Vec3& sigma) {
+  if (!sigma.allFinite() || (sigma.array() < 0.0).any()) return;
+  bias_consider_sigma_ = sigma;
+  bias_consider_pending_ = true;
+  if (phase_ == Phase::kIdle) apply_bias_changes();
+}
+
+void Identifier::apply_bias_changes() {
+  b_ -= bias_shift_;
+  bias_shift_.setZero();
+  if (bias_consider_pending_ && c_.mode == IdentifierMode::kJoint) {
+    bias_consider_pending_ = false;
+    b_.setZero();
+    p_all_.middleRows<3>(kIdB).setZero();
+    p_all_.middleCols<3>(kIdB).setZero();
+    for (int a = 0; a < 3; ++a) {
+      const double v = bias_consider_sigma_(a) * bias_consider_sigma_(a);
+      p_all_(kIdB + a, kIdB + a) = std::fmin(v, c_.gyro_bias_sigma * c_.gyro_bias_sigma);
+    }
+    p_b_ = p_all_.block<3, 3>(kIdB, kIdB);
   }
+  est_.gyro_bias = b_;
+  est_.gyro_bias_sigma = p_b_.diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
 void Identifier::sync_blocks() {
@@ -403,6 +425,8 @@ bool Identifier::joint_gain_rows() {
   joint_.k = joint_.p_ht.lazyProduct(s_inv);
   // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
   if (!exc_.offset) joint_.k.middleRows<3>(kIdR).setZero();
+  // (I17) b as a consider parameter: no gain, its covariance kept (Schmidt).
+  if (!c_.gyro_bias_estimated) joint_.k.middleRows<3>(kIdB).setZero();
   joint_.pending = true;
   return true;
 }
@@ -458,7 +482,7 @@ void Identifier::joint_covariance_rows(int first, int n) {
   for (int i = first; i < first + n; ++i) {
     Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
     row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
-    if (!exc_.offset) {
+    if (!exc_.offset || !c_.gyro_bias_estimated) {  // a gain with zeroed rows: the full form
       row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
       row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();
     }
@@ -714,8 +738,7 @@ void Identifier::step_phase() {
       if (c_.mode == IdentifierMode::kJoint) sync_blocks();
       // The step used the rate as it was given in its window; a bias shift requested since
       // applies from here on.
-      b_ -= bias_shift_;
-      bias_shift_.setZero();
+      apply_bias_changes();
       report();
       phase_ = Phase::kIdle;
       break;

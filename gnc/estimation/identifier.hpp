@@ -72,6 +72,10 @@ struct IdentifierConfig {
   // as three more parameters (I17): a bias b in omega puts -G b into the window equation, G the
   // gyroscopic term's Jacobian. 0: the rate is taken as unbiased (b held at zero).
   double gyro_bias_sigma{0.0};
+  // true: b is estimated with the others; false: b is a consider parameter (Schmidt): its
+  // uncertainty and cross-covariances are carried, so J, r and k are as uncertain as the bias
+  // makes them, but b-hat stays at zero (the rate as given) and the linearisation point with it.
+  bool gyro_bias_estimated{false};
   // Innovation gate (I18, kJoint): a window whose residual e0' S^-1 e0 exceeds gate_chi2 does
   // not fit the model with the confidence the covariance claims (an unmodelled fault, a model
   // change); it is refused and counted, estimate and covariance untouched. After
@@ -213,6 +217,11 @@ class Identifier {
   // far (e.g. a new gyro-bias estimate from the attitude filter): the bias state follows,
   // b <- b - delta, once the step of the window already closed (which used the old rate) is done.
   void shift_rate_bias(const Vec3& delta);
+  // With b a consider parameter (gyro_bias_estimated false): the rate given from the next window
+  // on has been corrected by a bias estimate whose error has this 1 sigma per axis (e.g. the
+  // attitude filter's); b's covariance becomes diag(sigma^2), its mean zero and its cross terms
+  // cleared (a fresh consider parameter), once the closed window's step is done.
+  void consider_rate_bias(const Vec3& sigma);
 
   const IdentifierEstimate& estimate() const { return est_; }
   const IdentifierExcitation& excitation() const { return exc_; }
@@ -288,6 +297,9 @@ class Identifier {
   Vec3 b_{Vec3::Zero()};
   Mat3 p_b_{Mat3::Zero()};
   Vec3 bias_shift_{Vec3::Zero()};  // shift_rate_bias not yet applied (a step is running)
+  Vec3 bias_consider_sigma_{Vec3::Zero()};  // consider_rate_bias not yet applied
+  bool bias_consider_pending_{false};
+  void apply_bias_changes();
   int gated_in_row_{0};
   MatId p_all_{MatId::Identity()};            // kJoint: [a; r; k]
   std::array<bool, kThrusters> reference_{};  // thrusters that define the thrust scale

@@ -250,7 +250,7 @@ TEST(Identifier, WithNoiseTheErrorsAreConsistentWithTheReportedSigma) {
 struct BiasedRunNees {
   double j{0.0}, r{0.0}, b{0.0}, j_rel_max{0.0};
 };
-BiasedRunNees biased_run_nees(double bias_sigma, int runs) {
+BiasedRunNees biased_run_nees(double bias_sigma, bool estimated, int runs) {
   BiasedRunNees out;
   std::mt19937_64 rng(2024);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -271,6 +271,7 @@ BiasedRunNees biased_run_nees(double bias_sigma, int runs) {
                                             s.r - Vec3(1, 1, 1).normalized());
     c.gyro_sigma = s.gyro_sigma;
     c.gyro_bias_sigma = bias_sigma;
+    c.gyro_bias_estimated = estimated;
     Identifier id;
     id.configure(c);
     TruthRun truth(s);
@@ -282,7 +283,7 @@ BiasedRunNees biased_run_nees(double bias_sigma, int runs) {
     const Vec3 dr = e.r - s.r;
     out.j += dj.dot(id.inertia_covariance().ldlt().solve(dj));
     out.r += dr.dot(id.offset_covariance().ldlt().solve(dr));
-    if (bias_sigma > 0.0) {
+    if (bias_sigma > 0.0 && estimated) {
       const Vec3 db = e.gyro_bias - s.gyro_bias;
       out.b += db.dot(id.bias_covariance().ldlt().solve(db));
     }
@@ -296,13 +297,18 @@ TEST(Identifier, WithAGyroBiasTheNormalisedErrorsStayInsideTheChiSquareBand) {
   const auto in_band = [](double sum, int dof) {
     return sum >= test::chi2_quantile(dof, -1.96) && sum <= test::chi2_quantile(dof, 1.96);
   };
-  const BiasedRunNees with = biased_run_nees(3e-5, kRuns);
+  const BiasedRunNees with = biased_run_nees(3e-5, true, kRuns);
   std::printf("bias estimated: mean NEES J %.2f (6), r %.2f (3), b %.2f (3); worst |dJ|/|J| %.2g\n",
               with.j / kRuns, with.r / kRuns, with.b / kRuns, with.j_rel_max);
   EXPECT_TRUE(in_band(with.j, 6 * kRuns)) << with.j;
   EXPECT_TRUE(in_band(with.r, 3 * kRuns)) << with.r;
   EXPECT_TRUE(in_band(with.b, 3 * kRuns)) << with.b;
-  const BiasedRunNees without = biased_run_nees(0.0, kRuns);
+  const BiasedRunNees consider = biased_run_nees(3e-5, false, kRuns);
+  std::printf("bias considered: mean NEES J %.2f (6), r %.2f (3); worst |dJ|/|J| %.2g\n",
+              consider.j / kRuns, consider.r / kRuns, consider.j_rel_max);
+  EXPECT_TRUE(in_band(consider.j, 6 * kRuns)) << consider.j;
+  EXPECT_TRUE(in_band(consider.r, 3 * kRuns)) << consider.r;
+  const BiasedRunNees without = biased_run_nees(0.0, false, kRuns);
   std::printf("bias ignored: mean NEES J %.2f (6), r %.2f (3); worst |dJ|/|J| %.2g\n",
               without.j / kRuns, without.r / kRuns, without.j_rel_max);
   EXPECT_FALSE(in_band(without.j, 6 * kRuns) && in_band(without.r, 3 * kRuns));
@@ -387,6 +393,41 @@ TEST(Identifier, AnUpdateRefusedByTheInnovationGateLeavesEstimateAndCovarianceAl
       EXPECT_GT(z.cwiseAbs().maxCoeff(), 10.0);
     }
   }
+}
+
+// (I17) With b a consider parameter, a new bias correction upstream (the MEKF's) sets b's
+// covariance to the given 1 sigma, clears its cross terms and keeps b-hat at zero, but only once
+// the closed window's step (which used the old rate) is done.
+TEST(Identifier, AConsideredRateBiasTakesTheGivenSigmaAfterTheStep) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  IdentifierConfig c = config_with_priors(s.j, s.r);
+  c.gyro_bias_sigma = 3e-5;
+  Identifier id;
+  id.configure(c);
+  EXPECT_NEAR(id.bias_covariance()(0, 0), 9e-10, 1e-22);
+  TruthRun truth(s);
+  RandomFiring fire(4);
+  const int n = static_cast<int>(std::lround(c.window_s / kDt));
+  int tick = 0;
+  bool asked = false, checked_pending = false;
+  const Vec3 sigma(1e-6, 2e-6, 3e-6);
+  truth.run(3 * n, fire, [&](double, const test::V3& w, const test::V8& f) {
+    id.update(id_input(w, f));
+    ++tick;
+    if (!asked && id.counters().windows == 1) {  // the first window has just closed
+      asked = true;
+      id.consider_rate_bias(sigma);
+      EXPECT_NEAR(id.bias_covariance()(0, 0), 9e-10, 1e-22);  // its step still runs
+      checked_pending = true;
+    }
+  });
+  ASSERT_TRUE(checked_pending);
+  // Two more windows' steps ran with the new covariance: b was never fitted (no gain), so its
+  // covariance is what was given, with no cross terms beyond what those steps created.
+  EXPECT_TRUE(id.estimate().gyro_bias.isZero());
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(id.bias_covariance()(a, a), sigma(a) * sigma(a), 1e-24);
 }
 
 // (I21) against a brute-force double sum over a fine grid, random phase: the closed form and the
