@@ -188,6 +188,9 @@ GncConfig load_gnc(const std::string& path) {
     ic.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
     if (r.has("gyro_bias_sigma_rad_s")) ic.gyro_bias_sigma = r.non_negative("gyro_bias_sigma_rad_s");
     if (r.has("gyro_bias_estimated")) ic.gyro_bias_estimated = r.boolean("gyro_bias_estimated");
+    if (r.has("mekf_bias_sigma_floor_rad_s")) {
+      id.mekf_bias_sigma_floor = r.non_negative("mekf_bias_sigma_floor_rad_s");
+    }
     if (r.has("gate_chi2")) ic.gate_chi2 = r.non_negative("gate_chi2");
     if (r.has("gate_reinflate_after")) {
       ic.gate_reinflate_after = r.integer("gate_reinflate_after");

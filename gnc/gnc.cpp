@@ -387,7 +387,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
         if (params_.identification.config.gyro_bias_estimated) {
           ident_.shift_rate_bias(mekf_.bias() - id_bias_);
         } else {
-          ident_.consider_rate_bias(mekf_.bias_sigma());
+          ident_.consider_rate_bias(
+              mekf_.bias_sigma().cwiseMax(params_.identification.mekf_bias_sigma_floor));
         }
         id_bias_ = mekf_.bias();
       }

@@ -367,6 +367,10 @@ struct IdentificationParams {
   bool enabled{false};  // run the identifier in the tick
   ModelAdoption adopt{ModelAdoption::kOff};
   double adopt_interval_s{300.0};  // s, at least this long between two automatic adoptions
+  // With the MEKF, the 1 sigma of the bias left in the corrected rate is the MEKF's bias sigma,
+  // but never below this (rad/s): the MEKF's bias sigma at convergence understates its error,
+  // and the identifier takes the residual bias afresh each window (README I17).
+  double mekf_bias_sigma_floor{3e-6};
   // The identifier's tuning. Its dt, thruster geometry and priors (j0, r0, k0) are not read from
   // here: they are the active table's dt, rcs and mass_hat, filled in by build_identifier_config.
   IdentifierConfig config{};
