@@ -186,7 +186,9 @@ GncConfig load_gnc(const std::string& path) {
     ic.r_prior_sigma = r.positive("offset_prior_sigma_m");
     ic.k_prior_sigma = r.positive("strength_prior_sigma");
     ic.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
-    if (r.has("gyro_bias_sigma_rad_s")) ic.gyro_bias_sigma = r.non_negative("gyro_bias_sigma_rad_s");
+    if (r.has("gyro_bias_sigma_rad_s")) {
+      ic.gyro_bias_sigma = r.non_negative("gyro_bias_sigma_rad_s");
+    }
     if (r.has("gyro_bias_estimated")) ic.gyro_bias_estimated = r.boolean("gyro_bias_estimated");
     if (r.has("mekf_bias_sigma_floor_rad_s")) {
       id.mekf_bias_sigma_floor = r.non_negative("mekf_bias_sigma_floor_rad_s");

@@ -13,7 +13,6 @@ namespace rocksteady::gnc {
 
 namespace {
 
-
 // Weighted recursive least squares with a vector measurement (I7): Phi theta = y + v,
 // cov(v) = R (the window noise plus what the other groups' uncertainty contributes).
 template <int N>
@@ -80,8 +79,8 @@ double held_disturbance_factor(double window_s, double hold_s) {
   // beyond, Simpson's rule on [0, min(hold, T)] (breakpoint at h on a node).
   const double t = window_s;
   const double tau = hold_s;
-  if (tau <= 0.5 * t) return t * tau / 3.0 - tau * tau * tau / (3.0 * t) +
-                             tau * tau * tau * tau / (5.0 * t * t);
+  if (tau <= 0.5 * t)
+    return t * tau / 3.0 - tau * tau * tau / (3.0 * t) + tau * tau * tau * tau / (5.0 * t * t);
   const double h = 0.5 * t;
   const auto r_w = [h](double u) {
     if (u <= h) return 2.0 * h / 3.0 - u * u / h + u * u * u / (2.0 * h * h);
@@ -336,10 +335,11 @@ Mat3 Identifier::bias_jacobian() const {
 
 void Identifier::joint_gain() {
   // (I13): e(x) = A_J a - sum_i k_i [(p_i + r) x e_i] ∫ w F_i dt = noise, linearised at the
-  // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat)], one extended-RLS step on all 25 parameters.
+  // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat), -G], one extended-RLS step on all 28
+  // parameters (with the rate bias b of I17).
   // The gain is formed over several ticks (joint_gain, then joint_gain_rows per block of rows),
   // the update applied on one (joint_apply) and the covariance updated over several
-  // (joint_covariance_step), so no tick carries more than a block of the 25-parameter step.
+  // (joint_covariance_step), so no tick carries more than a block of the 28-parameter step.
   joint_.pending = false;
   joint_.started = false;
   const Vec3 force = net_force_impulse();
@@ -403,8 +403,8 @@ bool Identifier::joint_gain_rows() {
   residual_cov_ = joint_.s;
   const Eigen::LDLT<Mat3> ldlt(joint_.s);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return true;
-  // K = P H' S^-1 with S^-1 from the 3x3 factorisation (a 25 x 3 times 3 x 3 product, no
-  // blocked triangular solve over 25 right-hand sides).
+  // K = P H' S^-1 with S^-1 from the 3x3 factorisation (a 28 x 3 times 3 x 3 product, no
+  // blocked triangular solve over 28 right-hand sides).
   const Mat3 s_inv = ldlt.solve(Mat3::Identity());
   // (I18) innovation gate: a window the model cannot explain within S is refused, estimate and
   // covariance untouched; too many in a row re-inflate J, r and k.
@@ -657,7 +657,7 @@ void Identifier::accumulate(const IdentifierInput& in) {
   acc_.a_j += alpha * l + wdt * (skew(in.omega) * l);
   acc_.sum_alpha2 += alpha * alpha;
   acc_.sum_gyro2 += wdt * wdt * in.omega.squaredNorm();
-  acc_.m += wdt * in.omega;  // (I17)
+  acc_.m += wdt * in.omega;                                    // (I17)
   acc_.w2 += (wdt * wdt) * (in.omega * in.omega.transpose());  // (I19)
   acc_.n += (alpha * wdt) * in.omega;
 }
@@ -795,8 +795,8 @@ Mat3 Identifier::second_order_noise() const {
     const Mat36 lm = inertia_regressor(latched_.m);
     std::array<Mat36, 3> bk;
     for (int k = 0; k < 3; ++k) {
-      bk[static_cast<std::size_t>(k)] = sm * inertia_regressor(Vec3::Unit(k)) +
-                                        se[static_cast<std::size_t>(k)] * lm;
+      bk[static_cast<std::size_t>(k)] =
+          sm * inertia_regressor(Vec3::Unit(k)) + se[static_cast<std::size_t>(k)] * lm;
     }
     for (int k = 0; k < 3; ++k) {
       const Mat36 bp = bk[static_cast<std::size_t>(k)] * p_a;
@@ -928,8 +928,7 @@ void Identifier::update_offset() {
   const Mat3 phi = -skew(force);
   const Vec3 r_keep = r_;
   const Mat3 p_keep = p_r_;
-  const Mat3 r_noise =
-      latched_r_ + consider_inertia() + consider_strengths();
+  const Mat3 r_noise = latched_r_ + consider_inertia() + consider_strengths();
   forget<3>(p_r_, c_.window_s, c_.r_forget_s, c_.r_prior_sigma * c_.r_prior_sigma);
   rls_update<3>(r_, p_r_, phi, y, r_noise);
   if (!r_.allFinite() || (r_ - c_.r0).norm() > c_.r_max_offset) {

@@ -39,8 +39,9 @@ Vec3 thruster_position(const RcsLayout& l, int i);
 
 // How the three groups are estimated (§I.5). kConcurrent: one RLS per group, each holding the
 // others at their latest estimates and counting their uncertainty as noise (Wilson, Lages & Mah
-// 2002). kJoint: the same window equation linearised in all 25 parameters at once (an extended
-// RLS), which keeps the cross-covariances the concurrent form drops.
+// 2002). kJoint: the same window equation linearised in all 28 parameters at once (J, r, k and
+// the rate bias, I17; an extended RLS), which keeps the cross-covariances the concurrent form
+// drops.
 enum class IdentifierMode : std::uint8_t { kConcurrent = 0, kJoint = 1 };
 
 // Joint state [a (6); r (3); k (16); b (3)]: b is the bias of the rate the identifier is given
@@ -173,7 +174,7 @@ struct IdentifierCounters {
   std::uint32_t offset_refused{0};
   std::uint32_t strength_clamped{0};
   std::uint32_t reinflations{0};
-  std::uint32_t windows_gated{0};     // refused by the innovation gate (I18)
+  std::uint32_t windows_gated{0};      // refused by the innovation gate (I18)
   std::uint32_t gate_reinflations{0};  // ... re-inflations after too many in a row
 };
 
@@ -262,11 +263,11 @@ class Identifier {
   Mat3 consider_inertia() const;      // (I7)
   Mat3 consider_offset() const;
   Mat3 consider_strengths() const;
-  void joint_gain();         // (I13) gain of the joint step: the linearisation
-  bool joint_gain_rows();    // ... a block of rows of P H'; then S and K (true when done)
+  void joint_gain();       // (I13) gain of the joint step: the linearisation
+  bool joint_gain_rows();  // ... a block of rows of P H'; then S and K (true when done)
   void joint_apply();
   void joint_covariance_rows(int first, int n);  // rows [first, first + n) of the P update
-  bool joint_covariance_step();    // a block of rows of the P update (true when all are done)
+  bool joint_covariance_step();  // a block of rows of the P update (true when all are done)
   void symmetrise_rows(int first, int n);
   void joint_finish_covariance();  // the remaining rows, symmetrise, cap        // (I13), (I14)
                                    // apply it, guarded
@@ -296,7 +297,7 @@ class Identifier {
   Mat16 p_k_{Mat16::Identity()};
   Vec3 b_{Vec3::Zero()};
   Mat3 p_b_{Mat3::Zero()};
-  Vec3 bias_shift_{Vec3::Zero()};  // shift_rate_bias not yet applied (a step is running)
+  Vec3 bias_shift_{Vec3::Zero()};           // shift_rate_bias not yet applied (a step is running)
   Vec3 bias_consider_sigma_{Vec3::Zero()};  // consider_rate_bias not yet applied
   bool bias_consider_pending_{false};
   void apply_bias_changes();

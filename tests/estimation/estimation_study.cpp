@@ -115,8 +115,8 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
     previous = plant.applied_force();
   }
   std::printf("case %d %-10s T=%2.0f s k0 1s %.2f bias %.0e |", case_number,
-              mode == gnc::IdentifierMode::kJoint ? "joint" : "concurrent", window_s,
-              k_prior_sigma, gyro_bias);
+              mode == gnc::IdentifierMode::kJoint ? "joint" : "concurrent", window_s, k_prior_sigma,
+              gyro_bias);
   for (int i = 0; i < kMarks; ++i) {
     std::printf(" %5.0fs: J %.2e (1s %.1e) r %.3f m (1s %.3f) k %.3f NEES %.1f/%.1f |", marks[i],
                 e[i].j, e[i].j_sigma_rel, e[i].r, e[i].r_sigma, e[i].k, e[i].nees_j, e[i].nees_r);
@@ -180,7 +180,8 @@ void hold(const std::string& dir, int case_number, double gyro_bias, double bias
     }
     plant.advance(Vec8::Zero(), false);
   }
-  const double analytic = test::farrenkopf_post_update_sigma(mc.gyro_arw, mc.gyro_bias_rw, mc.star_sigma, mc.dt);
+  const double analytic =
+      test::farrenkopf_post_update_sigma(mc.gyro_arw, mc.gyro_bias_rw, mc.star_sigma, mc.dt);
   std::printf(
       "case %d HOLD bias %.1e rw %.1e | MEKF attitude sigma %.3e rad (max %.2e), Farrenkopf %.3e "
       "(ratio %.3f); rate RMS %.2e rad/s | SPEC 6 filter attitude sigma %.3e, rate RMS %.2e | bias "

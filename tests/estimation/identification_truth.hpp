@@ -53,8 +53,8 @@ struct TruthSetup {
   double disturbance_sigma{0.0};  // N m per axis, held disturbance_hold_s
   double disturbance_hold_s{10.0};
   double disturbance_phase_s{0.0};  // first change of the held disturbance after this
-  double gyro_sigma{0.0};  // rad/s per sample
-  V3 gyro_bias{V3::Zero()};  // rad/s, constant, added to every gyro sample
+  double gyro_sigma{0.0};           // rad/s per sample
+  V3 gyro_bias{V3::Zero()};         // rad/s, constant, added to every gyro sample
   unsigned long long seed{1};
 };
 
@@ -83,7 +83,7 @@ class TruthRun {
       if (t >= next_draw - 1e-9) {
         for (int a = 0; a < 3; ++a) dist(a) = s_.disturbance_sigma * normal_(rng_);
         next_draw = (next_draw == 0.0 && first_change > 0.0) ? first_change
-                                                              : next_draw + s_.disturbance_hold_s;
+                                                             : next_draw + s_.disturbance_hold_s;
       }
       body_.step(s_.dt, rcs_.torque(u, s_.r, k_now_) + dist);
       previous = u;

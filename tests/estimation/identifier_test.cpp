@@ -183,28 +183,27 @@ TEST(Identifier, WithheldTicksDelayTheStepButChangeNoNumber) {
   RandomFiring fire(9);
   const int n = static_cast<int>(std::lround(c.window_s / kDt));
   int tick = 0, compared = 0, asymmetric = 0;
-  truth.run(static_cast<int>(600.0 / kDt), fire,
-            [&](double, const test::V3& w, const test::V8& f) {
-              every.update(id_input(w, f));
-              withheld.update(id_input(w, f), tick % 3 != 0);
-              ++tick;
-              // Just before the next window closes both have finished the previous window's step.
-              if (tick % n == n - 1 && every.counters().windows > 0) {
-                ++compared;
-                EXPECT_EQ(every.counters().windows, withheld.counters().windows);
-                EXPECT_TRUE(every.estimate().j == withheld.estimate().j) << tick;
-                EXPECT_TRUE(every.estimate().r == withheld.estimate().r) << tick;
-                EXPECT_TRUE(every.estimate().k == withheld.estimate().k) << tick;
-                EXPECT_TRUE(every.inertia_covariance() == withheld.inertia_covariance()) << tick;
-                EXPECT_TRUE(every.offset_covariance() == withheld.offset_covariance()) << tick;
-                EXPECT_TRUE(every.strength_covariance() == withheld.strength_covariance()) << tick;
-                const Mat16& pk = every.strength_covariance();
-                if (!(pk == pk.transpose()) ||
-                    !(every.inertia_covariance() == every.inertia_covariance().transpose())) {
-                  ++asymmetric;
-                }
-              }
-            });
+  truth.run(static_cast<int>(600.0 / kDt), fire, [&](double, const test::V3& w, const test::V8& f) {
+    every.update(id_input(w, f));
+    withheld.update(id_input(w, f), tick % 3 != 0);
+    ++tick;
+    // Just before the next window closes both have finished the previous window's step.
+    if (tick % n == n - 1 && every.counters().windows > 0) {
+      ++compared;
+      EXPECT_EQ(every.counters().windows, withheld.counters().windows);
+      EXPECT_TRUE(every.estimate().j == withheld.estimate().j) << tick;
+      EXPECT_TRUE(every.estimate().r == withheld.estimate().r) << tick;
+      EXPECT_TRUE(every.estimate().k == withheld.estimate().k) << tick;
+      EXPECT_TRUE(every.inertia_covariance() == withheld.inertia_covariance()) << tick;
+      EXPECT_TRUE(every.offset_covariance() == withheld.offset_covariance()) << tick;
+      EXPECT_TRUE(every.strength_covariance() == withheld.strength_covariance()) << tick;
+      const Mat16& pk = every.strength_covariance();
+      if (!(pk == pk.transpose()) ||
+          !(every.inertia_covariance() == every.inertia_covariance().transpose())) {
+        ++asymmetric;
+      }
+    }
+  });
   EXPECT_GE(compared, 25);
   EXPECT_EQ(asymmetric, 0);
   EXPECT_GT(every.counters().inertia_updates, 20u);
@@ -377,10 +376,11 @@ TEST(Identifier, AnUpdateRefusedByTheInnovationGateLeavesEstimateAndCovarianceAl
                 if (t > t_fault) r_move = std::fmax(r_move, (id.estimate().r - r_before).norm());
               });
     const Vec3 z = (id.estimate().r - s.r).cwiseQuotient(id.estimate().r_sigma);
-    std::printf("gate %d: windows gated %u, re-inflations %u, r moved %.3g m (1 sigma %.3g m "
-                "at the fault); at 700 s |r_hat - r| %.3g m, largest |error| / sigma %.3g\n",
-                gate, id.counters().windows_gated, id.counters().gate_reinflations, r_move,
-                r_sigma_fault, (id.estimate().r - s.r).norm(), z.cwiseAbs().maxCoeff());
+    std::printf(
+        "gate %d: windows gated %u, re-inflations %u, r moved %.3g m (1 sigma %.3g m "
+        "at the fault); at 700 s |r_hat - r| %.3g m, largest |error| / sigma %.3g\n",
+        gate, id.counters().windows_gated, id.counters().gate_reinflations, r_move, r_sigma_fault,
+        (id.estimate().r - s.r).norm(), z.cwiseAbs().maxCoeff());
     if (gate) {
       EXPECT_GE(checked, 2);
       EXPECT_GE(reinflated, 1);
@@ -433,8 +433,11 @@ TEST(Identifier, AConsideredRateBiasTakesTheGivenSigmaAfterTheStep) {
 // (I21) against a brute-force double sum over a fine grid, random phase: the closed form and the
 // Simpson branch.
 TEST(Identifier, HeldDisturbanceFactorMatchesTheDoubleIntegral) {
-  for (const auto& tt : {std::pair<double, double>{20.0, 10.0}, {60.0, 10.0}, {20.0, 15.0},
-                         {20.0, 40.0}, {8.0, 1.0}}) {
+  for (const auto& tt : {std::pair<double, double>{20.0, 10.0},
+                         {60.0, 10.0},
+                         {20.0, 15.0},
+                         {20.0, 40.0},
+                         {8.0, 1.0}}) {
     const double t_w = tt.first, tau = tt.second;
     const int n = 800;
     const double dt = t_w / n;
