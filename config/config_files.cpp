@@ -355,6 +355,9 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   p.mekf.gyro_arw = std::fmax(std::sqrt(c.gyro_psd), 1e-9);
   p.mekf.star_sigma = std::fmax(4.0 * std::sqrt(c.star_psd / m.sensor_period_s), 1e-7);
   p.identification.config.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
+  // A noise-free gyro is the study's idealised, perfect gyro: no bias either. A real one has the
+  // data sheet's bias (gyro_bias_sigma_rad_s), carried by the identifier (README I17).
+  if (c.gyro_psd <= 0.0) p.identification.config.gyro_bias_sigma = 0.0;
   if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
   // A gyro is never noise-free: the detector assumes at least 1e-7 rad/s per sample (a
   // navigation-grade gyro's resolution), so the noise-free cases do not trust rates to the bit.
