@@ -193,6 +193,7 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("mekf_bias_sigma_floor_rad_s")) {
       id.mekf_bias_sigma_floor = r.non_negative("mekf_bias_sigma_floor_rad_s");
     }
+    if (r.has("second_order_noise")) ic.second_order_noise = r.boolean("second_order_noise");
     if (r.has("gate_chi2")) ic.gate_chi2 = r.non_negative("gate_chi2");
     if (r.has("gate_reinflate_after")) {
       ic.gate_reinflate_after = r.integer("gate_reinflate_after");

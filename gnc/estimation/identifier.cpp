@@ -376,7 +376,7 @@ void Identifier::joint_gain() {
   if (joint_.any_thruster && c_.k_forget_s > 0.0) {
     d.segment<kThrusters>(kIdK).setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
   }
-  joint_.second_order = second_order_noise();
+  joint_.second_order = c_.second_order_noise ? second_order_noise() : Mat3::Zero();
   // P_f H' = D P D H' without forming P_f, a block of rows per tick (joint_gain_rows).
   joint_.h = h;
   joint_.dht = d.asDiagonal() * h.transpose();

@@ -84,6 +84,9 @@ struct IdentifierConfig {
   // back to their prior covariance (re-inflation), so the data are fitted again honestly.
   // 0: no gate.
   double gate_chi2{0.0};
+  // (I20) the second-order term of the bilinear products joins the innovation covariance
+  // (consistency from far priors; slower to become confident while r and k are both uncertain).
+  bool second_order_noise{false};
   int gate_reinflate_after{3};
   double disturbance_sigma{0.57735026918962576};
   double disturbance_corr_s{10.0};

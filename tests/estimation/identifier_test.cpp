@@ -271,6 +271,7 @@ BiasedRunNees biased_run_nees(double bias_sigma, bool estimated, int runs) {
     c.gyro_sigma = s.gyro_sigma;
     c.gyro_bias_sigma = bias_sigma;
     c.gyro_bias_estimated = estimated;
+    c.second_order_noise = true;
     Identifier id;
     id.configure(c);
     TruthRun truth(s);
