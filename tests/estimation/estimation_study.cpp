@@ -74,6 +74,7 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
   // The flight's bias prior and innovation gate (gnc.yaml, README I17/I18).
   c.gyro_bias_sigma = run.flight.identification.config.gyro_bias_sigma;
   c.gate_chi2 = run.flight.identification.config.gate_chi2;
+  c.second_order_noise = run.flight.identification.config.second_order_noise;
   c.gate_reinflate_after = run.flight.identification.config.gate_reinflate_after;
   const gnc::IdentifierConfigCheck check = gnc::validate(c);
   if (!check.ok) {
