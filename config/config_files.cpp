@@ -186,6 +186,19 @@ GncConfig load_gnc(const std::string& path) {
     ic.r_prior_sigma = r.positive("offset_prior_sigma_m");
     ic.k_prior_sigma = r.positive("strength_prior_sigma");
     ic.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
+    if (r.has("gyro_bias_sigma_rad_s")) {
+      ic.gyro_bias_sigma = r.non_negative("gyro_bias_sigma_rad_s");
+    }
+    if (r.has("gyro_bias_estimated")) ic.gyro_bias_estimated = r.boolean("gyro_bias_estimated");
+    if (r.has("mekf_bias_sigma_floor_rad_s")) {
+      id.mekf_bias_sigma_floor = r.non_negative("mekf_bias_sigma_floor_rad_s");
+    }
+    if (r.has("second_order_noise")) ic.second_order_noise = r.boolean("second_order_noise");
+    if (r.has("gate_chi2")) ic.gate_chi2 = r.non_negative("gate_chi2");
+    if (r.has("gate_reinflate_after")) {
+      ic.gate_reinflate_after = r.integer("gate_reinflate_after");
+      if (ic.gate_reinflate_after < 1) r.fail("gate_reinflate_after", "must be >= 1");
+    }
     ic.j_forget_s = r.non_negative("inertia_forget_s");
     ic.r_forget_s = r.non_negative("offset_forget_s");
     ic.j_confident_rel = r.positive("inertia_confident_rel");
@@ -343,6 +356,9 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   p.mekf.gyro_arw = std::fmax(std::sqrt(c.gyro_psd), 1e-9);
   p.mekf.star_sigma = std::fmax(4.0 * std::sqrt(c.star_psd / m.sensor_period_s), 1e-7);
   p.identification.config.gyro_sigma = std::sqrt(c.gyro_psd / m.sensor_period_s);
+  // A noise-free gyro is the study's idealised, perfect gyro: no bias either. A real one has the
+  // data sheet's bias (gyro_bias_sigma_rad_s), carried by the identifier (README I17).
+  if (c.gyro_psd <= 0.0) p.identification.config.gyro_bias_sigma = 0.0;
   if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
   // A gyro is never noise-free: the detector assumes at least 1e-7 rad/s per sample (a
   // navigation-grade gyro's resolution), so the noise-free cases do not trust rates to the bit.

@@ -396,7 +396,18 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
-      if (mekf) id_bias_ = mekf_.bias();
+      if (mekf) {
+        // The identifier's bias (I17) is the bias left in the rate it is given: estimated, it
+        // follows the new subtraction; as a consider parameter, its 1 sigma is the MEKF's.
+        // Either applies once the closed window's step is done.
+        if (params_.identification.config.gyro_bias_estimated) {
+          ident_.shift_rate_bias(mekf_.bias() - id_bias_);
+        } else {
+          ident_.consider_rate_bias(
+              mekf_.bias_sigma().cwiseMax(params_.identification.mekf_bias_sigma_floor));
+        }
+        id_bias_ = mekf_.bias();
+      }
       fault_model_stale_ = true;
     }
     // The detector predicts with the latest identified model; one that arrives while a closed

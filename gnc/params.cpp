@@ -193,6 +193,9 @@ ParamCheck validate(const GncParams& p) {
   if (!finite_positive(id.adopt_interval_s)) {
     return bad("identification.adopt_interval", "must be positive and finite");
   }
+  if (!finite_non_negative(id.mekf_bias_sigma_floor)) {
+    return bad("identification.mekf_bias_sigma_floor", "must be >= 0 and finite");
+  }
   if (id.enabled) {
     const IdentifierConfigCheck ic = validate(build_identifier_config(p));
     if (!ic.ok) return bad(ic.field, ic.reason);

@@ -13,7 +13,6 @@ namespace rocksteady::gnc {
 
 namespace {
 
-
 // Weighted recursive least squares with a vector measurement (I7): Phi theta = y + v,
 // cov(v) = R (the window noise plus what the other groups' uncertainty contributes).
 template <int N>
@@ -73,6 +72,33 @@ Vec3 thruster_position(const RcsLayout& l, int i) {
   return l.pod_position[l.channel_pod[i / 2]];
 }
 
+double held_disturbance_factor(double window_s, double hold_s) {
+  // R_w(u) for the triangle of half-width h = T/2 (a piecewise cubic):
+  //   2h/3 - u^2/h + u^3/(2h^2) on [0, h],  (2h - u)^3/(6h^2) on [h, 2h], 0 beyond.
+  // For hold <= T/2 the integral is closed: T hold/3 - hold^3/(3T) + hold^4/(5T^2) (I21);
+  // beyond, Simpson's rule on [0, min(hold, T)] (breakpoint at h on a node).
+  const double t = window_s;
+  const double tau = hold_s;
+  if (tau <= 0.5 * t)
+    return t * tau / 3.0 - tau * tau * tau / (3.0 * t) + tau * tau * tau * tau / (5.0 * t * t);
+  const double h = 0.5 * t;
+  const auto r_w = [h](double u) {
+    if (u <= h) return 2.0 * h / 3.0 - u * u / h + u * u * u / (2.0 * h * h);
+    if (u <= 2.0 * h) return (2.0 * h - u) * (2.0 * h - u) * (2.0 * h - u) / (6.0 * h * h);
+    return 0.0;
+  };
+  const auto f = [&](double u) { return (1.0 - u / tau) * r_w(u); };
+  // Two Simpson pieces, [0, h] and [h, min(tau, 2h)], 200 intervals each.
+  const auto simpson = [&](double a, double b) {
+    constexpr int kN = 200;
+    const double dx = (b - a) / kN;
+    double acc = f(a) + f(b);
+    for (int i = 1; i < kN; ++i) acc += (i % 2 == 1 ? 4.0 : 2.0) * f(a + i * dx);
+    return acc * dx / 3.0;
+  };
+  return 2.0 * (simpson(0.0, h) + simpson(h, std::fmin(tau, 2.0 * h)));
+}
+
 IdentifierConfigCheck validate(const IdentifierConfig& c) {
   auto bad = [](const char* field, const char* reason) {
     return IdentifierConfigCheck{false, field, reason};
@@ -106,6 +132,11 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   if (!finite_positive(c.r_prior_sigma)) return bad("r_prior_sigma", "must be positive and finite");
   if (!finite_positive(c.k_prior_sigma)) return bad("k_prior_sigma", "must be positive and finite");
   if (!finite_non_negative(c.gyro_sigma)) return bad("gyro_sigma", "must be >= 0 and finite");
+  if (!finite_non_negative(c.gyro_bias_sigma)) {
+    return bad("gyro_bias_sigma", "must be >= 0 and finite");
+  }
+  if (!finite_non_negative(c.gate_chi2)) return bad("gate_chi2", "must be >= 0 (0: no gate)");
+  if (c.gate_reinflate_after < 1) return bad("gate_reinflate_after", "must be >= 1");
   if (!finite_non_negative(c.disturbance_sigma)) {
     return bad("disturbance_sigma", "must be >= 0 and finite");
   }
@@ -146,6 +177,7 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
 void Identifier::configure(const IdentifierConfig& c) {
   c_ = c;
   n_ = static_cast<int>(std::lround(c.window_s / c.dt));
+  dist_factor_ = held_disturbance_factor(c.window_s, c.disturbance_corr_s);
   // Ticks of one joint step: linearisation, gain rows, apply, covariance rows, finish, strengths
   // and report. Smallest blocks that let the step end well before the next window closes.
   const auto ticks_for = [](int g, int r) {
@@ -176,10 +208,17 @@ void Identifier::reset() {
   p_j_ = c_.j_prior_sigma * c_.j_prior_sigma * Mat6::Identity();
   p_r_ = c_.r_prior_sigma * c_.r_prior_sigma * Mat3::Identity();
   p_k_ = c_.k_prior_sigma * c_.k_prior_sigma * Mat16::Identity();
+  b_.setZero();
+  p_b_ = c_.gyro_bias_sigma * c_.gyro_bias_sigma * Mat3::Identity();
+  bias_shift_.setZero();
+  bias_consider_pending_ = false;
+  gated_in_row_ = 0;
+  innovation_chi2_ = 0.0;
   p_all_.setZero();
   p_all_.topLeftCorner<6, 6>() = p_j_;
-  p_all_.block<3, 3>(6, 6) = p_r_;
-  p_all_.bottomRightCorner<kThrusters, kThrusters>() = p_k_;
+  p_all_.block<3, 3>(kIdR, kIdR) = p_r_;
+  p_all_.block<kThrusters, kThrusters>(kIdK, kIdK) = p_k_;
+  p_all_.block<3, 3>(kIdB, kIdB) = p_b_;
   reference_.fill(true);
   joint_ = JointStep{};
   anchor_ = AnchorStep{};
@@ -188,6 +227,7 @@ void Identifier::reset() {
   sample_ = -1;
   phase_ = Phase::kIdle;
   latched_noise_ = 1.0;
+  latched_r_ = Mat3::Identity();
   residual_cov_ = Mat3::Identity();
   exc_ = IdentifierExcitation{};
   obs_ = IdentifierObservability{};
@@ -236,7 +276,7 @@ void Identifier::reinflate_thruster(int i) {
   joint_.started = false;
   const double v = c_.k_prior_sigma * c_.k_prior_sigma;
   reinflate_block<kThrusters>(p_k_, i, 1, v);
-  reinflate_block<kIdParams>(p_all_, 9 + i, 1, v);
+  reinflate_block<kIdParams>(p_all_, kIdK + i, 1, v);
   reference_[i] = false;  // a changed thruster no longer defines the thrust scale
   ++counters_.reinflations;
 }
@@ -249,24 +289,65 @@ void Identifier::reinflate_all() {
   ++counters_.reinflations;
 }
 
+void Identifier::shift_rate_bias(const Vec3& delta) {
+  if (!delta.allFinite()) return;
+  bias_shift_ += delta;
+  if (phase_ == Phase::kIdle) apply_bias_changes();  // no step on a window with the old rate
+}
+
+void Identifier::consider_rate_bias(const Vec3& sigma) {
+  if (!sigma.allFinite() || (sigma.array() < 0.0).any()) return;
+  bias_consider_sigma_ = sigma;
+  bias_consider_pending_ = true;
+  if (phase_ == Phase::kIdle) apply_bias_changes();
+}
+
+void Identifier::apply_bias_changes() {
+  b_ -= bias_shift_;
+  bias_shift_.setZero();
+  if (bias_consider_pending_ && c_.mode == IdentifierMode::kJoint) {
+    bias_consider_pending_ = false;
+    b_.setZero();
+    p_all_.middleRows<3>(kIdB).setZero();
+    p_all_.middleCols<3>(kIdB).setZero();
+    for (int a = 0; a < 3; ++a) {
+      const double v = bias_consider_sigma_(a) * bias_consider_sigma_(a);
+      p_all_(kIdB + a, kIdB + a) = std::fmin(v, c_.gyro_bias_sigma * c_.gyro_bias_sigma);
+    }
+    p_b_ = p_all_.block<3, 3>(kIdB, kIdB);
+  }
+  est_.gyro_bias = b_;
+  est_.gyro_bias_sigma = p_b_.diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
 void Identifier::sync_blocks() {
   p_j_ = p_all_.topLeftCorner<6, 6>();
-  p_r_ = p_all_.block<3, 3>(6, 6);
-  p_k_ = p_all_.bottomRightCorner<kThrusters, kThrusters>();
+  p_r_ = p_all_.block<3, 3>(kIdR, kIdR);
+  p_k_ = p_all_.block<kThrusters, kThrusters>(kIdK, kIdK);
+  p_b_ = p_all_.block<3, 3>(kIdB, kIdB);
+}
+
+Mat3 Identifier::bias_jacobian() const {
+  // (I17): sum_i w_i dt [S(omega_i) J - S(J omega_i)] = S(m) J - S(J m), m = sum_i w_i dt omega_i.
+  const Mat3 j = inertia_matrix(a_);
+  return skew(latched_.m) * j - skew(j * latched_.m);
 }
 
 void Identifier::joint_gain() {
   // (I13): e(x) = A_J a - sum_i k_i [(p_i + r) x e_i] ∫ w F_i dt = noise, linearised at the
-  // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat)], one extended-RLS step on all 25 parameters.
+  // estimate: H = [A_J, S(F_hat), -Phi_k(r_hat), -G], one extended-RLS step on all 28
+  // parameters (with the rate bias b of I17).
   // The gain is formed over several ticks (joint_gain, then joint_gain_rows per block of rows),
   // the update applied on one (joint_apply) and the covariance updated over several
-  // (joint_covariance_step), so no tick carries more than a block of the 25-parameter step.
+  // (joint_covariance_step), so no tick carries more than a block of the 28-parameter step.
   joint_.pending = false;
   joint_.started = false;
   const Vec3 force = net_force_impulse();
   const Mat316 phi_k = strength_regressor();
   const Vec3 tau = phi_k * k_;
-  joint_.e0 = latched_.a_j * a_ - tau;
+  // (I17): the rate carries a bias b: e = A_J a - G(a) b - tau, G(a) b = [S(m) L(b) + S(b) L(m)] a.
+  const Mat3 g = bias_jacobian();
+  joint_.e0 = latched_.a_j * a_ - g * b_ - tau;
   exc_.inertia_motion = latched_.a_j.norm() * a_.norm() >= torque_threshold();
   exc_.inertia_scale = tau.norm() >= torque_threshold();
   exc_.offset = force.norm() >= c_.min_force_impulse;
@@ -277,9 +358,11 @@ void Identifier::joint_gain() {
   }
   if (!exc_.inertia_motion && !exc_.inertia_scale) return;
   Eigen::Matrix<double, 3, kIdParams> h;
-  h.leftCols<6>() = latched_.a_j;
-  h.middleCols<3>(6) = skew(force);
-  h.rightCols<kThrusters>() = -phi_k;
+  h.leftCols<6>() = latched_.a_j - skew(latched_.m) * inertia_regressor(b_) -
+                    skew(b_) * inertia_regressor(latched_.m);
+  h.middleCols<3>(kIdR) = skew(force);
+  h.middleCols<kThrusters>(kIdK) = -phi_k;
+  h.middleCols<3>(kIdB) = -g;
 
   // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
   VecId& d = joint_.d;
@@ -291,8 +374,9 @@ void Identifier::joint_gain() {
     d.segment<3>(6).setConstant(std::exp(0.5 * c_.window_s / c_.r_forget_s));
   }
   if (joint_.any_thruster && c_.k_forget_s > 0.0) {
-    d.tail<kThrusters>().setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
+    d.segment<kThrusters>(kIdK).setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
   }
+  joint_.second_order = c_.second_order_noise ? second_order_noise() : Mat3::Zero();
   // P_f H' = D P D H' without forming P_f, a block of rows per tick (joint_gain_rows).
   joint_.h = h;
   joint_.dht = d.asDiagonal() * h.transpose();
@@ -315,16 +399,34 @@ bool Identifier::joint_gain_rows() {
   }
   // Every row done: S and the gain on a tick of their own.
   joint_.started = false;
-  joint_.s = latched_noise_ * Mat3::Identity() + joint_.h.lazyProduct(joint_.p_ht);
+  joint_.s = latched_r_ + joint_.second_order + joint_.h.lazyProduct(joint_.p_ht);
   residual_cov_ = joint_.s;
   const Eigen::LDLT<Mat3> ldlt(joint_.s);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return true;
-  // K = P H' S^-1 with S^-1 from the 3x3 factorisation (a 25 x 3 times 3 x 3 product, no
-  // blocked triangular solve over 25 right-hand sides).
+  // K = P H' S^-1 with S^-1 from the 3x3 factorisation (a 28 x 3 times 3 x 3 product, no
+  // blocked triangular solve over 28 right-hand sides).
   const Mat3 s_inv = ldlt.solve(Mat3::Identity());
+  // (I18) innovation gate: a window the model cannot explain within S is refused, estimate and
+  // covariance untouched; too many in a row re-inflate J, r and k.
+  innovation_chi2_ = joint_.e0.dot(s_inv * joint_.e0);
+  if (c_.gate_chi2 > 0.0 && innovation_chi2_ > c_.gate_chi2) {
+    ++counters_.windows_gated;
+    if (++gated_in_row_ >= c_.gate_reinflate_after) {
+      gated_in_row_ = 0;
+      reinflate_block<kIdParams>(p_all_, kIdJ, 6, c_.j_prior_sigma * c_.j_prior_sigma);
+      reinflate_block<kIdParams>(p_all_, kIdR, 3, c_.r_prior_sigma * c_.r_prior_sigma);
+      reinflate_block<kIdParams>(p_all_, kIdK, kThrusters, c_.k_prior_sigma * c_.k_prior_sigma);
+      ++counters_.reinflations;
+      ++counters_.gate_reinflations;
+    }
+    return true;
+  }
+  gated_in_row_ = 0;
   joint_.k = joint_.p_ht.lazyProduct(s_inv);
   // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
-  if (!exc_.offset) joint_.k.middleRows<3>(6).setZero();
+  if (!exc_.offset) joint_.k.middleRows<3>(kIdR).setZero();
+  // (I17) b as a consider parameter: no gain, its covariance kept (Schmidt).
+  if (!c_.gyro_bias_estimated) joint_.k.middleRows<3>(kIdB).setZero();
   joint_.pending = true;
   return true;
 }
@@ -333,7 +435,7 @@ void Identifier::joint_apply() {
   if (!joint_.pending) return;
   joint_.pending = false;
   VecId x;
-  x << a_, r_, k_;
+  x << a_, r_, k_, b_;
   x -= joint_.k * joint_.e0;
   // Guards (I14): J positive definite and physical, r within bounds; else the update is refused
   // and the covariance left as it was.
@@ -346,7 +448,7 @@ void Identifier::joint_apply() {
     physical = m(0) > 0.0 && m(0) + m(1) >= m(2);
   }
   const bool r_ok =
-      x.segment<3>(6).allFinite() && (x.segment<3>(6) - c_.r0).norm() <= c_.r_max_offset;
+      x.segment<3>(kIdR).allFinite() && (x.segment<3>(kIdR) - c_.r0).norm() <= c_.r_max_offset;
   if (!physical || !r_ok) {
     if (!physical) ++counters_.inertia_refused;
     if (!r_ok) ++counters_.offset_refused;
@@ -358,8 +460,9 @@ void Identifier::joint_apply() {
   joint_.sym_rows = 0;
   joint_.rows_pending = true;
   a_ = x.head<6>();
-  r_ = x.segment<3>(6);
-  k_ = x.tail<kThrusters>();
+  r_ = x.segment<3>(kIdR);
+  k_ = x.segment<kThrusters>(kIdK);
+  b_ = x.segment<3>(kIdB);
   for (int i = 0; i < kThrusters; ++i) {
     const double clamped = std::fmin(std::fmax(k_(i), c_.k_min), c_.k_max);
     if (clamped != k_(i)) {
@@ -379,7 +482,7 @@ void Identifier::joint_covariance_rows(int first, int n) {
   for (int i = first; i < first + n; ++i) {
     Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
     row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
-    if (!exc_.offset) {
+    if (!exc_.offset || !c_.gyro_bias_estimated) {  // a gain with zeroed rows: the full form
       row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
       row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();
     }
@@ -428,10 +531,11 @@ void Identifier::joint_finish_covariance() {
     joint_.sym_rows = kIdParams;
   }
   // No variance above its prior (no wind-up while a direction is not excited).
-  const double caps[3] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
-                          c_.k_prior_sigma * c_.k_prior_sigma};
+  const double caps[4] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
+                          c_.k_prior_sigma * c_.k_prior_sigma,
+                          c_.gyro_bias_sigma * c_.gyro_bias_sigma};
   for (int i = 0; i < kIdParams; ++i) {
-    const double cap = caps[i < 6 ? 0 : (i < 9 ? 1 : 2)];
+    const double cap = caps[i < kIdR ? 0 : (i < kIdK ? 1 : (i < kIdB ? 2 : 3))];
     if (p_all_(i, i) > cap) {
       const double f = std::sqrt(cap / p_all_(i, i));
       p_all_.row(i) *= f;
@@ -449,7 +553,7 @@ void Identifier::anchor_scale() {
   double b = 0.0;
   for (int i = 0; i < kThrusters; ++i) {
     if (!reference_[i]) continue;
-    c(9 + i) = 1.0;
+    c(kIdK + i) = 1.0;
     b += c_.k0(i);
     ++n;
   }
@@ -461,12 +565,12 @@ void Identifier::anchor_scale() {
     // budget).
     VecId pc = VecId::Zero();
     for (int i = 0; i < kThrusters; ++i) {
-      if (reference_[i]) pc += p_all_.col(9 + i) * c(9 + i);
+      if (reference_[i]) pc += p_all_.col(kIdK + i) * c(kIdK + i);
     }
     const double cpc = c.dot(pc);
     if (!(cpc > 0.0)) return;
     VecId x;
-    x << a_, r_, k_;
+    x << a_, r_, k_, b_;
     x -= pc * ((c.dot(x) - b) / cpc);
     // P -= P c c'P / (c'P c), a block of rows per tick from the next tick on (anchor_rows).
     anchor_.pc = pc;
@@ -474,10 +578,11 @@ void Identifier::anchor_scale() {
     anchor_.rows = 0;
     anchor_.pending = true;
     a_ = x.head<6>();
-    r_ = x.segment<3>(6);
-    k_ = x.tail<kThrusters>();
+    r_ = x.segment<3>(kIdR);
+    k_ = x.segment<kThrusters>(kIdK);
+    b_ = x.segment<3>(kIdB);
   } else {
-    const Vec16 ck = c.tail<kThrusters>();
+    const Vec16 ck = c.segment<kThrusters>(kIdK);
     const Vec16 pc = p_k_ * ck;
     const double cpc = ck.dot(pc);
     if (!(cpc > 0.0)) return;
@@ -552,6 +657,9 @@ void Identifier::accumulate(const IdentifierInput& in) {
   acc_.a_j += alpha * l + wdt * (skew(in.omega) * l);
   acc_.sum_alpha2 += alpha * alpha;
   acc_.sum_gyro2 += wdt * wdt * in.omega.squaredNorm();
+  acc_.m += wdt * in.omega;                                    // (I17)
+  acc_.w2 += (wdt * wdt) * (in.omega * in.omega.transpose());  // (I19)
+  acc_.n += (alpha * wdt) * in.omega;
 }
 
 void Identifier::finish_step() {
@@ -576,6 +684,7 @@ void Identifier::update(const IdentifierInput& in, bool background) {
     finish_step();  // only when ticks were withheld from a window too short for the blocks
     latched_ = acc_;
     latched_noise_ = window_noise();
+    latched_r_ = window_noise_matrix();
     ++counters_.windows;
     phase_ = Phase::kInertia;
     // This sample also opens the next window (w = 0 here, so it only enters through alpha_0).
@@ -627,6 +736,9 @@ void Identifier::step_phase() {
       break;
     case Phase::kReport:
       if (c_.mode == IdentifierMode::kJoint) sync_blocks();
+      // The step used the rate as it was given in its window; a bias shift requested since
+      // applies from here on.
+      apply_bias_changes();
       report();
       phase_ = Phase::kIdle;
       break;
@@ -651,6 +763,78 @@ double Identifier::window_noise() const {
   const double dist = c_.disturbance_sigma * c_.disturbance_sigma * c_.disturbance_corr_s * t / 3.0;
   const double floor = c_.torque_floor * latched_.weight;
   return gyro + dist + floor * floor;
+}
+
+Mat3 Identifier::second_order_noise() const {
+  // (I20): e(x) is bilinear in (k, r) and in (a, b), so linearised at the estimate it leaves
+  //   e2 = dr x dF - G(da) db,   dF = sum_i dk_i I_i e_i,   G(da) db = sum_k db_k B_k da,
+  //   B_k = S(m) L(e_k) + S(e_k) L(m)   (I17),
+  // which the first-order step does not see. While dr, dk (or da, db) are large, early on and
+  // from the case-4 priors, it is much larger than the window noise; ignoring it makes the step
+  // overconfident and freezes the linearisation error in. Its covariance (the second-order
+  // filter's term, the errors taken as independent zero-mean Gaussians) joins S:
+  //   cov(dr x dF) = sum_kl Q_kl S(e_k) P_r S(e_l)',  Q = Phi_F P_k Phi_F',
+  //   cov(G(da) db) = sum_kl P_b,kl B_k P_a B_l'.
+  const Mat3 p_r = p_all_.block<3, 3>(kIdR, kIdR);
+  Mat316 phi_f;
+  for (int i = 0; i < kThrusters; ++i) phi_f.col(i) = latched_.impulse(i) * e_[i];
+  const Mat3 q = phi_f * p_all_.block<kThrusters, kThrusters>(kIdK, kIdK) * phi_f.transpose();
+  std::array<Mat3, 3> se;
+  for (int k = 0; k < 3; ++k) se[static_cast<std::size_t>(k)] = skew(Vec3::Unit(k));
+  Mat3 out = Mat3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const Mat3 sp = se[static_cast<std::size_t>(k)] * p_r;
+    for (int l = 0; l < 3; ++l) {
+      out.noalias() += q(k, l) * (sp * se[static_cast<std::size_t>(l)].transpose());
+    }
+  }
+  const Mat3 p_b = p_all_.block<3, 3>(kIdB, kIdB);
+  if (p_b.diagonal().maxCoeff() > 0.0) {
+    const Mat6 p_a = p_all_.topLeftCorner<6, 6>();
+    const Mat3 sm = skew(latched_.m);
+    const Mat36 lm = inertia_regressor(latched_.m);
+    std::array<Mat36, 3> bk;
+    for (int k = 0; k < 3; ++k) {
+      bk[static_cast<std::size_t>(k)] =
+          sm * inertia_regressor(Vec3::Unit(k)) + se[static_cast<std::size_t>(k)] * lm;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const Mat36 bp = bk[static_cast<std::size_t>(k)] * p_a;
+      for (int l = 0; l < 3; ++l) {
+        out.noalias() += p_b(k, l) * (bp * bk[static_cast<std::size_t>(l)].transpose());
+      }
+    }
+  }
+  return 0.5 * (out + out.transpose());
+}
+
+Mat3 Identifier::window_noise_matrix() const {
+  // (I19): the gyro's white noise eta_i enters the window equation through the sample's
+  // coefficient C_i = alpha_i J + w_i dt M(omega_i), M(v) = S(v) J - S(J v) (the Jacobian of
+  // v x J v), so its covariance is sigma^2 sum_i C_i C_i'. M is linear in omega, so the sum
+  // follows from three window moments: sum alpha^2, n = sum alpha w dt omega and
+  // W = sum (w dt)^2 omega omega':
+  //   sum C C' = (sum alpha^2) J J' + J M(n)' + M(n) J' + sum_kl W_kl M(e_k) M(e_l)'.
+  // Plus the disturbance and the floor of (I5), which act alike on every axis.
+  const Mat3 j = inertia_matrix(a_);
+  const auto m_of = [&j](const Vec3& v) -> Mat3 { return skew(v) * j - skew(j * v); };
+  std::array<Mat3, 3> me;
+  for (int k = 0; k < 3; ++k) me[static_cast<std::size_t>(k)] = m_of(Vec3::Unit(k));
+  const Mat3 mn = m_of(latched_.n);
+  Mat3 c = latched_.sum_alpha2 * (j * j.transpose()) + j * mn.transpose() + mn * j.transpose();
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) {
+      c.noalias() += latched_.w2(k, l) * (me[static_cast<std::size_t>(k)] *
+                                          me[static_cast<std::size_t>(l)].transpose());
+    }
+  }
+  const double g2 = c_.gyro_sigma * c_.gyro_sigma;
+  const double dist = c_.disturbance_sigma * c_.disturbance_sigma * dist_factor_;
+  const double floor = c_.torque_floor * latched_.weight;
+  Mat3 r = g2 * c;
+  r = 0.5 * (r + r.transpose()).eval();
+  r.diagonal().array() += dist + floor * floor;
+  return r;
 }
 
 Vec3 Identifier::model_torque_impulse(const Vec16& k, const Vec3& r) const {
@@ -708,7 +892,7 @@ void Identifier::update_inertia() {
   const double prior_var = c_.j_prior_sigma * c_.j_prior_sigma;
   if (exc_.inertia_scale) forget<6>(p_j_, c_.window_s, c_.j_forget_s, prior_var);
   // The other groups' uncertainty enters as measurement noise (I7).
-  const Mat3 r_noise = latched_noise_ * Mat3::Identity() + consider_offset() + consider_strengths();
+  const Mat3 r_noise = latched_r_ + consider_offset() + consider_strengths();
   residual_cov_ = r_noise + consider_inertia();
   rls_update<6>(a_, p_j_, latched_.a_j, y, r_noise);
   // Guard: positive definite, principal moments obey the triangle inequality.
@@ -744,8 +928,7 @@ void Identifier::update_offset() {
   const Mat3 phi = -skew(force);
   const Vec3 r_keep = r_;
   const Mat3 p_keep = p_r_;
-  const Mat3 r_noise =
-      latched_noise_ * Mat3::Identity() + consider_inertia() + consider_strengths();
+  const Mat3 r_noise = latched_r_ + consider_inertia() + consider_strengths();
   forget<3>(p_r_, c_.window_s, c_.r_forget_s, c_.r_prior_sigma * c_.r_prior_sigma);
   rls_update<3>(r_, p_r_, phi, y, r_noise);
   if (!r_.allFinite() || (r_ - c_.r0).norm() > c_.r_max_offset) {
@@ -767,7 +950,7 @@ void Identifier::update_strengths() {
   if (!any) return;
   const Mat316 phi = strength_regressor();
   const Vec3 y = latched_.a_j * a_;
-  const Mat3 r_noise = latched_noise_ * Mat3::Identity() + consider_inertia() + consider_offset();
+  const Mat3 r_noise = latched_r_ + consider_inertia() + consider_offset();
   forget<kThrusters>(p_k_, c_.window_s, c_.k_forget_s, c_.k_prior_sigma * c_.k_prior_sigma);
   rls_update<kThrusters>(k_, p_k_, phi, y, r_noise);
   for (int i = 0; i < kThrusters; ++i) {
@@ -789,6 +972,8 @@ void Identifier::report() {
   est_.r_sigma = p_r_.diagonal().cwiseMax(0.0).cwiseSqrt();
   est_.k = k_;
   est_.k_sigma = p_k_.diagonal().cwiseMax(0.0).cwiseSqrt();
+  est_.gyro_bias = b_;
+  est_.gyro_bias_sigma = p_b_.diagonal().cwiseMax(0.0).cwiseSqrt();
 
   // Observability (§I.3): directions still near their prior are reported, not estimated.
   const double ratio2 = c_.unobservable_ratio * c_.unobservable_ratio;
@@ -826,7 +1011,7 @@ void Identifier::report() {
 
   // Residual of the last window with the latest estimates (I12).
   if (latched_.weight > 0.0) {
-    const Vec3 res = latched_.a_j * a_ - model_torque_impulse(k_, r_);
+    const Vec3 res = latched_.a_j * a_ - bias_jacobian() * b_ - model_torque_impulse(k_, r_);
     est_.residual_torque = res / latched_.weight;
     // Against the window's innovation covariance before the update (joint: S; concurrent: the
     // inertia group's noise plus its own consider term).

@@ -39,11 +39,18 @@ Vec3 thruster_position(const RcsLayout& l, int i);
 
 // How the three groups are estimated (§I.5). kConcurrent: one RLS per group, each holding the
 // others at their latest estimates and counting their uncertainty as noise (Wilson, Lages & Mah
-// 2002). kJoint: the same window equation linearised in all 25 parameters at once (an extended
-// RLS), which keeps the cross-covariances the concurrent form drops.
+// 2002). kJoint: the same window equation linearised in all 28 parameters at once (J, r, k and
+// the rate bias, I17; an extended RLS), which keeps the cross-covariances the concurrent form
+// drops.
 enum class IdentifierMode : std::uint8_t { kConcurrent = 0, kJoint = 1 };
 
-inline constexpr int kIdParams = 6 + 3 + kThrusters;
+// Joint state [a (6); r (3); k (16); b (3)]: b is the bias of the rate the identifier is given
+// (I17). Index of each group's first parameter:
+inline constexpr int kIdJ = 0;
+inline constexpr int kIdR = 6;
+inline constexpr int kIdK = 9;
+inline constexpr int kIdB = 9 + kThrusters;
+inline constexpr int kIdParams = 6 + 3 + kThrusters + 3;
 using VecId = Eigen::Matrix<double, kIdParams, 1>;
 using MatId = Eigen::Matrix<double, kIdParams, kIdParams>;
 
@@ -62,6 +69,25 @@ struct IdentifierConfig {
   // Noise of the window equation (I5): gyro white noise per sample (rad/s), the external
   // disturbance (N m per axis, held for disturbance_corr_s), and a floor (N m).
   double gyro_sigma{0.0};
+  // Bias of the given rate, 1 sigma per axis (rad/s; the gyro's data sheet). kJoint estimates it
+  // as three more parameters (I17): a bias b in omega puts -G b into the window equation, G the
+  // gyroscopic term's Jacobian. 0: the rate is taken as unbiased (b held at zero).
+  double gyro_bias_sigma{0.0};
+  // true: b is estimated with the others; false: b is a consider parameter (Schmidt): its
+  // uncertainty and cross-covariances are carried, so J, r and k are as uncertain as the bias
+  // makes them, but b-hat stays at zero (the rate as given) and the linearisation point with it.
+  bool gyro_bias_estimated{false};
+  // Innovation gate (I18, kJoint): a window whose residual e0' S^-1 e0 exceeds gate_chi2 does
+  // not fit the model with the confidence the covariance claims (an unmodelled fault, a model
+  // change); it is refused and counted, estimate and covariance untouched. After
+  // gate_reinflate_after refused windows in a row the model is declared changed: J, r and k go
+  // back to their prior covariance (re-inflation), so the data are fitted again honestly.
+  // 0: no gate.
+  double gate_chi2{0.0};
+  // (I20) the second-order term of the bilinear products joins the innovation covariance
+  // (consistency from far priors; slower to become confident while r and k are both uncertain).
+  bool second_order_noise{false};
+  int gate_reinflate_after{3};
   double disturbance_sigma{0.57735026918962576};
   double disturbance_corr_s{10.0};
   double torque_floor{0.1};
@@ -109,6 +135,11 @@ struct IdentifierConfigCheck {
 // The first bad field and why, or ok.
 IdentifierConfigCheck validate(const IdentifierConfig& c);
 
+// (I21) Variance of ∫ w d dt per unit disturbance variance, w the triangular window of length
+// window_s, d held for hold_s with a random phase (autocorrelation 1 - |u| / hold_s):
+// 2 ∫_0^hold (1 - u / hold) R_w(u) du, R_w the window's autocorrelation.
+double held_disturbance_factor(double window_s, double hold_s);
+
 struct IdentifierInput {
   Vec3 omega{Vec3::Zero()};  // body rate at this tick, rad/s (gyro or estimate)
   bool omega_valid{false};
@@ -146,6 +177,8 @@ struct IdentifierCounters {
   std::uint32_t offset_refused{0};
   std::uint32_t strength_clamped{0};
   std::uint32_t reinflations{0};
+  std::uint32_t windows_gated{0};      // refused by the innovation gate (I18)
+  std::uint32_t gate_reinflations{0};  // ... re-inflations after too many in a row
 };
 
 struct IdentifierEstimate {
@@ -155,6 +188,8 @@ struct IdentifierEstimate {
   Vec3 r_sigma{Vec3::Zero()};
   Vec16 k{Vec16::Ones()};
   Vec16 k_sigma{Vec16::Zero()};
+  Vec3 gyro_bias{Vec3::Zero()};  // bias of the given rate (I17), rad/s
+  Vec3 gyro_bias_sigma{Vec3::Zero()};
   bool inertia_confident{false};
   bool offset_confident{false};  // every observable direction within r_confident
   std::array<bool, kThrusters> thruster_confident{};
@@ -182,6 +217,15 @@ class Identifier {
   void reinflate_offset();
   void reinflate_thruster(int i);
   void reinflate_all();
+  // The rate given from the next window on has `delta` subtracted beyond what was subtracted so
+  // far (e.g. a new gyro-bias estimate from the attitude filter): the bias state follows,
+  // b <- b - delta, once the step of the window already closed (which used the old rate) is done.
+  void shift_rate_bias(const Vec3& delta);
+  // With b a consider parameter (gyro_bias_estimated false): the rate given from the next window
+  // on has been corrected by a bias estimate whose error has this 1 sigma per axis (e.g. the
+  // attitude filter's); b's covariance becomes diag(sigma^2), its mean zero and its cross terms
+  // cleared (a fresh consider parameter), once the closed window's step is done.
+  void consider_rate_bias(const Vec3& sigma);
 
   const IdentifierEstimate& estimate() const { return est_; }
   const IdentifierExcitation& excitation() const { return exc_; }
@@ -190,6 +234,7 @@ class Identifier {
   const Mat6& inertia_covariance() const { return p_j_; }
   const Mat3& offset_covariance() const { return p_r_; }
   const Mat16& strength_covariance() const { return p_k_; }
+  const Mat3& bias_covariance() const { return p_b_; }
 
  private:
   // The data of one window, latched at its end.
@@ -199,6 +244,9 @@ class Identifier {
     double weight{0.0};            // ∫ w dt, s
     double sum_alpha2{0.0};        // sum of the per-sample weights on L(omega), squared (I5)
     double sum_gyro2{0.0};         // sum of (w dt |omega|)^2 (I5)
+    Vec3 m{Vec3::Zero()};          // sum of w dt omega: G = S(m) J - S(J m) (I17)
+    Mat3 w2{Mat3::Zero()};         // sum of (w dt)^2 omega omega' (I19)
+    Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
   };
   enum class Phase : std::uint8_t {
     kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport
@@ -208,18 +256,21 @@ class Identifier {
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
   double sample_weight(int i) const;  // w(t_i)
   double window_noise() const;        // row variance of the latched window (I5)
+  Mat3 window_noise_matrix() const;   // covariance of the latched window's equation (I19)
   double torque_threshold() const;    // (I16)
   Vec3 model_torque_impulse(const Vec16& k, const Vec3& r) const;  // ∫ w tau dt (I6)
   Vec3 net_force_impulse() const;     // sum k_i e_i ∫ w F_i dt with k_hat
+  Mat3 bias_jacobian() const;         // G(J_hat) of (I17)
+  Mat3 second_order_noise() const;    // (I20)
   Mat316 strength_regressor() const;  // (I11) with r_hat
   Mat3 consider_inertia() const;      // (I7)
   Mat3 consider_offset() const;
   Mat3 consider_strengths() const;
-  void joint_gain();         // (I13) gain of the joint step: the linearisation
-  bool joint_gain_rows();    // ... a block of rows of P H'; then S and K (true when done)
+  void joint_gain();       // (I13) gain of the joint step: the linearisation
+  bool joint_gain_rows();  // ... a block of rows of P H'; then S and K (true when done)
   void joint_apply();
   void joint_covariance_rows(int first, int n);  // rows [first, first + n) of the P update
-  bool joint_covariance_step();    // a block of rows of the P update (true when all are done)
+  bool joint_covariance_step();  // a block of rows of the P update (true when all are done)
   void symmetrise_rows(int first, int n);
   void joint_finish_covariance();  // the remaining rows, symmetrise, cap        // (I13), (I14)
                                    // apply it, guarded
@@ -247,6 +298,13 @@ class Identifier {
   Mat3 p_r_{Mat3::Identity()};
   Vec16 k_{Vec16::Ones()};
   Mat16 p_k_{Mat16::Identity()};
+  Vec3 b_{Vec3::Zero()};
+  Mat3 p_b_{Mat3::Zero()};
+  Vec3 bias_shift_{Vec3::Zero()};           // shift_rate_bias not yet applied (a step is running)
+  Vec3 bias_consider_sigma_{Vec3::Zero()};  // consider_rate_bias not yet applied
+  bool bias_consider_pending_{false};
+  void apply_bias_changes();
+  int gated_in_row_{0};
   MatId p_all_{MatId::Identity()};            // kJoint: [a; r; k]
   std::array<bool, kThrusters> reference_{};  // thrusters that define the thrust scale
   // The joint step is spread over ticks in row blocks (the Cortex-M7 tick budget): rows of P H'
@@ -269,6 +327,7 @@ class Identifier {
     VecId d{VecId::Ones()};
     Vec3 e0{Vec3::Zero()};
     Mat3 s{Mat3::Identity()};
+    Mat3 second_order{Mat3::Zero()};  // (I20) the bilinear terms' covariance
     Eigen::Matrix<double, kIdParams, 3> p_ht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
     Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
   };
@@ -289,7 +348,10 @@ class Identifier {
   Vec8 last_force_{Vec8::Zero()};
   Phase phase_{Phase::kIdle};
   double latched_noise_{1.0};
+  double dist_factor_{0.0};  // (I21) var(∫ w d dt) / sigma_d^2 for the held disturbance
+  Mat3 latched_r_{Mat3::Identity()};
   Mat3 residual_cov_{Mat3::Identity()};  // innovation covariance of the latched window
+  double innovation_chi2_{0.0};          // e0' S^-1 e0 of the latched window (I18)
 
   IdentifierEstimate est_{};
   IdentifierExcitation exc_{};
@@ -309,6 +371,10 @@ struct IdentificationParams {
   bool enabled{false};  // run the identifier in the tick
   ModelAdoption adopt{ModelAdoption::kOff};
   double adopt_interval_s{300.0};  // s, at least this long between two automatic adoptions
+  // With the MEKF, the 1 sigma of the bias left in the corrected rate is the MEKF's bias sigma,
+  // but never below this (rad/s): the MEKF's bias sigma at convergence understates its error,
+  // and the identifier takes the residual bias afresh each window (README I17).
+  double mekf_bias_sigma_floor{3e-6};
   // The identifier's tuning. Its dt, thruster geometry and priors (j0, r0, k0) are not read from
   // here: they are the active table's dt, rcs and mass_hat, filled in by build_identifier_config.
   IdentifierConfig config{};

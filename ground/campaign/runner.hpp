@@ -35,7 +35,7 @@ struct TimeRow {
   gnc::Mode mode{gnc::Mode::kIdle};
 };
 
-// Identification against the truth at one instant (the marks: 60, 300, 1000, 3000 s).
+// Identification against the truth at one instant (the marks: 60, 300, 600, 1000, 3000 s).
 struct IdentificationMark {
   double t_s{0.0};
   bool reached{false};   // the run lasted that long with the identifier on

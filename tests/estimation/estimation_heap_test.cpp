@@ -68,5 +68,47 @@ TEST(EstimationHeap, IdentifierUpdatesAllocateNothingInEveryPhase) {
   }
 }
 
+// The flight's settings (I17-I21): the rate bias carried (considered and estimated), the
+// second-order term, the innovation gate (forced to refuse and re-inflate by a tiny threshold), and
+// the bias corrections from upstream.
+TEST(EstimationHeap, IdentifierWithBiasGateAndSecondOrderTermAllocatesNothing) {
+  for (bool estimated : {false, true}) {
+    for (double gate : {16.27, 1e-9}) {
+      IdentifierConfig c;
+      c.rcs = study_rcs_layout(200.0);
+      c.j0 = total_inertia(study_true_mass_properties());
+      c.window_s = 2.0;
+      c.gyro_sigma = 1e-5;
+      c.gyro_bias_sigma = 3e-5;
+      c.gyro_bias_estimated = estimated;
+      c.second_order_noise = true;
+      c.gate_chi2 = gate;
+      Identifier id;
+      id.configure(c);
+      IdentifierInput in;
+      in.omega_valid = true;
+      long counted = -1;
+      {
+        Armed armed;
+        for (int k = 0; k < 400; ++k) {
+          in.omega = Vec3(0.01, 0.02, 0.03) + 1e-5 * k * Vec3(1, -1, 0.5);
+          for (int ch = 0; ch < kChannels; ++ch) in.force(ch) = 150.0 * std::sin(0.1 * k + ch);
+          if (k % 20 == 1) {
+            id.shift_rate_bias(Vec3(1e-7, 0.0, -1e-7));
+            id.consider_rate_bias(Vec3(2e-6, 2e-6, 2e-6));
+          }
+          id.update(in);
+        }
+        counted = rocksteady::test::heap_allocations();
+      }
+      EXPECT_EQ(counted, 0);
+      EXPECT_GT(id.counters().windows, 15u);
+      if (gate < 1.0) {
+        EXPECT_GT(id.counters().gate_reinflations, 0u);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rocksteady::gnc

@@ -43,14 +43,18 @@ Vec3 dpd(const Vec3& omega, const Vec4& beta, bool& pd) {
 }
 
 struct Errors {
-  double j, r, k, j_sigma_rel, r_sigma;
+  double j, r, k, j_sigma_rel, r_sigma, nees_j, nees_r;
 };
 
+// window_s <= 0: the flight's window for the case (gnc.yaml, quiet or noisy sensors).
+// gyro_bias > 0: the plant's gyro gets a constant bias of that norm.
 void identification(const std::string& dir, int case_number, gnc::IdentifierMode mode,
-                    double window_s, double k_prior_sigma) {
-  const config::RunSetup run =
+                    double window_s, double k_prior_sigma, double gyro_bias = 0.0) {
+  config::RunSetup run =
       config::load_run(dir + "/mission.yaml", dir + "/gnc.yaml",
                        dir + "/cases/case" + std::to_string(case_number) + ".yaml");
+  run.truth.sensors.gyro_bias = Vec3(1.0, -0.5, 0.3).normalized() * gyro_bias;
+  if (window_s <= 0.0) window_s = run.flight.identification.config.window_s;
   plant::Plant plant(run.truth);
   const Mat3 j_true = plant.inertia();
   const Vec3 r_true = run.truth.mass.r_so_bcm;
@@ -67,6 +71,11 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
   c.r_prior_sigma = 1.0;
   c.k_prior_sigma = k_prior_sigma;
   c.gyro_sigma = std::sqrt(run.truth.sensors.gyro_psd / run.truth.sensors.period_s);
+  // The flight's bias prior and innovation gate (gnc.yaml, README I17/I18).
+  c.gyro_bias_sigma = run.flight.identification.config.gyro_bias_sigma;
+  c.gate_chi2 = run.flight.identification.config.gate_chi2;
+  c.second_order_noise = run.flight.identification.config.second_order_noise;
+  c.gate_reinflate_after = run.flight.identification.config.gate_reinflate_after;
   const gnc::IdentifierConfigCheck check = gnc::validate(c);
   if (!check.ok) {
     std::printf("bad identifier config: %s: %s\n", check.field, check.reason);
@@ -76,8 +85,9 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
   id.configure(c);
   Vec8 previous = Vec8::Zero();
   bool pd = false;
-  const double marks[] = {60.0, 300.0, 1000.0, 3000.0};
-  Errors e[4];
+  const double marks[] = {60.0, 300.0, 600.0, 1000.0, 3000.0};
+  constexpr int kMarks = 5;
+  Errors e[kMarks];
   int m = 0;
   const int ticks = static_cast<int>(std::lround(3000.0 / c.dt));
   for (int k = 0; k <= ticks; ++k) {
@@ -88,28 +98,32 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
     in.force = previous;
     id.update(in);
     const double t = k * c.dt;
-    if (m < 4 && t >= marks[m] - 1e-9) {
+    if (m < kMarks && t >= marks[m] - 1e-9) {
       const gnc::IdentifierEstimate& est = id.estimate();
       e[m].j = (est.j - j_true).norm() / j_true.norm();
       e[m].r = (est.r - r_true).norm();
       e[m].k = (est.k - run.truth.thruster_strength).cwiseAbs().maxCoeff();
       e[m].j_sigma_rel = est.j_sigma.norm() / j_true.norm();
       e[m].r_sigma = est.r_sigma.norm();
+      const gnc::Vec6 da = gnc::inertia_params(est.j) - gnc::inertia_params(j_true);
+      const Vec3 dr = est.r - r_true;
+      e[m].nees_j = da.dot(id.inertia_covariance().ldlt().solve(da));
+      e[m].nees_r = dr.dot(id.offset_covariance().ldlt().solve(dr));
       ++m;
     }
     const Vec8 u = allocate(b_hat, dpd(s.gyro.rate, s.star.quat, pd), run.flight.rcs.u_max);
     plant.advance(u, true);
     previous = plant.applied_force();
   }
-  std::printf("case %d %-10s T=%2.0f s k0 1s %.2f |", case_number,
-              mode == gnc::IdentifierMode::kJoint ? "joint" : "concurrent", window_s,
-              k_prior_sigma);
-  for (int i = 0; i < 4; ++i) {
-    std::printf(" %5.0fs: J %.2e (1s %.1e) r %.3f m (1s %.3f) k %.3f |", marks[i], e[i].j,
-                e[i].j_sigma_rel, e[i].r, e[i].r_sigma, e[i].k);
+  std::printf("case %d %-10s T=%2.0f s k0 1s %.2f bias %.0e |", case_number,
+              mode == gnc::IdentifierMode::kJoint ? "joint" : "concurrent", window_s, k_prior_sigma,
+              gyro_bias);
+  for (int i = 0; i < kMarks; ++i) {
+    std::printf(" %5.0fs: J %.2e (1s %.1e) r %.3f m (1s %.3f) k %.3f NEES %.1f/%.1f |", marks[i],
+                e[i].j, e[i].j_sigma_rel, e[i].r, e[i].r_sigma, e[i].k, e[i].nees_j, e[i].nees_r);
   }
-  std::printf(" r unobs %d, refused %u\n", id.observability().offset_unobservable,
-              id.counters().inertia_refused);
+  std::printf(" r unobs %d, refused %u, gated %u\n", id.observability().offset_unobservable,
+              id.counters().inertia_refused, id.counters().windows_gated);
 }
 
 void hold(const std::string& dir, int case_number, double gyro_bias, double bias_rw) {
@@ -167,7 +181,8 @@ void hold(const std::string& dir, int case_number, double gyro_bias, double bias
     }
     plant.advance(Vec8::Zero(), false);
   }
-  const double analytic = test::farrenkopf_post_update_sigma(mc.gyro_arw, mc.gyro_bias_rw, mc.star_sigma, mc.dt);
+  const double analytic =
+      test::farrenkopf_post_update_sigma(mc.gyro_arw, mc.gyro_bias_rw, mc.star_sigma, mc.dt);
   std::printf(
       "case %d HOLD bias %.1e rw %.1e | MEKF attitude sigma %.3e rad (max %.2e), Farrenkopf %.3e "
       "(ratio %.3f); rate RMS %.2e rad/s | SPEC 6 filter attitude sigma %.3e, rate RMS %.2e | bias "
@@ -186,12 +201,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
+  for (int cs = 1; cs <= 7; ++cs) {
+    identification(dir, cs, gnc::IdentifierMode::kJoint, 0.0, 0.01);  // the flight's window
+  }
   for (int cs : {1, 4, 5, 7}) {
     identification(dir, cs, gnc::IdentifierMode::kJoint, 20.0, 0.05);
     identification(dir, cs, gnc::IdentifierMode::kJoint, 20.0, 0.01);
     identification(dir, cs, gnc::IdentifierMode::kJoint, 60.0, 0.01);
     identification(dir, cs, gnc::IdentifierMode::kConcurrent, 20.0, 0.01);
   }
+  for (int cs : {5, 7}) identification(dir, cs, gnc::IdentifierMode::kJoint, 0.0, 0.01, 5e-5);
   for (int cs : {5, 6, 7}) hold(dir, cs, 0.0, 0.0);
   hold(dir, 5, 5e-5, 0.0);
   hold(dir, 5, 5e-5, 1e-9);

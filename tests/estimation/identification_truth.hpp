@@ -52,7 +52,9 @@ struct TruthSetup {
   double dt{0.1};
   double disturbance_sigma{0.0};  // N m per axis, held disturbance_hold_s
   double disturbance_hold_s{10.0};
-  double gyro_sigma{0.0};  // rad/s per sample
+  double disturbance_phase_s{0.0};  // first change of the held disturbance after this
+  double gyro_sigma{0.0};           // rad/s per sample
+  V3 gyro_bias{V3::Zero()};         // rad/s, constant, added to every gyro sample
   unsigned long long seed{1};
 };
 
@@ -70,16 +72,18 @@ class TruthRun {
     V8 previous = V8::Zero();
     V3 dist = V3::Zero();
     double next_draw = 0.0;
+    const double first_change = s_.disturbance_phase_s;
     for (int k = 0; k <= ticks; ++k) {
       const double t = k * s_.dt;
-      V3 meas = body_.omega;
+      V3 meas = body_.omega + s_.gyro_bias;
       for (int a = 0; a < 3; ++a) meas(a) += s_.gyro_sigma * normal_(rng_);
       each(t, meas, previous);
       if (k == ticks) break;
       const V8 u = command(t, meas);
       if (t >= next_draw - 1e-9) {
         for (int a = 0; a < 3; ++a) dist(a) = s_.disturbance_sigma * normal_(rng_);
-        next_draw += s_.disturbance_hold_s;
+        next_draw = (next_draw == 0.0 && first_change > 0.0) ? first_change
+                                                             : next_draw + s_.disturbance_hold_s;
       }
       body_.step(s_.dt, rcs_.torque(u, s_.r, k_now_) + dist);
       previous = u;
