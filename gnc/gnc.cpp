@@ -393,7 +393,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
     ident_.update(in, !fdi_busy);
+    bool window_latched = false;
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
+      window_latched = true;
       candidate_windows_ = ident_.counters().windows;
       candidate_status_ = model_candidate(candidate_);
       if (mekf) {
@@ -411,8 +413,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       fault_model_stale_ = true;
     }
     // The detector predicts with the latest identified model; one that arrives while a closed
-    // window is evaluated is held by the detector until the evaluation ends (F10).
-    if (fault_model_stale_ && !fdi_busy) {
+    // window is evaluated is held by the detector until the evaluation ends (F10). The refresh
+    // (a 3x3 inverse and eigenvalues, 16 columns) waits for a tick that neither latches the
+    // identifier's window nor carries a heavy step of the detector.
+    if (fault_model_stale_ && !fdi_busy && !window_latched) {
       refresh_fault_model();
       fault_model_stale_ = false;
     }

@@ -332,7 +332,7 @@ class Identifier {
     Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
   };
   JointStep joint_{};
-  static constexpr int kAnchorRowsPerTick = 9;
+  static constexpr int kAnchorRowsPerTick = 7;
   struct AnchorStep {  // the thrust-scale anchor's covariance term, a block of rows per tick
     bool pending{false};
     int rows{0};
