@@ -38,6 +38,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   last_valve_ = valve_open_;
   isolation_inhibited_ = false;
   reduced_reported_ = false;
+  release_fault_model();
   refresh_fault_model();
   modes_.reset(params.mode.initial);
   laws_.reset_state();
@@ -107,6 +108,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
     candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
     ident_.reinflate_all();
   }
+  release_fault_model();
   refresh_fault_model();
   if (!target_changed) refs_.set_target(target);  // keep a ground-commanded target
   return c;
@@ -133,7 +135,34 @@ void Gnc::refresh_fault_model() {
     m.r_cov = Mat3::Identity() * (rs * rs);
     m.k_sigma = params_.identification.config.k_prior_sigma;
   }
+  // (F12) The identifier's innovation gate (I18) re-inflates J, r and k when its windows no
+  // longer fit the model: the data changed, which is what the detector isolates. Taking the
+  // re-inflated covariance would blind the detector (its noise (F5) grows a hundredfold) while
+  // the identifier re-converges with the fault absorbed. The detector keeps the model it had
+  // until the identifier is again at least as certain in J, r and k; a confirmation (which
+  // re-inflates on purpose) or a new table releases it.
+  if (params_.identification.enabled) {
+    const std::uint32_t gr = ident_.counters().gate_reinflations;
+    if (gr != gate_reinflations_seen_) {
+      gate_reinflations_seen_ = gr;
+      fault_model_held_ = params_.fdi.enabled;
+    }
+    if (fault_model_held_) {
+      const FaultModel& h = fault_model_given_;
+      const bool as_certain = m.j_rel_sigma <= h.j_rel_sigma &&
+                              m.r_cov.diagonal().maxCoeff() <= h.r_cov.diagonal().maxCoeff() &&
+                              m.k_sigma <= h.k_sigma;
+      if (!as_certain) return;
+      fault_model_held_ = false;
+    }
+  }
+  fault_model_given_ = m;
   fdi_.set_model(m);
+}
+
+void Gnc::release_fault_model() {
+  fault_model_held_ = false;
+  gate_reinflations_seen_ = params_.identification.enabled ? ident_.counters().gate_reinflations : 0;
 }
 
 void Gnc::apply_fault_overrides(const GncCommands& commands, ModeEvents& events) {
@@ -215,6 +244,7 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
     // the detector insensitive until the model is re-identified (no cascade of confirmations).
     if (params_.identification.enabled) {
       ident_.reinflate_all();
+      release_fault_model();
       refresh_fault_model();
     }
     const int pod = params_.rcs.channel_pod[fe.thruster / 2];

@@ -73,6 +73,7 @@ class Gnc {
   void adopt_model(double t, ModeEvents& events);  // automatic policy, at the tick boundary
   void fill_estimation_telemetry(GncTelemetry& tl) const;
   void refresh_fault_model();
+  void release_fault_model();  // (F12) the detector takes the identifier's next model
   void apply_fault_overrides(const GncCommands& commands, ModeEvents& events);
   void detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events);
   AllocatorLimits allocation_limits() const;
@@ -107,6 +108,11 @@ class Gnc {
   ModelCandidate candidate_status_{ModelCandidate::kDisabled};
   std::uint32_t candidate_windows_{0};
   bool fault_model_stale_{false};  // a window closed: refresh the detector's model
+  // (gnc/fdi/README.md (F12)) The model last given to the detector, and the one it keeps while
+  // the identifier re-converges after its innovation gate re-inflated J, r and k (I18).
+  FaultModel fault_model_given_{};
+  bool fault_model_held_{false};
+  std::uint32_t gate_reinflations_seen_{0};
   GncParams candidate_{};  // scratch for the automatic adoption (too large for a tick's stack)
 };
 

@@ -47,7 +47,7 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
     }
   }
   st_ = FaultDetectorStatus{};
-  score_.fill(0.0);
+  reset_scores();
   suspecting_ = false;  // before set_model: nothing suspected, the model is taken (F7)
   FaultModel m;
   m.j = Mat3::Identity();
@@ -55,6 +55,12 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
   reset();
 }
 
+
+void FaultDetector::reset_scores() {
+  score_.fill(0.0);
+  pool_llr_.fill(0.0);
+  pool_energy_.fill(0.0);
+}
 
 void FaultDetector::reset_episode() {
   lambda_.fill(0.0);
@@ -76,7 +82,7 @@ void FaultDetector::reset() {
   have_start_ = false;
   n_ = 0;
   cancel_evaluation();
-  score_.fill(0.0);
+  reset_scores();
   suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
@@ -130,7 +136,7 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   if (kind == FaultKind::kStuckOn) st_.confirmed_on |= bit;
   if (kind == FaultKind::kStuckOff) st_.confirmed_off |= bit;
   cancel_evaluation();  // that window was scored without the fault in the model
-  score_.fill(0.0);
+  reset_scores();
   suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
@@ -147,7 +153,7 @@ void FaultDetector::clear(int thruster) {
     st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
   }
   cancel_evaluation();
-  score_.fill(0.0);
+  reset_scores();
   suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
@@ -380,6 +386,8 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     const bool latched = (((st_.confirmed_on | st_.confirmed_off) >> thruster) & 1u) != 0;
     if (latched) {
       score_[k] = 0.0;
+      pool_llr_[k] = 0.0;
+      pool_energy_[k] = 0.0;
       continue;
     }
     const Vec3& b = b_[k % static_cast<std::size_t>(kThrusters)];
@@ -392,8 +400,19 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     const double llr = (sr - 0.5 * ss) / var;
     lambda_[k] += llr;
     info_[k] += cc / var;
-    if (ss / var >= p_.min_signature) {  // else not observable in this window: no evidence
+    const double energy = ss / var;
+    if (energy >= p_.min_signature) {  // observable in this window alone
       score_[k] = std::fmax(0.0, score_[k] + llr);
+    } else if (energy > 0.0) {
+      // (F11) Too weak alone (a jet commanded at a few percent of u_max): pooled with the
+      // hypothesis's other weak windows until the pool is as observable as one strong window.
+      pool_llr_[k] += llr;
+      pool_energy_[k] += energy;
+      if (pool_energy_[k] >= p_.min_signature) {
+        score_[k] = std::fmax(0.0, score_[k] + pool_llr_[k]);
+        pool_llr_[k] = 0.0;
+        pool_energy_[k] = 0.0;
+      }
     }
   }
 }
@@ -478,7 +497,8 @@ void FaultDetector::decide() {
     return;
   }
   // (F6) clearly ahead of the runner-up, and (F8) of every alternative beyond the model's error.
-  const int blocking = best_s - second > p_.margin_llr ? blocking_alternative(best) : runner_up;
+  int blocking = best_s - second > p_.margin_llr ? blocking_alternative(best) : runner_up;
+  if (blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
   if (blocking < 0) {
     const int thruster = best % kThrusters;
     const FaultKind kind = best < kThrusters ? FaultKind::kStuckOn : FaultKind::kStuckOff;
@@ -526,6 +546,32 @@ double FaultDetector::cross(int h, int g) const {
   const double ah = h < kThrusters ? u_max_ : 0.0;
   const double ag = g < kThrusters ? u_max_ : 0.0;
   return ah * ag * at(ph, pg) + ah * at(ph, ig) + ag * at(ih, pg) + at(ih, ig);
+}
+
+double FaultDetector::partial_loss_llr(int g) const {
+  // (F13) The episode's LLR of "thruster g lost a fraction a of its thrust", a in (0, 1] fitted:
+  // with SR = sum S~.r~ / var = Lambda + E / 2 and E = sum |S~|^2 / var = |b|^2 A, the maximum
+  // over a of a SR - a^2 E / 2 is SR^2 / (2 E) for SR < E, and Lambda (a = 1) beyond.
+  const auto k = static_cast<std::size_t>(g);
+  const double e = b_[k % static_cast<std::size_t>(kThrusters)].squaredNorm() * info_[k];
+  const double sr = lambda_[k] + 0.5 * e;
+  if (sr <= 0.0 || e <= 0.0) return 0.0;
+  return sr >= e ? lambda_[k] : sr * sr / (2.0 * e);
+}
+
+int FaultDetector::partial_loss_alternative(int h) const {
+  // (F13) A stuck-off leader must beat, by margin_llr, a partial loss of thrust of every other
+  // jet (a degraded jet explains its residual exactly with its own a < 1, and only that much of
+  // a smaller, nearly parallel signature of another jet), and its own amplitude must be that of
+  // a jet that produces nothing: its fitted a < 1 may not gain margin_llr over a = 1.
+  const double lh = lambda_[static_cast<std::size_t>(h)];
+  if (partial_loss_llr(h) - lh > p_.margin_llr) return h;
+  for (int g = kThrusters; g < kHypotheses; ++g) {
+    if (g == h) continue;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> (g - kThrusters)) & 1u) != 0) continue;
+    if (lh - partial_loss_llr(g) <= p_.margin_llr) return g;
+  }
+  return -1;
 }
 
 int FaultDetector::blocking_alternative(int h) const {

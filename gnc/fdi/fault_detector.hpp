@@ -153,6 +153,10 @@ class FaultDetector {
   // The alternative that the leader h cannot yet be told from under (F6)/(F8), or -1 (exposed to
   // close_window only).
   int blocking_alternative(int h) const;
+  // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
+  // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.
+  int partial_loss_alternative(int h) const;
+  double partial_loss_llr(int g) const;
 
   FaultDetectorParams p_{};
   double u_max_{200.0};
@@ -229,6 +233,12 @@ class FaultDetector {
   std::array<Vec3, kThrusters> b_{};
 
   std::array<double, kHypotheses> score_{};
+  // (F11) Windows in which a hypothesis's signature was too weak to score on its own are pooled:
+  // their LLRs and signature energies add up until the pooled energy reaches min_signature, and
+  // the pool is then scored as one window.
+  std::array<double, kHypotheses> pool_llr_{};
+  std::array<double, kHypotheses> pool_energy_{};
+  void reset_scores();
   bool suspecting_{false};  // some score above half the confirmation level (F7)
   int runner_up_{-1};       // the runner-up of the last scored window
   // (F8) Since the current episode began (the last window with every score at zero): the

@@ -117,6 +117,52 @@ TEST(GncIdentification, AutomaticPolicyAdoptsTheIdentifiedModelAtABoundaryWithAn
   EXPECT_EQ(loop.out.telemetry.est.candidate, ModelCandidate::kUnchanged);
 }
 
+// gnc/fdi/README.md (F12): when the identifier's innovation gate (I18) re-inflates J, r and k
+// because its windows stopped fitting (here a channel dies: its column of the true B goes to
+// zero), the fault detector keeps the model it had. Its residual noise (F5) stays where it was,
+// instead of growing with the re-inflated covariance while the identifier re-converges.
+TEST(GncIdentification, AGateReinflationLeavesTheFaultDetectorItsModel) {
+  GncParams p = identifying_params(ModelAdoption::kOff);
+  p.identification.config.gate_chi2 = 16.27;
+  p.identification.config.gate_reinflate_after = 3;
+  p.fdi.enabled = true;
+  p.fdi.window_ticks = 20;
+  p.fdi.gyro_sigma = 1e-7;
+  p.fdi.disturbance_sigma = 1e-4;
+  p.fdi.auto_isolate = false;
+  p.fdi.confirm_llr = 1e12;  // never confirm: only the model hand-off is looked at
+  test::SmallLoop loop(p);
+  loop.body.omega *= 2.0;  // a longer despin: the channel dies while it is fired
+  ASSERT_TRUE(loop.gnc.init(p).ok);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  loop.tick(c);
+  // The despin goes on until the identifier is confident (it converges within 60 s).
+  for (int k = 0; k < 1200 && !loop.gnc.identifier().estimate().inertia_confident; ++k) {
+    loop.tick();
+  }
+  ASSERT_TRUE(loop.gnc.identifier().estimate().inertia_confident);
+  for (int k = 0; k < 2 * p.fdi.window_ticks + FaultDetector::kEvaluationSteps; ++k) loop.tick();
+  const double noise_before = loop.out.telemetry.fdi.noise_sigma;
+  ASSERT_GT(noise_before, 0.0);
+  loop.b_true.col(0).setZero();  // channel 0 produces nothing from now on
+  int reinflated_at = -1;
+  for (int k = 0; k < 2400 && reinflated_at < 0; ++k) {
+    loop.tick();
+    if (loop.gnc.identifier().counters().gate_reinflations > 0) reinflated_at = k;
+  }
+  ASSERT_GE(reinflated_at, 0) << "the identifier's gate never re-inflated: gated "
+                              << loop.gnc.identifier().counters().windows_gated << " of "
+                              << loop.gnc.identifier().counters().windows << " mode "
+                              << to_string(loop.out.telemetry.mode) << " |w| "
+                              << loop.body.omega.norm();
+  // Two windows later the detector still tests against the model it had.
+  for (int k = 0; k < 2 * p.fdi.window_ticks + FaultDetector::kEvaluationSteps; ++k) loop.tick();
+  EXPECT_LT(loop.out.telemetry.fdi.noise_sigma, 3.0 * noise_before)
+      << "before " << noise_before << " after " << loop.out.telemetry.fdi.noise_sigma;
+}
+
 TEST(GncIdentification, PolicyOffOnlyOffersTheCandidate) {
   const GncParams truth = identifying_params(ModelAdoption::kOff);
   test::SmallLoop loop(truth);
