@@ -191,8 +191,14 @@ int main(int argc, char** argv) {
     sub->add_option("--replan-early-r", spec.replan.early_r_m,
                     "replan strategies: ... and each offset 1 sigma at most this, m")
         ->capture_default_str();
-    sub->add_flag("--replan-on-identified", spec.replan.on_identified,
-                  "replan strategies: re-plan when the identifier's model becomes confident");
+    sub->add_option("--replan-refuted-max", spec.replan.refuted_max_s,
+                    "replan strategies: when the identifier refutes the a-priori model at "
+                    "--replan-first-max, wait for the identified model until then, s")
+        ->capture_default_str();
+    sub->add_option("--replan-on-identified", spec.replan.on_identified,
+                    "replan strategies: re-plan when the identifier's model becomes confident "
+                    "(true/false)")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");

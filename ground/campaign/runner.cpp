@@ -83,6 +83,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     pol.early_sigmas = o.early_sigmas;
     pol.early_j_rel = o.early_j_rel;
     pol.early_r_m = o.early_r_m;
+    pol.refuted_max_s = o.refuted_max_s;
     pol.on_identified = o.on_identified;
     replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
   }

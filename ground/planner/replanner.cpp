@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <limits>
 
 #include "gnc/estimation/identifier.hpp"
 
@@ -177,6 +178,13 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
     }
     if (tl.t < policy_.first_plan_s) return std::nullopt;
     if (!identified_ && tl.t < policy_.first_plan_max_s) return std::nullopt;
+    if (!identified_ && tl.t < policy_.refuted_max_s && tl.est.identifying &&
+        tl.est.windows > 0 &&
+        !apriori_confirmed(flight_, tl.est, policy_.early_sigmas,
+                           std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity())) {
+      return std::nullopt;  // the estimate refutes the table: wait for the identified model
+    }
     return ReplanTrigger::kFirst;
   }
   if (tl.mode != gnc::Mode::kTrack || resync_) return std::nullopt;

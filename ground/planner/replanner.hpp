@@ -43,15 +43,20 @@ struct ReplanPolicy {
   // inertia and offset component within early_sigmas of its reported 1 sigma, with that 1 sigma
   // at most early_j_rel |J_hat| (inertia) and early_r_m (offset). A model that is confirmed this
   // way is planned for at once instead of being identified on the D+PD reference for longer.
-  double early_plan_s{0.0};
+  double early_plan_s{60.0};
   double early_sigmas{3.0};
-  double early_j_rel{0.01};
-  double early_r_m{0.05};
+  double early_j_rel{0.02};
+  double early_r_m{1.0};
+  // At first_plan_max_s without a confident model: if the identifier's estimate refutes the
+  // a-priori model (a component beyond early_sigmas of its 1 sigma, whatever the 1 sigma), wait
+  // for the identified model until refuted_max_s instead of planning for a model known to be
+  // wrong (<= first_plan_max_s: off, plan for the a-priori model at first_plan_max_s).
+  double refuted_max_s{3000.0};
   double period_s{600.0};           // periodic re-plan (<= 0: off)
   double error_fraction{0.1};       // tracking-error trigger (<= 0: off)
   double error_floor{2e-4};         // rad/s
   bool on_model_update{true};       // re-plan when the flight adopted an identified model
-  bool on_identified{false};        // re-plan when the plan flown is for the a-priori model and the
+  bool on_identified{true};         // re-plan when the plan flown is for the a-priori model and the
                                     // identifier's model became confident (adopted or not)
   double min_interval_s{120.0};     // between two plans (also after a failed one)
   double latency_s{10.0};           // planning latency: delivered no earlier than t + latency

@@ -44,6 +44,9 @@ ReplanPolicy policy(double latency) {
   p.min_interval_s = 30.0;
   p.error_fraction = 0.0;
   p.on_model_update = false;
+  p.on_identified = false;
+  p.early_plan_s = 0.0;
+  p.refuted_max_s = 0.0;
   return p;
 }
 
@@ -240,6 +243,38 @@ TEST(Replanner, EarlyPlanForTheAPrioriModelOnlyOnceTheIdentifierConfirmsIt) {
   ASSERT_TRUE(d2.has_value());
   EXPECT_EQ(wait.records().front().trigger, ReplanTrigger::kFirst);
   EXPECT_NEAR(wait.records().front().t_state, 100.0, 1e-9);
+}
+
+TEST(Replanner, ARefutedAPrioriModelIsNotPlannedForUntilRefutedMax) {
+  const gnc::GncParams table = case1_table();
+  ReplanPolicy pol = policy(0.0);
+  pol.first_plan_s = 50.0;
+  pol.first_plan_max_s = 50.0;
+  pol.refuted_max_s = 120.0;
+  const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+  const double sj = 0.05 * j.norm();  // never confident, never confirmed (1 sigma above 2 %)
+  const Vec3 w(0.01, 0.02, 0.03);
+  auto fly = [&](double dj) {
+    Replanner rp(table, pol);
+    for (int k = 0; k < 2000; ++k) {
+      gnc::GncTelemetry tl = tlm(k * table.dt, gnc::Mode::kDetumble, w);
+      tl.est = report(table, sj, 0.5, 1, dj);
+      if (rp.update(tl)) break;
+    }
+    return rp.records();
+  };
+  // The estimate agrees with the table (within 3 sigma): planned for the table at first_plan_max.
+  const auto agree = fly(2.0 * sj);
+  ASSERT_EQ(agree.size(), 1u);
+  EXPECT_TRUE(agree[0].ok) << agree[0].error;
+  EXPECT_NEAR(agree[0].t_state, 50.0, 1e-9);
+  // It refutes it (Jyy 4 sigma away): no plan for a model known to be wrong until refuted_max.
+  const auto refute = fly(4.0 * sj);
+  ASSERT_EQ(refute.size(), 1u);
+  EXPECT_TRUE(refute[0].ok) << refute[0].error;
+  EXPECT_NEAR(refute[0].t_state, 120.0, 1e-9);
+  EXPECT_EQ(refute[0].trigger, ReplanTrigger::kFirst);
+  EXPECT_FALSE(refute[0].identified);
 }
 
 }  // namespace
