@@ -178,6 +178,27 @@ int main(int argc, char** argv) {
     sub->add_option("--replan-min-horizon", spec.replan.min_horizon_s,
                     "replan strategies: shortest plan horizon, s")
         ->capture_default_str();
+    sub->add_option("--replan-early", spec.replan.early_plan_s,
+                    "replan strategies: from then on, plan for the a-priori model as soon as the "
+                    "identifier's estimate confirms it, s (0: off)")
+        ->capture_default_str();
+    sub->add_option("--replan-early-sigmas", spec.replan.early_sigmas,
+                    "replan strategies: the early plan's confirmation: within this many 1 sigma")
+        ->capture_default_str();
+    sub->add_option("--replan-early-j-rel", spec.replan.early_j_rel,
+                    "replan strategies: ... with each inertia 1 sigma at most this x |J_hat|")
+        ->capture_default_str();
+    sub->add_option("--replan-early-r", spec.replan.early_r_m,
+                    "replan strategies: ... and each offset 1 sigma at most this, m")
+        ->capture_default_str();
+    sub->add_option("--replan-refuted-max", spec.replan.refuted_max_s,
+                    "replan strategies: when the identifier refutes the a-priori model at "
+                    "--replan-first-max, wait for the identified model until then, s")
+        ->capture_default_str();
+    sub->add_option("--replan-on-identified", spec.replan.on_identified,
+                    "replan strategies: re-plan when the identifier's model becomes confident "
+                    "(true/false)")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");

@@ -79,6 +79,12 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     pol.min_interval_s = o.min_interval_s;
     pol.horizon_factor = o.horizon_factor;
     pol.min_horizon_s = o.min_horizon_s;
+    pol.early_plan_s = o.early_plan_s;
+    pol.early_sigmas = o.early_sigmas;
+    pol.early_j_rel = o.early_j_rel;
+    pol.early_r_m = o.early_r_m;
+    pol.refuted_max_s = o.refuted_max_s;
+    pol.on_identified = o.on_identified;
     replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
   }
 #else

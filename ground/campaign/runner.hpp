@@ -89,6 +89,13 @@ struct ReplanOptions {
   double min_interval_s{120.0};    // between two plans
   double horizon_factor{8.0};      // plan horizon, in shortest despins from the current state,
   double min_horizon_s{0.0};       // and at least this long
+  double early_plan_s{60.0};       // > 0: from then on, plan for the a-priori model as soon as
+                                   // the identifier confirms it (replanner.hpp ReplanPolicy)
+  double early_sigmas{3.0};        // the confirmation: within this many 1 sigma,
+  double early_j_rel{0.02};        // each inertia 1 sigma at most this x |J_hat|,
+  double early_r_m{1.0};           // each offset 1 sigma at most this (m)
+  double refuted_max_s{3000.0};     // a-priori model refuted at first_plan_max_s: wait until then
+  bool on_identified{true};        // re-plan when the identifier's model becomes confident
 };
 
 // One plan of the re-planner, and what the flight did with it.

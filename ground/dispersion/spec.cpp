@@ -378,6 +378,12 @@ DispersionSpec load_spec(const std::string& path) {
     if (r.has("min_interval_s")) s.replan.min_interval_s = r.non_negative("min_interval_s");
     if (r.has("horizon_factor")) s.replan.horizon_factor = r.positive("horizon_factor");
     if (r.has("min_horizon_s")) s.replan.min_horizon_s = r.non_negative("min_horizon_s");
+    if (r.has("early_plan_s")) s.replan.early_plan_s = r.non_negative("early_plan_s");
+    if (r.has("on_identified")) s.replan.on_identified = r.boolean("on_identified");
+    if (r.has("early_sigmas")) s.replan.early_sigmas = r.positive("early_sigmas");
+    if (r.has("early_j_rel")) s.replan.early_j_rel = r.positive("early_j_rel");
+    if (r.has("early_r_m")) s.replan.early_r_m = r.positive("early_r_m");
+    if (r.has("refuted_max_s")) s.replan.refuted_max_s = r.non_negative("refuted_max_s");
     if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
       r.fail("first_plan_max_s", "must not be below first_plan_s");
     }

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -255,6 +256,12 @@ SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
       warm != nullptr ? guess_from_samples(nlp, *warm) : momentum_ramp_guess(nlp, model);
 
   Ipopt::SmartPtr<DespinTnlp> tnlp = new DespinTnlp(nlp, std::move(x0));
+  // One IPOPT solve at a time in a process: Debian's IPOPT factorises with sequential MUMPS, whose
+  // MPI stub and Fortran state are process-global (two campaign workers re-planning at once ended
+  // in "double free or corruption"). The solves do not depend on each other, so results are
+  // unchanged; only concurrent callers wait.
+  static std::mutex ipopt_mutex;
+  const std::lock_guard<std::mutex> ipopt_lock(ipopt_mutex);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", settings.print_level);
   if (settings.print_level >= 5) app->Options()->SetStringValue("print_timing_statistics", "yes");

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <limits>
 
 #include "gnc/estimation/identifier.hpp"
 
@@ -15,6 +16,7 @@ const char* to_string(ReplanTrigger t) {
     case ReplanTrigger::kPeriodic: return "periodic";
     case ReplanTrigger::kTrackingError: return "tracking_error";
     case ReplanTrigger::kModelUpdate: return "model_update";
+    case ReplanTrigger::kEarly: return "early";
   }
   return "?";
 }
@@ -29,6 +31,27 @@ std::optional<gnc::GncParams> identified_params(const gnc::GncParams& flight,
   gnc::GncParams p = gnc::with_model(flight, gnc::inertia_matrix(est.j), est.r, k);
   if (!gnc::validate(p).ok) return std::nullopt;
   return p;
+}
+
+bool apriori_confirmed(const gnc::GncParams& flight, const gnc::EstimationTelemetry& est,
+                       double sigmas, double j_rel, double r_m) {
+  if (!est.identifying || est.windows == 0) return false;
+  if (!est.j.allFinite() || !est.j_sigma.allFinite() || !est.r.allFinite() ||
+      !est.r_sigma.allFinite()) {
+    return false;
+  }
+  const gnc::Vec6 j0 = gnc::inertia_params(gnc::total_inertia(flight.mass_hat));
+  const double j_bound = j_rel * j0.norm();
+  for (int i = 0; i < 6; ++i) {
+    if (!(est.j_sigma(i) > 0.0) || est.j_sigma(i) > j_bound) return false;
+    if (std::abs(est.j(i) - j0(i)) > sigmas * est.j_sigma(i)) return false;
+  }
+  const gnc::Vec3& r0 = flight.mass_hat.r_so_bcm;
+  for (int i = 0; i < 3; ++i) {
+    if (!(est.r_sigma(i) > 0.0) || est.r_sigma(i) > r_m) return false;
+    if (std::abs(est.r(i) - r0(i)) > sigmas * est.r_sigma(i)) return false;
+  }
+  return true;
 }
 
 namespace {
@@ -147,8 +170,21 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
   if (!tl.omega_hat.allFinite()) return std::nullopt;
   if (flying_ == nullptr) {
     if (tl.mode == gnc::Mode::kSafe || tl.mode == gnc::Mode::kIdle) return std::nullopt;
+    if (policy_.early_plan_s > 0.0 && tl.t >= policy_.early_plan_s && !identified_ &&
+        tl.t < policy_.first_plan_s &&
+        apriori_confirmed(flight_, tl.est, policy_.early_sigmas, policy_.early_j_rel,
+                          policy_.early_r_m)) {
+      return ReplanTrigger::kEarly;
+    }
     if (tl.t < policy_.first_plan_s) return std::nullopt;
     if (!identified_ && tl.t < policy_.first_plan_max_s) return std::nullopt;
+    if (!identified_ && tl.t < policy_.refuted_max_s && tl.est.identifying &&
+        tl.est.windows > 0 &&
+        !apriori_confirmed(flight_, tl.est, policy_.early_sigmas,
+                           std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::infinity())) {
+      return std::nullopt;  // the estimate refutes the table: wait for the identified model
+    }
     return ReplanTrigger::kFirst;
   }
   if (tl.mode != gnc::Mode::kTrack || resync_) return std::nullopt;
@@ -159,6 +195,10 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
     return std::nullopt;
   }
   if (policy_.on_model_update && tl.est.adoptions > adoptions_seen_) {
+    return ReplanTrigger::kModelUpdate;
+  }
+  if (policy_.on_identified && identified_ && delivered_record_ < records_.size() &&
+      !records_[delivered_record_].identified) {
     return ReplanTrigger::kModelUpdate;
   }
   if (policy_.error_fraction > 0.0 && flying_table_ != nullptr) {

@@ -38,10 +38,26 @@ namespace rocksteady::ground::planner {
 struct ReplanPolicy {
   double first_plan_s{300.0};       // identify at least this long before the first plan
   double first_plan_max_s{600.0};   // plan then even if the model is not confident yet
+  // Early plan for the a-priori model (<= 0: off): from early_plan_s on (before first_plan_s too),
+  // plan for the flight's table as soon as the identifier's estimate agrees with it: every
+  // inertia and offset component within early_sigmas of its reported 1 sigma, with that 1 sigma
+  // at most early_j_rel |J_hat| (inertia) and early_r_m (offset). A model that is confirmed this
+  // way is planned for at once instead of being identified on the D+PD reference for longer.
+  double early_plan_s{60.0};
+  double early_sigmas{3.0};
+  double early_j_rel{0.02};
+  double early_r_m{1.0};
+  // At first_plan_max_s without a confident model: if the identifier's estimate refutes the
+  // a-priori model (a component beyond early_sigmas of its 1 sigma, whatever the 1 sigma), wait
+  // for the identified model until refuted_max_s instead of planning for a model known to be
+  // wrong (<= first_plan_max_s: off, plan for the a-priori model at first_plan_max_s).
+  double refuted_max_s{3000.0};
   double period_s{600.0};           // periodic re-plan (<= 0: off)
   double error_fraction{0.1};       // tracking-error trigger (<= 0: off)
   double error_floor{2e-4};         // rad/s
   bool on_model_update{true};       // re-plan when the flight adopted an identified model
+  bool on_identified{true};         // re-plan when the plan flown is for the a-priori model and the
+                                    // identifier's model became confident (adopted or not)
   double min_interval_s{120.0};     // between two plans (also after a failed one)
   double latency_s{10.0};           // planning latency: delivered no earlier than t + latency
   double horizon_factor{kHorizonFactor};  // t_f = factor x shortest despin from the state,
@@ -51,8 +67,8 @@ struct ReplanPolicy {
   int max_plans{20};
 };
 
-// Why a plan was made.
-enum class ReplanTrigger : std::uint8_t { kFirst, kPeriodic, kTrackingError, kModelUpdate };
+// Why a plan was made (kEarly: the first plan, for the a-priori model the identifier confirmed).
+enum class ReplanTrigger : std::uint8_t { kFirst, kPeriodic, kTrackingError, kModelUpdate, kEarly };
 const char* to_string(ReplanTrigger t);
 
 struct ReplanRecord {
@@ -133,6 +149,13 @@ class Replanner {
   bool resync_{false};  // the next sample re-synchronises t0 (as the flight does at the switch)
   bool stopped_{false};
 };
+
+// The identifier's estimate agrees with the flight's a-priori model: every J_tot and r_SO/BCM
+// component within `sigmas` of its reported 1 sigma, each inertia 1 sigma at most j_rel |J_hat| and
+// each offset 1 sigma at most r_m (so the agreement means something), inertia and offset observable
+// enough to be reported (at least one window).
+bool apriori_confirmed(const gnc::GncParams& flight, const gnc::EstimationTelemetry& est,
+                       double sigmas, double j_rel, double r_m);
 
 // The flight's table with the identified model (J_tot, r_SO/BCM, the confident thruster strengths)
 // from its telemetry, when the inertia and the offset are confident; nullopt otherwise.

@@ -33,6 +33,9 @@ ReplanOptions fast_policy(double latency_s) {
   o.min_interval_s = 100.0;
   o.error_fraction = 0.0;  // periodic only: a predictable number of plans
   o.on_model_update = false;
+  o.on_identified = false;
+  o.early_plan_s = 0.0;    // the first plan at 100 s exactly, for the table
+  o.refuted_max_s = 0.0;
   return o;
 }
 

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <thread>
+#include <vector>
 
 #include "ground/planner/cache.hpp"
 #include "ground/planner/planner.hpp"
@@ -197,6 +199,34 @@ TEST(Planner, SphericalBodyFuelMatchesTheClosedForm) {
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.fuel_kg, closed_form, 0.01 * closed_form);
   EXPECT_GE(r.fuel_kg, closed_form * (1 - 1e-6));  // it is a lower bound for every transcription
+}
+
+TEST(Planner, PlansFromConcurrentThreadsEqualTheSerialPlan) {
+  // The campaign's workers re-plan at the same time (ntcl+replan with --jobs 2): IPOPT with
+  // sequential MUMPS is process-global, so plan() serialises the solves. Every concurrent plan must
+  // be the serial plan, bit for bit (and the process must survive).
+  PlanProblem p;
+  p.case_name = "concurrent";
+  p.model = study_case_model(200.0, 0.0, 0.0);
+  p.settings.t_final_max = 600.0;
+  p.settings.nodes = 41;
+  const PlanResult serial = plan(p);
+  ASSERT_TRUE(serial.ok) << serial.error;
+  constexpr int kThreads = 3;
+  std::vector<PlanResult> results(kThreads);
+  std::vector<std::thread> pool;
+  for (int i = 0; i < kThreads; ++i) {
+    pool.emplace_back([&p, &results, i]() { results[i] = plan(p); });
+  }
+  for (std::thread& t : pool) t.join();
+  for (int i = 0; i < kThreads; ++i) {
+    ASSERT_TRUE(results[i].ok) << results[i].error;
+    EXPECT_EQ(results[i].fuel_kg, serial.fuel_kg) << i;
+    ASSERT_EQ(results[i].samples.size(), serial.samples.size()) << i;
+    for (std::size_t k = 0; k < serial.samples.size(); ++k) {
+      EXPECT_EQ(results[i].samples[k].omega_d, serial.samples[k].omega_d) << i << " " << k;
+    }
+  }
 }
 
 TEST(Planner, InfeasibleHorizonIsAClearErrorAndWritesNoFile) {

@@ -4,6 +4,10 @@
 // the plan being flown.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
+#include "gnc/estimation/identifier.hpp"
 #include "gnc/guidance/trajectory.hpp"
 #include "gnc/io.hpp"
 #include "gnc/model/mass_properties.hpp"
@@ -40,6 +44,9 @@ ReplanPolicy policy(double latency) {
   p.min_interval_s = 30.0;
   p.error_fraction = 0.0;
   p.on_model_update = false;
+  p.on_identified = false;
+  p.early_plan_s = 0.0;
+  p.refuted_max_s = 0.0;
   return p;
 }
 
@@ -138,6 +145,136 @@ TEST(Replanner, RePlanWhileTrackingStartsOnThePlanVerifiesAndARefusalKeepsThePre
   ASSERT_TRUE(third.has_value());
   EXPECT_GE(rp.records().back().t_state, r2.t_state + policy(0.0).min_interval_s - 1e-9);
   EXPECT_TRUE(rp.records().back().ok) << rp.records().back().error;
+}
+
+// An identifier report around the table's J_tot and r_SO/BCM, offset by `dj` (inertia parameter
+// i, kg m^2) and `dr` (offset component i, m), with 1 sigma `sj` and `sr` on every component.
+gnc::EstimationTelemetry report(const gnc::GncParams& table, double sj, double sr, int ij = 0,
+                                double dj = 0.0, int ir = 0, double dr = 0.0) {
+  gnc::EstimationTelemetry e;
+  e.identifying = true;
+  e.windows = 5;
+  e.j = gnc::inertia_params(gnc::total_inertia(table.mass_hat));
+  e.j(ij) += dj;
+  e.j_sigma = gnc::Vec6::Constant(sj);
+  e.r = table.mass_hat.r_so_bcm;
+  e.r(ir) += dr;
+  e.r_sigma = gnc::Vec3::Constant(sr);
+  return e;
+}
+
+TEST(Replanner, APrioriModelConfirmedOnlyWithinItsSigmasAndWithSmallSigmas) {
+  const gnc::GncParams table = case1_table();
+  // |J_tot| as a 6-vector, computed here from the mass properties (Eq. 1).
+  const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+  const double j_norm = std::sqrt(j(0, 0) * j(0, 0) + j(1, 1) * j(1, 1) + j(2, 2) * j(2, 2) +
+                                  j(0, 1) * j(0, 1) + j(0, 2) * j(0, 2) + j(1, 2) * j(1, 2));
+  const double sj = 1e-3 * j_norm;  // well inside the 1 % bound
+  const double sr = 0.01;
+  // At the table's values: confirmed.
+  EXPECT_TRUE(apriori_confirmed(table, report(table, sj, sr), 3.0, 0.01, 0.05));
+  // Every inertia component and every offset component: 2.9 sigma away confirms, 3.1 does not.
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_TRUE(apriori_confirmed(table, report(table, sj, sr, i, 2.9 * sj), 3.0, 0.01, 0.05)) << i;
+    EXPECT_FALSE(apriori_confirmed(table, report(table, sj, sr, i, -3.1 * sj), 3.0, 0.01, 0.05))
+        << i;
+  }
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(apriori_confirmed(table, report(table, sj, sr, 0, 0.0, i, -2.9 * sr), 3.0, 0.01,
+                                  0.05)) << i;
+    EXPECT_FALSE(apriori_confirmed(table, report(table, sj, sr, 0, 0.0, i, 3.1 * sr), 3.0, 0.01,
+                                   0.05)) << i;
+  }
+  // Agreement that means nothing (a 1 sigma above the bounds) does not confirm.
+  EXPECT_FALSE(apriori_confirmed(table, report(table, 0.011 * j_norm, sr), 3.0, 0.01, 0.05));
+  EXPECT_FALSE(apriori_confirmed(table, report(table, sj, 0.06), 3.0, 0.01, 0.05));
+  // No window yet, identification off, or a non-finite report: not confirmed.
+  gnc::EstimationTelemetry e = report(table, sj, sr);
+  e.windows = 0;
+  EXPECT_FALSE(apriori_confirmed(table, e, 3.0, 0.01, 0.05));
+  e = report(table, sj, sr);
+  e.identifying = false;
+  EXPECT_FALSE(apriori_confirmed(table, e, 3.0, 0.01, 0.05));
+  e = report(table, sj, sr);
+  e.j_sigma(3) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(apriori_confirmed(table, e, 3.0, 0.01, 0.05));
+}
+
+TEST(Replanner, EarlyPlanForTheAPrioriModelOnlyOnceTheIdentifierConfirmsIt) {
+  const gnc::GncParams table = case1_table();
+  ReplanPolicy pol = policy(0.0);
+  pol.first_plan_s = 100.0;
+  pol.first_plan_max_s = 100.0;
+  pol.early_plan_s = 5.0;
+  const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+  const double sj = 1e-4 * j.norm();
+  // An identifier that disagrees (5 sigma on Jxx) until 20 s, then agrees: the plan comes at the
+  // first telemetry that agrees, for the table's model, long before first_plan_s.
+  Replanner rp(table, pol);
+  const Vec3 w(0.01, 0.02, 0.03);
+  std::optional<Delivery> d;
+  double t = 0.0;
+  for (int k = 0; k < 1000 && !d; ++k) {
+    t = k * table.dt;
+    gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+    tl.est = report(table, sj, 0.01, 0, t < 20.0 - 1e-9 ? 5.0 * sj : 0.0);
+    d = rp.update(tl);
+  }
+  ASSERT_TRUE(d.has_value());
+  ASSERT_EQ(rp.records().size(), 1u);
+  const ReplanRecord& r = rp.records().front();
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.trigger, ReplanTrigger::kEarly);
+  EXPECT_STREQ(to_string(r.trigger), "early");
+  EXPECT_NEAR(r.t_state, 20.0, 1e-9);
+  EXPECT_FALSE(r.identified);
+  EXPECT_TRUE(d->first);
+
+  // Before early_plan_s nothing is planned even when confirmed; a disagreeing identifier waits for
+  // first_plan_s (and then plans for the table: no confident model).
+  Replanner wait(table, pol);
+  std::optional<Delivery> d2;
+  for (int k = 0; k < 2000 && !d2; ++k) {
+    t = k * table.dt;
+    gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+    tl.est = report(table, sj, 0.01, 2, t < 4.0 ? 0.0 : 5.0 * sj);
+    d2 = wait.update(tl);
+  }
+  ASSERT_TRUE(d2.has_value());
+  EXPECT_EQ(wait.records().front().trigger, ReplanTrigger::kFirst);
+  EXPECT_NEAR(wait.records().front().t_state, 100.0, 1e-9);
+}
+
+TEST(Replanner, ARefutedAPrioriModelIsNotPlannedForUntilRefutedMax) {
+  const gnc::GncParams table = case1_table();
+  ReplanPolicy pol = policy(0.0);
+  pol.first_plan_s = 50.0;
+  pol.first_plan_max_s = 50.0;
+  pol.refuted_max_s = 120.0;
+  const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+  const double sj = 0.05 * j.norm();  // never confident, never confirmed (1 sigma above 2 %)
+  const Vec3 w(0.01, 0.02, 0.03);
+  auto fly = [&](double dj) {
+    Replanner rp(table, pol);
+    for (int k = 0; k < 2000; ++k) {
+      gnc::GncTelemetry tl = tlm(k * table.dt, gnc::Mode::kDetumble, w);
+      tl.est = report(table, sj, 0.5, 1, dj);
+      if (rp.update(tl)) break;
+    }
+    return rp.records();
+  };
+  // The estimate agrees with the table (within 3 sigma): planned for the table at first_plan_max.
+  const auto agree = fly(2.0 * sj);
+  ASSERT_EQ(agree.size(), 1u);
+  EXPECT_TRUE(agree[0].ok) << agree[0].error;
+  EXPECT_NEAR(agree[0].t_state, 50.0, 1e-9);
+  // It refutes it (Jyy 4 sigma away): no plan for a model known to be wrong until refuted_max.
+  const auto refute = fly(4.0 * sj);
+  ASSERT_EQ(refute.size(), 1u);
+  EXPECT_TRUE(refute[0].ok) << refute[0].error;
+  EXPECT_NEAR(refute[0].t_state, 120.0, 1e-9);
+  EXPECT_EQ(refute[0].trigger, ReplanTrigger::kFirst);
+  EXPECT_FALSE(refute[0].identified);
 }
 
 }  // namespace
