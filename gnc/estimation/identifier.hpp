@@ -208,7 +208,8 @@ class Identifier {
   // One tick.
   // `background`: whether this tick may carry a block of the latched window's step (the
   // executive leaves it out on ticks that already carry other periodic work, e.g. the fault
-  // detector's window close). A step still running when the next window closes is finished then.
+  // detector's heavy evaluation steps). A step still running when the next window closes is
+  // finished then.
   void update(const IdentifierInput& in, bool background = true);
 
   // Re-inflation on a declared change (a fault, a table switch): the group's covariance goes

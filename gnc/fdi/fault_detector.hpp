@@ -111,10 +111,6 @@ class FaultDetector {
   void configure(const FaultDetectorParams& p, const RcsLayout& rcs, double u_max, double dt);
   void reset();  // scores and windows; latched faults are kept (clear() removes them)
   void set_model(const FaultModel& m);
-  // Whether the next valid update closes a window.
-  bool window_closes_next() const {
-    return p_.enabled && have_start_ && n_ + 1 >= p_.window_ticks;
-  }
   // (F10) A closed window is being evaluated: the next update runs one step of it.
   bool evaluating() const { return eval_phase_ != 0; }
   // The next update runs one of the evaluation's heavy steps: the two scoring steps, and the
