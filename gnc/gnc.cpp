@@ -609,7 +609,12 @@ void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
   e.offset_unobservable = static_cast<std::uint8_t>(ident_.observability().offset_unobservable);
   e.residual_torque = est.residual_torque;
   e.residual_chi2 = est.residual_chi2;
-  e.windows = ident_.counters().windows;
+  const IdentifierCounters& ic = ident_.counters();
+  e.windows = ic.windows;
+  e.rate_bias_sigma = est.gyro_bias_sigma;
+  e.windows_gated = ic.windows_gated;
+  e.gate_reinflations = ic.gate_reinflations;
+  e.guard_refusals = ic.inertia_refused + ic.offset_refused;
   e.candidate = candidate_status_;
 }
 

@@ -166,6 +166,10 @@ struct EstimationTelemetry {
   Vec3 residual_torque{Vec3::Zero()};   // N m, last window's mean residual with the estimates
   double residual_chi2{0.0};            // its squared norm normalised by the window noise
   std::uint32_t windows{0};
+  Vec3 rate_bias_sigma{Vec3::Zero()};   // rad/s, the gyro bias 1 sigma the identifier carries (I17)
+  std::uint32_t windows_gated{0};       // windows refused by the innovation gate (I18)
+  std::uint32_t gate_reinflations{0};   // J, r, k re-inflated after gated windows in a row (I18)
+  std::uint32_t guard_refusals{0};      // updates refused by the guards (I14)
   ModelCandidate candidate{ModelCandidate::kDisabled};
   std::uint32_t adoptions{0};           // identified models adopted into the active table
 };

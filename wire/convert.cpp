@@ -125,6 +125,10 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   put(e.residual_torque, m.id_residual_torque);
   m.id_residual_chi2 = e.residual_chi2;
   m.id_windows = e.windows;
+  put(e.rate_bias_sigma, m.id_rate_bias_sigma);
+  m.id_windows_gated = e.windows_gated;
+  m.id_gate_reinflations = e.gate_reinflations;
+  m.id_guard_refusals = e.guard_refusals;
   m.id_candidate = static_cast<std::int8_t>(e.candidate);
   m.model_adoptions = e.adoptions;
   const gnc::FdiTelemetry& f = g.fdi;

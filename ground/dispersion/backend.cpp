@@ -290,6 +290,27 @@ std::string reproduce_command(const Inputs& in, const std::string& dir) {
   return c;
 }
 
+std::vector<DrawResult> references(const Inputs& in, const std::string& dir, std::ostream& log) {
+  std::vector<DrawResult> refs;
+  const FaultPlan& fp = in.spec.faults;
+  if (!fp.enabled || fp.case_files.empty()) return refs;
+  const Sampler sampler(in.spec, in.mission);
+  for (std::size_t c = 0; c < fp.case_files.size(); ++c) {
+    if (auto stored = read_reference(dir, fp.case_numbers[c])) {
+      refs.push_back(std::move(*stored));
+      continue;
+    }
+    const std::optional<DrawParams> p = reference_params(in.spec, sampler, c);
+    if (!p) continue;  // no draw flies this case (fewer draws than the grid)
+    log << "[dispersion] fault-free reference of case " << fp.case_numbers[c] << "\n";
+    const auto planner = campaign::make_default_trajectory_source("");
+    DrawResult r = fly_reference(in.mission, in.gnc, in.spec, *p, *planner);
+    write_reference(dir, r);
+    refs.push_back(std::move(r));
+  }
+  return refs;
+}
+
 int collect(const std::string& dir, std::ostream& out, bool plots) {
   const Inputs in = inputs_from_manifest(dir);
   std::vector<DrawResult> draws;
@@ -302,7 +323,7 @@ int collect(const std::string& dir, std::ostream& out, bool plots) {
       ++missing;
     }
   }
-  const Summary s = summarize(in.spec, draws);
+  const Summary s = summarize(in.spec, draws, references(in, dir, out));
   const OutputPaths p = write_outputs(dir, in.spec, draws, s, reproduce_command(in, dir), plots);
   out << "results: " << p.results_csv << "\nsummary: " << p.summary_json
       << "\nreport:  " << p.report_md << "\n";

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "config/config_files.hpp"
+#include "ground/dispersion/draw.hpp"
 #include "ground/dispersion/spec.hpp"
 
 namespace rocksteady::dispersion {
@@ -57,7 +58,12 @@ int submit_slurm(const Inputs& in, const std::string& dir, const std::vector<int
 // One array task: the draws listed for `shard` in <dir>/slurm/draws.txt.
 int run_shard(const std::string& dir, int shard, int shards, std::ostream& log);
 
-// Merges every draw file and writes the outputs; returns the number of draws missing.
+// The fault-free references of a fault dispersion over study cases (one per case, read from
+// <dir>/reference/, flown here when missing); empty for any other dispersion.
+std::vector<DrawResult> references(const Inputs& in, const std::string& dir, std::ostream& log);
+
+// Merges every draw file (and the fault-free references) and writes the outputs; returns the
+// number of draws missing.
 int collect(const std::string& dir, std::ostream& out, bool plots = true);
 
 std::string self_exe();

@@ -169,13 +169,15 @@ config::RunSetup make_setup(const config::MissionConfig& mission, const config::
   return s;
 }
 
-DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfig& gnc,
-                    const DispersionSpec& spec, const Sampler& sampler, int index,
-                    campaign::TrajectorySource& planner, const FlyOptions& options) {
+namespace {
+
+DrawResult fly_sampled(const config::MissionConfig& mission, const config::GncConfig& gnc,
+                       const DispersionSpec& spec, int index, const DrawParams& sampled,
+                       campaign::TrajectorySource& planner, const FlyOptions& options) {
   const auto wall0 = std::chrono::steady_clock::now();
   DrawResult r;
   r.index = index;
-  r.sampled = sampler.draw(index);
+  r.sampled = sampled;
   auto fail_all = [&](const std::string& status, const std::string& why) {
     for (const campaign::Strategy& st : spec.strategies) {
       StrategyOutcome o;
@@ -255,6 +257,39 @@ DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfi
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return r;
+}
+
+}  // namespace
+
+DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfig& gnc,
+                    const DispersionSpec& spec, const Sampler& sampler, int index,
+                    campaign::TrajectorySource& planner, const FlyOptions& options) {
+  return fly_sampled(mission, gnc, spec, index, sampler.draw(index), planner, options);
+}
+
+std::optional<DrawParams> reference_params(const DispersionSpec& spec, const Sampler& sampler,
+                                           std::size_t case_index) {
+  const FaultPlan& fp = spec.faults;
+  if (!fp.enabled || case_index >= fp.case_files.size()) return std::nullopt;
+  for (int i = 0; i < spec.draws; ++i) {
+    DrawParams d = sampler.draw(i);
+    if (d.case_file != fp.case_files[case_index]) continue;
+    d.index = -1;
+    d.has_fault = false;
+    d.fault = plant::ThrusterFault{};
+    return d;
+  }
+  return std::nullopt;
+}
+
+DrawResult fly_reference(const config::MissionConfig& mission, const config::GncConfig& gnc,
+                         const DispersionSpec& spec, const DrawParams& reference,
+                         campaign::TrajectorySource& planner) {
+  return fly_sampled(mission, gnc, spec, -1, reference, planner, FlyOptions{});
+}
+
+std::string reference_path(const std::string& dir, int case_number) {
+  return (fs::path(dir) / "reference" / ("case" + std::to_string(case_number) + ".json")).string();
 }
 
 DrawResult crashed_draw(const DispersionSpec& spec, const Sampler& sampler, int index,
@@ -465,8 +500,9 @@ std::string draw_path(const std::string& dir, int index) {
   return (fs::path(dir) / "draws" / name).string();
 }
 
-void write_draw(const std::string& dir, const DrawResult& r) {
-  const std::string path = draw_path(dir, r.index);
+namespace {
+
+void write_atomically(const std::string& path, const DrawResult& r) {
   fs::create_directories(fs::path(path).parent_path());
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
@@ -479,8 +515,8 @@ void write_draw(const std::string& dir, const DrawResult& r) {
   fs::rename(tmp, path);  // atomic: a reader sees the whole file or none
 }
 
-std::optional<DrawResult> read_draw(const std::string& dir, int index) {
-  std::ifstream in(draw_path(dir, index));
+std::optional<DrawResult> read_result(const std::string& path) {
+  std::ifstream in(path);
   if (!in) return std::nullopt;
   try {
     const json j = json::parse(in);
@@ -488,6 +524,24 @@ std::optional<DrawResult> read_draw(const std::string& dir, int index) {
   } catch (const std::exception&) {
     return std::nullopt;  // unreadable: run again
   }
+}
+
+}  // namespace
+
+void write_draw(const std::string& dir, const DrawResult& r) {
+  write_atomically(draw_path(dir, r.index), r);
+}
+
+std::optional<DrawResult> read_draw(const std::string& dir, int index) {
+  return read_result(draw_path(dir, index));
+}
+
+void write_reference(const std::string& dir, const DrawResult& r) {
+  write_atomically(reference_path(dir, r.sampled.case_number), r);
+}
+
+std::optional<DrawResult> read_reference(const std::string& dir, int case_number) {
+  return read_result(reference_path(dir, case_number));
 }
 
 }  // namespace rocksteady::dispersion

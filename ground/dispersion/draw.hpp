@@ -87,6 +87,16 @@ DrawResult fly_draw(const config::MissionConfig& mission, const config::GncConfi
                     const DispersionSpec& spec, const Sampler& sampler, int index,
                     campaign::TrajectorySource& planner, const FlyOptions& options = {});
 
+// The fault-free reference of a fault dispersion over study cases (`faults: cases`): case
+// `case_index` of the plan flown as the draws fly it (the case file, every strategy, the same
+// noise), without a thruster fault. The draws' fuel penalty is measured against it. nullopt when
+// the spec has no such case or no draw flies it. Its index is -1.
+std::optional<DrawParams> reference_params(const DispersionSpec& spec, const Sampler& sampler,
+                                           std::size_t case_index);
+DrawResult fly_reference(const config::MissionConfig& mission, const config::GncConfig& gnc,
+                         const DispersionSpec& spec, const DrawParams& reference,
+                         campaign::TrajectorySource& planner);
+
 // A result for a draw whose process died (the reason says how).
 DrawResult crashed_draw(const DispersionSpec& spec, const Sampler& sampler, int index,
                         const std::string& reason);
@@ -99,5 +109,9 @@ DrawResult draw_from_json(const nlohmann::json& j);
 std::string draw_path(const std::string& dir, int index);
 void write_draw(const std::string& dir, const DrawResult& r);
 std::optional<DrawResult> read_draw(const std::string& dir, int index);
+// <dir>/reference/case<N>.json: the fault-free reference of study case N (same format as a draw).
+std::string reference_path(const std::string& dir, int case_number);
+void write_reference(const std::string& dir, const DrawResult& r);
+std::optional<DrawResult> read_reference(const std::string& dir, int case_number);
 
 }  // namespace rocksteady::dispersion

@@ -87,7 +87,87 @@ Percentiles percentiles(const std::vector<double>& v) {
   return p;
 }
 
-Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& draws) {
+std::string declared_kind(plant::FaultKind k) {
+  switch (k) {
+    case plant::FaultKind::kStuckOn: return "stuck-on";
+    case plant::FaultKind::kStuckOff: return "stuck-off";
+    case plant::FaultKind::kDegraded: return "degraded";
+    case plant::FaultKind::kNone: break;
+  }
+  return "none";
+}
+
+namespace {
+
+// Per strategy x kind x onset (case 0) and x case: isolation and fuel penalty (FaultGroupStats).
+void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>& draws,
+                      const std::vector<DrawResult>& references, Summary& s) {
+  if (!spec.faults.enabled) return;
+  for (const DrawResult& r : references) {
+    for (const StrategyOutcome& o : r.runs) {
+      s.references.push_back(
+          {r.sampled.case_number, o.strategy, o.status, o.success, o.total_fuel_kg});
+    }
+  }
+  auto reference_fuel = [&](int case_number, const std::string& strategy) -> std::optional<double> {
+    for (const ReferenceRow& x : s.references) {
+      if (x.case_number == case_number && x.strategy == strategy && x.status == "ok") {
+        return x.fuel_kg;
+      }
+    }
+    return std::nullopt;
+  };
+  std::vector<int> cases{0};
+  for (int c : spec.faults.case_numbers) cases.push_back(c);
+  if (spec.faults.case_numbers.empty()) cases = {0};
+  for (std::size_t k = 0; k < spec.strategies.size(); ++k) {
+    for (plant::FaultKind kind : spec.faults.kinds) {
+      for (double onset : spec.faults.onsets_s) {
+        for (int c : cases) {
+          FaultGroupStats g;
+          g.strategy = spec.strategies[k].name;
+          g.kind = plant::to_string(kind);
+          g.onset_s = onset;
+          g.case_number = c;
+          std::vector<double> lat, pen;
+          for (const DrawResult& d : draws) {
+            if (!d.sampled.has_fault || d.sampled.fault.kind != kind ||
+                d.sampled.fault.onset_s != onset || (c != 0 && d.sampled.case_number != c) ||
+                k >= d.runs.size() || d.runs[k].status != "ok") {
+              continue;
+            }
+            const StrategyOutcome& o = d.runs[k];
+            ++g.runs;
+            g.successes += o.success ? 1 : 0;
+            const campaign::FdiReport& f = o.fdi;
+            if (f.confirmations == 0) {
+              ++g.none;
+            } else if (f.confirmations == 1 && f.thruster == d.sampled.fault.thruster &&
+                       f.kind == declared_kind(kind) && f.first_confirmation_s) {
+              ++g.isolated;
+              lat.push_back(*f.first_confirmation_s - onset);
+            } else {
+              ++g.wrong;
+            }
+            const std::optional<double> ref = reference_fuel(d.sampled.case_number, o.strategy);
+            if (ref && o.total_fuel_kg) pen.push_back(*o.total_fuel_kg - *ref);
+          }
+          if (g.runs == 0) continue;
+          g.latency_s = percentiles(lat);
+          if (!lat.empty()) g.latency_max_s = *std::max_element(lat.begin(), lat.end());
+          g.penalty_kg = percentiles(pen);
+          if (!pen.empty()) g.penalty_max_kg = *std::max_element(pen.begin(), pen.end());
+          s.faults.push_back(g);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& draws,
+                  const std::vector<DrawResult>& references) {
   Summary s;
   s.name = spec.name;
   s.draws_expected = spec.draws;
@@ -287,6 +367,7 @@ Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& dra
       }
     }
   }
+  summarize_faults(spec, draws, references, s);
   return s;
 }
 
@@ -387,12 +468,38 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                      {"bins", bins},
                      {"crossover_delta_j_kg_m2", opt_json(c.crossover_kg_m2)}});
   }
+  json faults = json::array();
+  for (const FaultGroupStats& g : s.faults) {
+    faults.push_back({{"strategy", g.strategy},
+                      {"kind", g.kind},
+                      {"onset_s", g.onset_s},
+                      {"case", g.case_number},
+                      {"runs", g.runs},
+                      {"successes", g.successes},
+                      {"isolated", g.isolated},
+                      {"wrong", g.wrong},
+                      {"none", g.none},
+                      {"latency_s", pct_json(g.latency_s)},
+                      {"latency_max_s", opt_json(g.latency_max_s)},
+                      {"fuel_penalty_kg", pct_json(g.penalty_kg)},
+                      {"fuel_penalty_max_kg", opt_json(g.penalty_max_kg)}});
+  }
+  json refs = json::array();
+  for (const ReferenceRow& r : s.references) {
+    refs.push_back({{"case", r.case_number},
+                    {"strategy", r.strategy},
+                    {"status", r.status},
+                    {"success", r.success},
+                    {"total_fuel_kg", opt_json(r.fuel_kg)}});
+  }
   return {{"name", s.name},
           {"draws_expected", s.draws_expected},
           {"draws_present", s.draws_present},
           {"strategies", strategies},
           {"paired_fuel", paired},
           {"prop5_crossover", cross},
+          {"faults", faults},
+          {"fault_free_references", refs},
           {"timing",
            {{"simulated_s", s.simulated_s},
             {"closed_loop_cpu_wall_s", s.closed_loop_wall_s_sum},
@@ -554,6 +661,64 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
       }
       md << "| `" << spec.strategies[k].name << "` | " << n << " | " << conf << " | " << susp
          << " | " << valve << " |\n";
+    }
+  }
+  if (!s.faults.empty()) {
+    md << "\n## Thruster faults\n\nPer strategy, fault kind and onset, over the study cases: "
+          "runs, success (both SPEC §7 goals), the fault isolated (exactly one confirmation, "
+          "naming the draw's thruster and kind), a wrong confirmation (another thruster or kind, "
+          "or more than one), none; the latency from onset to the confirmation over the isolated "
+          "runs (for stuck-off and degraded faults it includes the time before the jet is next "
+          "commanded); the fuel penalty against the same case flown by the same strategy without "
+          "the fault";
+    if (s.references.empty()) md << " (no fault-free reference: the plan has no study cases)";
+    md << ".\n\n| strategy | fault | onset (s) | runs | success | isolated | wrong | none | "
+          "latency p50 / p95 / max (s) | fuel penalty p50 / p95 / max (kg) |\n"
+          "|---|---|---:|---:|---:|---:|---:|---:|---|---|\n";
+    for (const FaultGroupStats& g : s.faults) {
+      if (g.case_number != 0) continue;
+      md << "| `" << g.strategy << "` | " << g.kind << " | " << fmt("%.0f", g.onset_s) << " | "
+         << g.runs << " | " << g.successes << " | " << g.isolated << " | " << g.wrong << " | "
+         << g.none << " | " << nc(g.latency_s.p50, "%.1f") << " / " << nc(g.latency_s.p95, "%.1f")
+         << " / " << nc(g.latency_max_s, "%.1f") << " | " << nc(g.penalty_kg.p50, "%.2f")
+         << " / " << nc(g.penalty_kg.p95, "%.2f") << " / " << nc(g.penalty_max_kg, "%.2f")
+         << " |\n";
+    }
+    if (!spec.faults.case_numbers.empty()) {
+      md << "\nPer case: isolated / runs (latency p50 s), and successes.\n\n| strategy | fault | "
+            "onset (s) |";
+      for (int c : spec.faults.case_numbers) md << " case " << c << " |";
+      md << "\n|---|---|---:|";
+      for (std::size_t c = 0; c < spec.faults.case_numbers.size(); ++c) md << "---|";
+      md << "\n";
+      for (const FaultGroupStats& g : s.faults) {
+        if (g.case_number != 0) continue;
+        md << "| `" << g.strategy << "` | " << g.kind << " | " << fmt("%.0f", g.onset_s) << " |";
+        for (int c : spec.faults.case_numbers) {
+          const FaultGroupStats* x = nullptr;
+          for (const FaultGroupStats& h : s.faults) {
+            if (h.case_number == c && h.strategy == g.strategy && h.kind == g.kind &&
+                h.onset_s == g.onset_s) {
+              x = &h;
+            }
+          }
+          if (x == nullptr) {
+            md << " — |";
+          } else {
+            md << " " << x->isolated << "/" << x->runs << " (" << nc(x->latency_s.p50, "%.1f")
+               << "), " << x->successes << " ok |";
+          }
+        }
+        md << "\n";
+      }
+    }
+    if (!s.references.empty()) {
+      md << "\nFault-free references (each case as the draws fly it, without the fault):\n\n"
+            "| case | strategy | status | success | fuel (kg) |\n|---:|---|---|---|---:|\n";
+      for (const ReferenceRow& r : s.references) {
+        md << "| " << r.case_number << " | `" << r.strategy << "` | " << r.status << " | "
+           << (r.success ? "yes" : "no") << " | " << nc(r.fuel_kg, "%.2f") << " |\n";
+      }
     }
   }
   md << "\n## Worst draws\n\n";

@@ -83,6 +83,33 @@ struct Crossover {
   std::optional<double> crossover_kg_m2;  // first sign change of the median, log-interpolated
 };
 
+// A fault dispersion (`faults:`): per strategy, fault kind and onset (case 0), and per study case
+// as well, what the fault detector made of the draw's fault and what the fault cost against the
+// case's fault-free reference flown by the same strategy (read_reference).
+struct FaultGroupStats {
+  std::string strategy;
+  std::string kind;  // stuck_off | stuck_on | degraded (plant::to_string)
+  double onset_s{0.0};
+  int case_number{0};  // 0: every case
+  int runs{0};         // flown (status ok)
+  int successes{0};    // both SPEC §7 goals and |omega| <= eps_trans throughout
+  int isolated{0};     // exactly one confirmation, naming the draw's thruster and kind
+  int wrong{0};        // some confirmation, not that one
+  int none{0};         // no confirmation
+  Percentiles latency_s;  // isolated runs: first confirmation minus onset
+  std::optional<double> latency_max_s;
+  Percentiles penalty_kg;  // total fuel minus the reference's (draws and reference both flew)
+  std::optional<double> penalty_max_kg;
+};
+
+struct ReferenceRow {
+  int case_number{0};
+  std::string strategy;
+  std::string status;
+  bool success{false};
+  std::optional<double> fuel_kg;
+};
+
 struct Summary {
   std::string name;
   int draws_expected{0};
@@ -90,13 +117,20 @@ struct Summary {
   std::vector<StrategyStats> strategies;
   std::vector<PairedStats> paired;
   std::vector<Crossover> crossovers;
+  std::vector<FaultGroupStats> faults;    // a fault dispersion only
+  std::vector<ReferenceRow> references;   // its fault-free references
   double draw_wall_s_sum{0.0};
   double simulated_s{0.0};
   double closed_loop_wall_s_sum{0.0};
   double plan_wall_s_sum{0.0};
 };
 
-Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& draws);
+// `references`: the fault-free references of a fault dispersion over study cases (may be empty:
+// then no fuel penalty is given).
+Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& draws,
+                  const std::vector<DrawResult>& references = {});
+// The kind the flight software declares for a plant fault kind (stuck-on, stuck-off, degraded).
+std::string declared_kind(plant::FaultKind k);
 
 struct OutputPaths {
   std::string results_csv, summary_json, report_md;

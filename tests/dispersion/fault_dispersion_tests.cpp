@@ -3,6 +3,7 @@
 // reason, and a drawn fault reaches the plant (read back) and changes the flight.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <set>
 #include <tuple>
 
@@ -166,6 +167,49 @@ TEST(FaultDispersion, TheDrawnFaultReachesThePlantAndChangesTheFlight) {
   EXPECT_EQ(back.sampled.fault.kind, plant::FaultKind::kStuckOn);
   EXPECT_EQ(back.sampled.case_file, r.sampled.case_file);
   EXPECT_EQ(back.flown->faults, r.flown->faults);
+}
+
+// The fault-free reference of a case: the case as its draws fly it, without their fault, so the
+// draws' fuel penalty is the fault's alone.
+TEST(FaultDispersion, TheReferenceFliesTheCaseWithoutTheFault) {
+  Fixture f;
+  const DispersionSpec spec = load_spec(test::write_temp("ref.yaml", fault_spec("grid", 24)));
+  const Sampler sampler(spec, f.mission);
+  NoPlanner planner;
+  const std::optional<DrawParams> p = reference_params(spec, sampler, 0);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_FALSE(p->has_fault);
+  EXPECT_EQ(p->case_number, 1);
+  EXPECT_EQ(p->case_file, spec.faults.case_files[0]);
+  EXPECT_EQ(reference_params(spec, sampler, 1)->case_number, 5);
+  EXPECT_FALSE(reference_params(spec, sampler, 2).has_value());
+  const DrawResult ref = fly_reference(f.mission, f.gnc, spec, *p, planner);
+  ASSERT_TRUE(ref.flown.has_value());
+  EXPECT_EQ(ref.flown->faults, "none");
+  ASSERT_EQ(ref.runs.size(), 1u);
+  ASSERT_TRUE(ref.runs[0].total_fuel_kg.has_value());
+  // The same case through the campaign runner, independently: the same fuel to the bit.
+  config::RunSetup healthy =
+      config::load_case_run(f.mission, f.gnc, test::source("configs/cases/case1.yaml"));
+  campaign::FswFlightSide side;
+  campaign::RunOptions opt;
+  opt.duration_s = spec.duration_s;
+  const campaign::RunResult h =
+      campaign::run_closed_loop(healthy, spec.strategies[0], side, nullptr, opt);
+  EXPECT_EQ(*ref.runs[0].total_fuel_kg, h.total_fuel_kg);
+  // Draw 0 (thruster 3 stuck on at 5 s in case 1) costs more than its reference.
+  const DrawResult faulty = fly_draw(f.mission, f.gnc, spec, sampler, 0, planner);
+  EXPECT_GT(*faulty.runs[0].total_fuel_kg, *ref.runs[0].total_fuel_kg);
+  // Stored and read back as a draw file is.
+  const std::string root =
+      (std::filesystem::path(test::write_temp("ref.yaml", fault_spec("grid", 24))).parent_path() /
+       "refdir")
+          .string();
+  write_reference(root, ref);
+  const std::optional<DrawResult> back = read_reference(root, 1);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(to_json(*back, false), to_json(ref, false));
+  EXPECT_FALSE(read_reference(root, 5).has_value());
 }
 
 }  // namespace

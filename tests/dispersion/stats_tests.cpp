@@ -95,5 +95,102 @@ TEST(Summary, SuccessWorstAndPairedDifferencesOnSyntheticDraws) {
   EXPECT_LT(*s.crossovers[0].crossover_kg_m2, 1e6);
 }
 
+// A fault dispersion over two study cases: isolation counted per kind, onset and case against the
+// draw's injected fault, latency from onset, fuel penalty against the case's fault-free reference.
+TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheReference) {
+  DispersionSpec spec;
+  spec.name = "faults";
+  spec.strategies = {*campaign::parse_strategy("ntcl+dpd_ref")};
+  spec.faults.enabled = true;
+  spec.faults.kinds = {plant::FaultKind::kStuckOn, plant::FaultKind::kStuckOff};
+  spec.faults.onsets_s = {60.0};
+  spec.faults.case_numbers = {1, 5};
+  spec.faults.case_files = {"case1.yaml", "case5.yaml"};
+  struct Row {
+    int case_number;
+    plant::FaultKind kind;
+    int thruster;
+    int confirmed_thruster;  // -1 none
+    const char* confirmed_kind;
+    int confirmations;
+    double confirmed_at;
+    double fuel;
+    bool success;
+  };
+  const Row rows[] = {
+      {1, plant::FaultKind::kStuckOn, 3, 3, "stuck-on", 1, 62.0, 110.0, true},    // isolated, 2 s
+      {1, plant::FaultKind::kStuckOn, 4, 5, "stuck-on", 1, 61.0, 120.0, true},    // wrong thruster
+      {5, plant::FaultKind::kStuckOn, 6, 6, "stuck-on", 1, 70.0, 130.0, false},   // isolated, 10 s
+      {5, plant::FaultKind::kStuckOn, 7, 7, "stuck-on", 2, 64.0, 140.0, true},    // and another
+      {1, plant::FaultKind::kStuckOff, 0, 0, "stuck-on", 1, 90.0, 101.0, true},   // wrong kind
+      {5, plant::FaultKind::kStuckOff, 1, -1, "", 0, 0.0, 95.0, true},            // none
+  };
+  std::vector<DrawResult> draws;
+  int i = 0;
+  for (const Row& r : rows) {
+    DrawResult d;
+    d.index = i++;
+    d.sampled.case_number = r.case_number;
+    d.sampled.has_fault = true;
+    d.sampled.fault.kind = r.kind;
+    d.sampled.fault.thruster = r.thruster;
+    d.sampled.fault.onset_s = 60.0;
+    StrategyOutcome o = ok("ntcl+dpd_ref", r.fuel, r.success);
+    o.fdi.enabled = true;
+    o.fdi.confirmations = r.confirmations;
+    o.fdi.thruster = r.confirmed_thruster;
+    o.fdi.kind = r.confirmed_kind;
+    if (r.confirmations > 0) o.fdi.first_confirmation_s = r.confirmed_at;
+    d.runs = {o};
+    draws.push_back(d);
+  }
+  std::vector<DrawResult> refs(2);
+  refs[0].sampled.case_number = 1;
+  refs[0].runs = {ok("ntcl+dpd_ref", 100.0, true)};
+  refs[1].sampled.case_number = 5;
+  refs[1].runs = {ok("ntcl+dpd_ref", 90.0, true)};
+  const Summary s = summarize(spec, draws, refs);
+  ASSERT_EQ(s.references.size(), 2u);
+  auto group = [&](plant::FaultKind k, int c) -> const FaultGroupStats* {
+    for (const FaultGroupStats& g : s.faults) {
+      if (g.kind == plant::to_string(k) && g.case_number == c) return &g;
+    }
+    return nullptr;
+  };
+  const FaultGroupStats* on = group(plant::FaultKind::kStuckOn, 0);
+  ASSERT_NE(on, nullptr);
+  EXPECT_EQ(on->runs, 4);
+  EXPECT_EQ(on->successes, 3);
+  EXPECT_EQ(on->isolated, 2);
+  EXPECT_EQ(on->wrong, 2);
+  EXPECT_EQ(on->none, 0);
+  EXPECT_NEAR(*on->latency_s.p50, 6.0, 1e-12);  // 2 s and 10 s
+  EXPECT_NEAR(*on->latency_max_s, 10.0, 1e-12);
+  // Penalties: 10, 20 (case 1, reference 100) and 40, 50 (case 5, reference 90).
+  EXPECT_NEAR(*on->penalty_kg.p50, 30.0, 1e-12);
+  EXPECT_NEAR(*on->penalty_max_kg, 50.0, 1e-12);
+  const FaultGroupStats* on5 = group(plant::FaultKind::kStuckOn, 5);
+  ASSERT_NE(on5, nullptr);
+  EXPECT_EQ(on5->runs, 2);
+  EXPECT_EQ(on5->isolated, 1);
+  EXPECT_EQ(on5->wrong, 1);
+  const FaultGroupStats* off = group(plant::FaultKind::kStuckOff, 0);
+  ASSERT_NE(off, nullptr);
+  EXPECT_EQ(off->isolated, 0);
+  EXPECT_EQ(off->wrong, 1);
+  EXPECT_EQ(off->none, 1);
+  EXPECT_FALSE(off->latency_s.p50.has_value());
+  EXPECT_NEAR(*off->penalty_kg.p50, 3.0, 1e-12);  // 1 and 5
+  // Without references there is no penalty, and the counts are unchanged.
+  const Summary bare = summarize(spec, draws);
+  EXPECT_TRUE(bare.references.empty());
+  for (const FaultGroupStats& g : bare.faults) {
+    EXPECT_EQ(g.penalty_kg.n, 0);
+    if (g.kind == "stuck_on" && g.case_number == 0) {
+      EXPECT_EQ(g.isolated, 2);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rocksteady::dispersion

@@ -157,6 +157,13 @@ TEST(GncIdentification, AGateReinflationLeavesTheFaultDetectorItsModel) {
                               << loop.gnc.identifier().counters().windows << " mode "
                               << to_string(loop.out.telemetry.mode) << " |w| "
                               << loop.body.omega.norm();
+  // The telemetry shows the gate at work: the refused windows and the re-inflation (the tick's
+  // output is built after the identifier ran, so it carries the identifier's own counters).
+  const EstimationTelemetry& est = loop.out.telemetry.est;
+  EXPECT_EQ(est.windows_gated, loop.gnc.identifier().counters().windows_gated);
+  EXPECT_GE(est.windows_gated, static_cast<std::uint32_t>(p.identification.config.gate_reinflate_after));
+  EXPECT_EQ(est.gate_reinflations, 1u);
+  EXPECT_EQ(est.rate_bias_sigma, loop.gnc.identifier().estimate().gyro_bias_sigma);
   // Two windows later the detector still tests against the model it had.
   for (int k = 0; k < 2 * p.fdi.window_ticks + FaultDetector::kEvaluationSteps; ++k) loop.tick();
   EXPECT_LT(loop.out.telemetry.fdi.noise_sigma, 3.0 * noise_before)
@@ -260,6 +267,37 @@ TEST(GncMekf, SelectedEstimatorFliesTheLoopToHold) {
   EXPECT_LT((loop.out.telemetry.q_hat - mrp::from_quaternion(beta_at_sample)).norm(), 1e-6);
   EXPECT_LT(loop.gnc.mekf().bias().norm(), 1e-6);
   EXPECT_GT(loop.gnc.mekf().counters().updates, 100u);
+}
+
+// With the MEKF flying, the identifier carries the MEKF's gyro-bias 1 sigma (floored, and capped
+// at the data sheet's prior) as its consider parameter (gnc/estimation/README.md (I17)), and the
+// telemetry reports the sigma it carries: the prior before the first window, the MEKF's after.
+TEST(GncMekf, TheIdentifierCarriesTheMekfBiasSigmaAndTheTelemetryReportsIt) {
+  GncParams p = identifying_params(ModelAdoption::kOff);
+  p.estimator.kind = EstimatorKind::kMekf;
+  p.mekf.gyro_arw = 1e-6;
+  p.mekf.star_sigma = 1e-5;
+  const double prior = 3e-5;
+  p.identification.config.gyro_bias_sigma = prior;
+  p.identification.mekf_bias_sigma_floor = 1e-7;
+  ASSERT_TRUE(validate(p).ok);
+  test::SmallLoop loop(p);
+  ASSERT_TRUE(loop.gnc.init(p).ok);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  loop.tick(c);
+  EXPECT_EQ(loop.out.telemetry.est.rate_bias_sigma, Vec3::Constant(prior));
+  for (int k = 0; k < 400; ++k) loop.tick();  // five 2 s windows at 20 Hz
+  ASSERT_GE(loop.gnc.identifier().counters().windows, 4u);
+  const Vec3 carried = loop.out.telemetry.est.rate_bias_sigma;
+  EXPECT_EQ(carried, loop.gnc.identifier().estimate().gyro_bias_sigma);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(carried(a), 0.1 * prior);  // the MEKF's, far below the data sheet's
+    EXPECT_GE(carried(a), p.identification.mekf_bias_sigma_floor);
+    // The MEKF's bias sigma only shrinks, so the one latched a window ago bounds today's.
+    EXPECT_GE(carried(a), loop.gnc.mekf().bias_sigma()(a));
+  }
 }
 
 }  // namespace
