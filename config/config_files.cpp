@@ -154,6 +154,7 @@ GncConfig load_gnc(const std::string& path) {
     p.mekf.init_bias_sigma = r.positive("init_bias_sigma_rad_s");
     p.mekf.gate_chi2 = r.positive("gate_chi2");
     p.mekf.max_consecutive_rejects = r.integer("max_consecutive_rejects");
+    if (r.has("rate_cutoff_rad_s")) p.mekf.rate_cutoff = r.non_negative("rate_cutoff_rad_s");
     r.finish();
   }
 

@@ -14,6 +14,7 @@ void Gnc::configure_components() {
   const Mat3 j_hat = total_inertia(params_.mass_hat);  // Eq. (1) with the estimates
   filter_.configure(params_.estimator, j_hat, params_.dt);
   if (params_.estimator.kind == EstimatorKind::kMekf) mekf_.configure(build_mekf_config(params_));
+  mekf_.set_rate_model(j_hat);
   modes_.configure(params_.mode, params_.guidance.omega_switch);
   refs_.configure(params_.guidance, params_.dt);
   laws_.configure(law_gains(params_), j_hat, params_.dt);
@@ -395,6 +396,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     mi.gyro_valid = m.omega_valid;
     if (m.q_valid) mi.star_quat = sample.star_quat / qn;
     mi.star_valid = m.q_valid;
+    mi.torque = last_torque_;
     mekf_.update(mi);
     omega_hat = mekf_.omega();
     q_hat = mekf_.q();

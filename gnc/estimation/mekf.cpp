@@ -50,6 +50,7 @@ MekfConfigCheck validate(const MekfConfig& c) {
   if (!finite_positive(c.quat_norm_tolerance) || c.quat_norm_tolerance >= 1.0) {
     return bad("quat_norm_tolerance", "must be in (0, 1)");
   }
+  if (!finite_non_negative(c.rate_cutoff)) return bad("rate_cutoff", "must be >= 0 and finite");
   return {};
 }
 
@@ -67,7 +68,15 @@ void Mekf::configure(const MekfConfig& c) {
   q_.bottomLeftCorner<3, 3>() = q_.topRightCorner<3, 3>();
   q_.bottomRightCorner<3, 3>() = (u2 * dt) * Mat3::Identity();
   r_var_ = c.star_sigma * c.star_sigma;
-  reset();
+  rate_gain_ = c.rate_cutoff > 0.0 ? 1.0 - std::exp(-c.rate_cutoff * dt) : 1.0;
+  // A running filter keeps its estimate (a new parameter table, e.g. an adopted identified
+  // model, re-configures every component); reset() forgets it.
+  if (!initialised_) reset();
+}
+
+void Mekf::set_rate_model(const Mat3& j_hat) {
+  j_hat_ = j_hat;
+  j_hat_inv_ = j_hat.inverse();
 }
 
 void Mekf::reset() {
@@ -213,15 +222,33 @@ void Mekf::update(const MekfInput& in) {
     }
     return;
   }
-  // A missing gyro sample: hold the last one.
-  const Vec3 gyro = gyro_ok ? in.gyro_rate : last_gyro_;
+  // (M8) The rate stage's prediction through Eq. (2) with J_hat and the commanded torque (Heun).
+  const bool stage = c_.rate_cutoff > 0.0;
+  Vec3 predicted = omega_;
+  if (stage) {
+    auto w_dot = [&](const Vec3& w) -> Vec3 {
+      return j_hat_inv_ * ((j_hat_ * w).cross(w) + in.torque);
+    };
+    const Vec3 k1 = w_dot(omega_);
+    const Vec3 k2 = w_dot(omega_ + c_.dt * k1);
+    predicted = omega_ + 0.5 * c_.dt * (k1 + k2);
+  }
+  // A missing gyro sample: the stage's prediction when it runs (as a gyro would read it), else
+  // the last sample held.
+  const Vec3 gyro = gyro_ok ? in.gyro_rate : (stage ? Vec3(predicted + bias_) : last_gyro_);
   propagate(0.5 * (last_gyro_ + gyro));
   last_gyro_ = gyro;
   if (star_ok && in.t > last_star_t_) {
     last_star_t_ = in.t;
     star_update(in.star_quat / qn);
   }
-  omega_ = last_gyro_ - bias_;
+  const Vec3 measured = last_gyro_ - bias_;
+  // (M8) Correct towards the bias-corrected gyro: SPEC §6 step 3 on omega_gyro - b_hat.
+  if (stage) {
+    omega_ = gyro_ok ? Vec3(predicted + rate_gain_ * (measured - predicted)) : predicted;
+  } else {
+    omega_ = measured;
+  }
 }
 
 Vec3 Mekf::q() const {

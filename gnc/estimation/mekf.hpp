@@ -49,6 +49,11 @@ struct MekfConfig {
   // Sample acceptance (as the SPEC §6 filter): rate above this, or quaternion norm off by more.
   double gyro_max_rate{1.0};
   double quat_norm_tolerance{0.01};
+  // (M8) Rate output stage, rad/s. 0: omega_hat = omega_gyro - b_hat (the gyro's white noise
+  // unfiltered). > 0: omega_hat is predicted through Eq. (2) with the model J_hat
+  // (set_rate_model) and the commanded torque, then corrected towards omega_gyro - b_hat with the
+  // gain 1 - exp(-rate_cutoff dt): the SPEC §6 filter's rate step on the bias-corrected gyro.
+  double rate_cutoff{0.0};
 };
 
 struct MekfConfigCheck {
@@ -67,6 +72,7 @@ struct MekfInput {
   bool gyro_valid{false};
   Vec4 star_quat{0.0, 0.0, 0.0, 1.0};  // attitude of F_B in F_I, scalar last
   bool star_valid{false};
+  Vec3 torque{Vec3::Zero()};  // N m, commanded over the previous tick (the rate stage, M8)
 };
 
 struct MekfCounters {
@@ -78,8 +84,11 @@ struct MekfCounters {
 
 class Mekf {
  public:
-  // Takes a validated config (call validate() first; configure() does not re-check).
+  // Takes a validated config (call validate() first; configure() does not re-check). A filter
+  // that is running keeps its estimate and covariance; call reset() to forget them.
   void configure(const MekfConfig& c);
+  // The model of the rate stage (M8): J_hat, Eq. (1) with the estimates. Keeps the estimate.
+  void set_rate_model(const Mat3& j_hat);
   // Forget the estimate: the next valid gyro + star pair initialises it.
   void reset();
   // One tick: propagate over dt with the mean of the previous and this tick's gyro samples, then
@@ -89,7 +98,8 @@ class Mekf {
   bool initialised() const { return initialised_; }
   const Vec4& quaternion() const { return beta_; }  // beta_hat, scalar last
   Vec3 q() const;                                   // MRP, |q| <= 1 set
-  const Vec3& omega() const { return omega_; }      // omega_hat = omega_gyro - b_hat, rad/s
+  // omega_hat, rad/s: omega_gyro - b_hat, or the rate stage's estimate (M8) when rate_cutoff > 0.
+  const Vec3& omega() const { return omega_; }
   const Vec3& bias() const { return bias_; }        // b_hat, rad/s
   const Mat6& covariance() const { return p_; }     // [dtheta; db]
   Vec3 attitude_sigma() const;                      // rad, 1 sigma per body axis
@@ -118,6 +128,9 @@ class Mekf {
   Vec3 bias_{Vec3::Zero()};
   Vec3 omega_{Vec3::Zero()};
   Vec3 last_gyro_{Vec3::Zero()};
+  Mat3 j_hat_{Mat3::Identity()};  // the rate stage's model (M8)
+  Mat3 j_hat_inv_{Mat3::Identity()};
+  double rate_gain_{1.0};
   Mat6 p_{Mat6::Identity()};
   double last_star_t_{0.0};
   int consecutive_rejects_{0};

@@ -148,6 +148,17 @@ TEST(ConfigShipped, AllocatorKeyIsOptionalAndSelectsTheL1Allocator) {
   EXPECT_EQ(load_gnc(absent.path()).params.allocator, gnc::AllocatorKind::kPseudoInverse);
 }
 
+// The MEKF's rate stage (gnc/estimation/README.md (M8)): on at the SPEC §6 cutoff in the shipped
+// file, off (the raw gyro less the bias) when the key is absent, and a negative value is an error.
+TEST(ConfigShipped, MekfRateCutoffIsOptionalAndChecked) {
+  EXPECT_NEAR(load_gnc(kGnc).params.mekf.rate_cutoff, 0.02 * 3.141592653589793, 1e-15);
+  const std::string line = "  rate_cutoff_rad_s: 0.06283185307179587";
+  TempFile absent("gnc.yaml", replaced(read(kGnc), line, ""));
+  EXPECT_EQ(load_gnc(absent.path()).params.mekf.rate_cutoff, 0.0);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  rate_cutoff_rad_s: -1.0"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "mekf.rate_cutoff_rad_s", "must not be negative");
+}
+
 TEST(ConfigErrors, UnreadableFile) {
   const std::string missing = kConfigs + "/cases/no_such_case.yaml";
   expect_error([&] { load_case(missing); }, missing, "", "cannot read file");

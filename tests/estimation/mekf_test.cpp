@@ -11,6 +11,7 @@
 
 #include "estimation_truth.hpp"
 #include "gnc/estimation/mekf.hpp"
+#include "gnc/math/rotation.hpp"
 
 namespace rocksteady::gnc {
 namespace {
@@ -89,6 +90,8 @@ TEST(MekfConfig, NamesTheFirstBadField) {
       {[](MekfConfig& c) { c.max_consecutive_rejects = 0; }, "max_consecutive_rejects"},
       {[](MekfConfig& c) { c.gyro_max_rate = 0.0; }, "gyro_max_rate"},
       {[](MekfConfig& c) { c.quat_norm_tolerance = 1.0; }, "quat_norm_tolerance"},
+      {[](MekfConfig& c) { c.rate_cutoff = -0.1; }, "rate_cutoff"},
+      {[](MekfConfig& c) { c.rate_cutoff = INFINITY; }, "rate_cutoff"},
   };
   for (const Case& cs : cases) {
     MekfConfig c;
@@ -342,6 +345,109 @@ TEST(Mekf, AHeldStarSampleIsNotUsedTwiceAndBadInputIsCounted) {
   EXPECT_LT(f.omega().norm(), 1e-15);  // the last good gyro sample is held
 }
 
+
+// (M8) The rate stage on a torque-free tumble with the true J: the estimate is the model's
+// prediction pulled towards the bias-corrected gyro with gain K = 1 - exp(-w_r dt). Its error is
+// then the gyro's white noise through a first-order filter, whose variance ratio is K / (2 - K)
+// (closed form of y_k = (1 - K) y_{k-1} + K x_k with white x), against 1 for the raw gyro; the
+// bias error passes at unit gain in both, so the bias is known here (zero).
+TEST(Mekf, RateStageFiltersTheGyroNoiseToTheFirstOrderClosedForm) {
+  SensorNoise n;
+  n.gyro_arw = 1e-5;  // per-sample sigma 3.2e-5 rad/s, as study cases 6-7
+  n.star_sigma = 1e-4;
+  const Mat3 j = Vec3(3.0e7, 3.5e7, 4.0e7).asDiagonal();
+  double var_raw = 0.0, var_stage = 0.0;
+  int count = 0;
+  double gain = 0.0;
+  for (double cutoff : {0.0, 0.02 * 3.141592653589793}) {
+    MekfConfig c = config_for(n);
+    c.init_bias_sigma = 1e-9;  // the bias is known: the rate error is the white noise alone
+    c.rate_cutoff = cutoff;
+    ASSERT_TRUE(validate(c).ok);
+    RigidBody body;
+    body.j = j;
+    body.omega = Vec3(2e-2, -1e-2, 1.5e-2);
+    body.beta = test::axis_angle(Vec3(1, 2, 3), 0.7);
+    Sensors sensors(n, kDt, 77, Vec3::Zero());
+    Mekf f;
+    f.configure(c);
+    f.set_rate_model(j);
+    double sum = 0.0;
+    int samples = 0;
+    for (int k = 0; k < 20000; ++k) {
+      if (k > 0) body.step(kDt, Vec3::Zero());
+      f.update(input(k * kDt, sensors.gyro(body.omega), sensors.star(body.beta)));
+      if (k >= 2000) {  // after the stage's transient (time constant 16 s)
+        sum += (f.omega() - body.omega).squaredNorm() / 3.0;
+        ++samples;
+      }
+    }
+    (cutoff > 0.0 ? var_stage : var_raw) = sum / samples;
+    count = samples;
+    gain = 1.0 - std::exp(-cutoff * kDt);
+  }
+  const double white = n.gyro_arw * n.gyro_arw / kDt;
+  // The raw output carries the per-sample variance (3 x 18000 samples: within 3 %).
+  EXPECT_NEAR(var_raw / white, 1.0, 0.03) << count;
+  // The stage: K / (2 - K) = 3.1e-3 of it, an 18x smaller sigma. The filtered errors are
+  // correlated over ~1/K samples, so 18000 of them are ~110 independent ones: within 25 %.
+  const double expected = gain / (2.0 - gain);
+  EXPECT_NEAR(var_stage / white / expected, 1.0, 0.25)
+      << "stage " << var_stage << " expected " << expected * white;
+}
+
+// (M8) With the stage on, a missing gyro sample is carried by the model (Eq. 2 with the torque
+// commanded), not by the held sample: a body under a known constant torque. The attitude is
+// propagated with that rate too, so the star tracker keeps agreeing with it (nothing gated).
+TEST(Mekf, RateStageCarriesAMissingGyroSampleThroughTheModel) {
+  SensorNoise n;
+  n.gyro_arw = 1e-9;
+  n.star_sigma = 1e-6;
+  MekfConfig c = config_for(n);
+  c.init_bias_sigma = 1e-9;  // the bias is known: the stage's model alone carries the rate
+  c.rate_cutoff = 0.5;
+  const Mat3 j = Vec3(3.0e7, 3.5e7, 4.0e7).asDiagonal();
+  RigidBody body;
+  body.j = j;
+  body.omega = Vec3(1e-3, 0.0, 0.0);
+  body.beta = quat::identity();
+  const Vec3 torque(0.0, 300.0, -200.0);
+  Sensors sensors(n, kDt, 5, Vec3::Zero());
+  Mekf f;
+  f.configure(c);
+  f.set_rate_model(j);
+  for (int k = 0; k < 400; ++k) {
+    if (k > 0) body.step(kDt, torque);
+    MekfInput in = input(k * kDt, sensors.gyro(body.omega), sensors.star(body.beta));
+    in.torque = torque;
+    if (k >= 300) in.gyro_valid = false;  // the last 10 s without a gyro
+    f.update(in);
+  }
+  // 10 s of 300 N m on 3.5e7 kg m^2 is 8.6e-5 rad/s: the held sample would be that far off.
+  EXPECT_LT((f.omega() - body.omega).norm(), 1e-6) << (f.omega() - body.omega).transpose();
+  EXPECT_EQ(f.counters().gated, 0u);
+  EXPECT_EQ(f.counters().reinitialised, 0u);
+}
+
+// A running filter re-configured (a new parameter table re-configures every component) keeps its
+// estimate and covariance; reset() forgets them.
+TEST(Mekf, ReconfiguringARunningFilterKeepsItsEstimate) {
+  SensorNoise n;
+  const MekfConfig c = config_for(n);
+  Mekf kept;
+  run(n, c, 11, 600, Vec3(2e-5, -1e-5, 3e-5), [&](int, const Mekf& f, const RigidBody&, const Sensors&) {
+    kept = f;
+  });
+  ASSERT_TRUE(kept.initialised());
+  const Vec3 bias = kept.bias();
+  const Mat6 p = kept.covariance();
+  kept.configure(c);
+  EXPECT_TRUE(kept.initialised());
+  EXPECT_EQ(kept.bias(), bias);
+  EXPECT_EQ(kept.covariance(), p);
+  kept.reset();
+  EXPECT_FALSE(kept.initialised());
+}
 
 TEST(Mekf, HoldAttitudeErrorMatchesFarrenkopfSteadyState) {
   // Case 5 noise (SPEC §5) with a small bias random walk, body at rest (HOLD).
