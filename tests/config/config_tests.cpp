@@ -157,6 +157,10 @@ TEST(ConfigShipped, MekfRateCutoffIsOptionalAndChecked) {
   EXPECT_EQ(load_gnc(absent.path()).params.mekf.rate_cutoff, 0.0);
   TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  rate_cutoff_rad_s: -1.0"));
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "mekf.rate_cutoff_rad_s", "must not be negative");
+  // A case with a perfect gyro (cases 1-4) has no noise to filter: the stage is off there.
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(4)).flight.mekf.rate_cutoff, 0.0);
+  EXPECT_NEAR(load_run(kMission, kGnc, case_file(6)).flight.mekf.rate_cutoff,
+              0.02 * 3.141592653589793, 1e-15);
 }
 
 TEST(ConfigErrors, UnreadableFile) {
