@@ -111,6 +111,7 @@ int firmware_main() {
     g_params.estimator.kind = gnc::EstimatorKind::kMekf;
     g_params.mekf.gyro_arw = 1e-6;
     g_params.mekf.star_sigma = 4e-4;
+    g_params.mekf.rate_cutoff = 0.02 * 3.14159265358979323846;  // the rate stage (M8), as flown
     g_params.allocator = gnc::AllocatorKind::kL1;
     g_params.identification.enabled = true;
     g_params.identification.adopt = gnc::ModelAdoption::kAuto;
