@@ -552,7 +552,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       const bool healthy = (lim.lo.array() < 0.0).all() && (lim.hi.array() > 0.0).all() &&
                            (lim.bias.array() == 0.0).all();
       const IdentifierEstimate& e = ident_.estimate();
-      if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable)) {
+      const double identified_s =
+          static_cast<double>(ident_.counters().windows) * params_.identification.config.window_s;
+      if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable,
+                                    identified_s)) {
         excite_status_ = excite_.apply(excite_.force(ident_.counters().windows), lim.lo, lim.hi,
                                        params_.dt, u);
       }

@@ -20,6 +20,9 @@ ExcitationConfigCheck validate(const ExcitationConfig& c) {
   if (!(std::isfinite(c.duration_s) && c.duration_s >= 0.0)) {
     return {false, "identification.excitation.duration_s", "must be >= 0 and finite"};
   }
+  if (!(std::isfinite(c.start_after_s) && c.start_after_s >= 0.0)) {
+    return {false, "identification.excitation.start_after_s", "must be >= 0 and finite"};
+  }
   if (!finite_positive(c.r_sigma_stop_m)) {
     return {false, "identification.excitation.r_sigma_stop_m", "must be positive and finite"};
   }
@@ -104,8 +107,9 @@ void IdentificationExcitation::step_model() {
   ++stage_;
 }
 
-bool IdentificationExcitation::wanted(double max_r_sigma, int unobservable) const {
-  return config_.enabled && ready() && n_directions_ > 0 && elapsed_ < config_.duration_s &&
+bool IdentificationExcitation::wanted(double max_r_sigma, int unobservable,
+                                      double identified_s) const {
+  return config_.enabled && ready() && n_directions_ > 0 && identified_s >= config_.start_after_s && elapsed_ < config_.duration_s &&
          (unobservable > 0 || !(max_r_sigma <= config_.r_sigma_stop_m));
 }
 

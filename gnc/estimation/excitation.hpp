@@ -37,6 +37,9 @@ struct ExcitationConfig {
   Vec3 force_n{100.0, 100.0, 400.0};
   double duration_s{600.0};     // at most this long in all (s of excitation)
   double r_sigma_stop_m{0.005}; // stop once every 1 sigma of r_hat is below this (and none unobservable)
+  // Start only after this much identification (closed windows times their length, s): the first
+  // windows, with r_hat still up to 1 m off, would fit the excitation's torque into J (README §I.6).
+  double start_after_s{0.0};
 };
 
 struct ExcitationConfigCheck {
@@ -68,10 +71,11 @@ class IdentificationExcitation {
   // One stage of the model computation (no-op once ready). Call once a tick.
   void step_model();
   bool ready() const { return stage_ == kModelStages && valid_; }
-  // Whether the excitation should run: enabled, model ready, less than duration_s spent, and r not
-  // yet known to r_sigma_stop_m in every direction (max_r_sigma: largest 1 sigma of r_hat;
-  // unobservable: directions of r the data have not shown).
-  bool wanted(double max_r_sigma, int unobservable) const;
+  // Whether the excitation should run: enabled, model ready, at least start_after_s of
+  // identification done (identified_s), less than duration_s spent, and r not yet known to
+  // r_sigma_stop_m in every direction (max_r_sigma: largest 1 sigma of r_hat; unobservable:
+  // directions of r the data have not shown).
+  bool wanted(double max_r_sigma, int unobservable, double identified_s) const;
   // The force of window `window_index` (I24): +x, -x, +y, -y, +z, -z with the axes' amplitudes
   // (axes at zero amplitude skipped).
   Vec3 force(std::uint32_t window_index) const;

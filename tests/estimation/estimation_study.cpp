@@ -138,7 +138,8 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
       ++m;
     }
     Vec8 u = allocate(b_hat, dpd(s.gyro.rate, s.star.quat, pd), run.flight.rcs.u_max);
-    if (ex.wanted(id.estimate().r_sigma.maxCoeff(), id.observability().offset_unobservable)) {
+    if (ex.wanted(id.estimate().r_sigma.maxCoeff(), id.observability().offset_unobservable,
+                  static_cast<double>(id.counters().windows) * c.window_s)) {
       const gnc::ExcitationStatus xs = ex.apply(ex.force(id.counters().windows), lo, hi, c.dt, u);
       gamma_sum += xs.gamma;
       ++excited_ticks;
@@ -164,8 +165,8 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
 
 // The seven cases without and with the excitation: markdown rows for the design note.
 void excitation_table(const std::string& dir, const gnc::ExcitationConfig& x) {
-  std::printf("excitation F (%.0f, %.0f, %.0f) N, at most %.0f s, stop at r 1s %.3f m%s\n",
-              x.force_n(0), x.force_n(1), x.force_n(2), x.duration_s, x.r_sigma_stop_m,
+  std::printf("excitation F (%.0f, %.0f, %.0f) N, after %.0f s, at most %.0f s, stop at r 1s %.3f m%s\n",
+              x.force_n(0), x.force_n(1), x.force_n(2), x.start_after_s, x.duration_s, x.r_sigma_stop_m,
               g_estimate_bias ? ", gyro bias estimated" : "");
   std::printf("| case | excitation | 60 s | 300 s | 600 s | 1000 s | 3000 s | fuel 3000 s (kg) | excited (s) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
@@ -267,7 +268,10 @@ int main(int argc, char** argv) {
   }
   const std::string dir = argv[1];
   if (argc > 2) {
-    gnc::ExcitationConfig x;
+    // The flight's excitation settings (gnc.yaml), then the command line's.
+    gnc::ExcitationConfig x =
+        config::load_run(dir + "/mission.yaml", dir + "/gnc.yaml", dir + "/cases/case1.yaml")
+            .flight.identification.excitation;
     x.enabled = true;
     if (argc > 3) {  // "F" or "Fx,Fy,Fz"
       const std::string a = argv[3];

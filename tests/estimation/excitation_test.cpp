@@ -105,27 +105,37 @@ TEST(IdentificationExcitation, CyclesSixDirectionsOnePerWindow) {
 TEST(IdentificationExcitation, StaysOffUntilTheBasisIsReadyAndStopsWhenROrTimeIsDone) {
   Rig rig;
   Vec8 u = Vec8::Zero();
-  EXPECT_FALSE(rig.ex.wanted(1.0, 3));  // basis not computed yet
+  EXPECT_FALSE(rig.ex.wanted(1.0, 3, 0.0));  // basis not computed yet
   const ExcitationStatus s0 =
       rig.ex.apply(rig.ex.force(0), Vec8::Constant(-200), Vec8::Constant(200), 0.1, u);
   EXPECT_FALSE(s0.active);
   EXPECT_EQ(u, Vec8::Zero());
   rig.ready();
-  EXPECT_TRUE(rig.ex.wanted(1.0, 3));
-  EXPECT_TRUE(rig.ex.wanted(0.004, 1));   // a direction still unobservable
-  EXPECT_TRUE(rig.ex.wanted(0.006, 0));   // above the stop sigma
-  EXPECT_FALSE(rig.ex.wanted(0.004, 0));  // known well enough
+  EXPECT_TRUE(rig.ex.wanted(1.0, 3, 0.0));
+  EXPECT_TRUE(rig.ex.wanted(0.004, 1, 0.0));   // a direction still unobservable
+  EXPECT_TRUE(rig.ex.wanted(0.006, 0, 0.0));   // above the stop sigma
+  EXPECT_FALSE(rig.ex.wanted(0.004, 0, 0.0));  // known well enough
+  // The start delay: not before start_after_s of identification.
+  {
+    ExcitationConfig c = rig.ex.config();
+    c.start_after_s = 60.0;
+    rig.ex.configure(c);
+    EXPECT_FALSE(rig.ex.wanted(1.0, 3, 40.0));
+    EXPECT_TRUE(rig.ex.wanted(1.0, 3, 60.0));
+    c.start_after_s = 0.0;
+    rig.ex.configure(c);
+  }
   // The duration cap.
   for (int k = 0; k < 6000; ++k) {
     u.setZero();
     rig.ex.apply(rig.ex.force(0), Vec8::Constant(-200), Vec8::Constant(200), 0.1, u);
   }
-  EXPECT_FALSE(rig.ex.wanted(1.0, 3));
+  EXPECT_FALSE(rig.ex.wanted(1.0, 3, 0.0));
   rig.ex.restart();
-  EXPECT_TRUE(rig.ex.wanted(1.0, 3));
+  EXPECT_TRUE(rig.ex.wanted(1.0, 3, 0.0));
   // A new model switches it off until its basis is ready again.
   rig.ex.set_model(torque_matrix(rig.rcs, rig.r_hat + Vec3(0.1, 0, 0)), rig.rcs);
-  EXPECT_FALSE(rig.ex.wanted(1.0, 3));
+  EXPECT_FALSE(rig.ex.wanted(1.0, 3, 0.0));
 }
 
 // The study's saturating allocation: Eq. (53) rescaled so that the peak channel sits at u_max.
@@ -197,6 +207,9 @@ TEST(IdentificationExcitation, ConfigValidationNamesTheField) {
   c = ExcitationConfig{};
   c.r_sigma_stop_m = std::nan("");
   EXPECT_STREQ(validate(c).field, "identification.excitation.r_sigma_stop_m");
+  c = ExcitationConfig{};
+  c.start_after_s = -1.0;
+  EXPECT_STREQ(validate(c).field, "identification.excitation.start_after_s");
 }
 
 }  // namespace

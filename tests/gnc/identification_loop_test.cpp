@@ -264,6 +264,7 @@ DespinRun despin_identification(bool excite, AllocatorKind allocator) {
   id.config.gate_chi2 = 16.27;
   id.excitation.enabled = excite;
   id.excitation.force_n = Vec3(100.0, 100.0, 400.0);
+  id.excitation.start_after_s = 60.0;  // the flight setting (gnc.yaml)
   EXPECT_TRUE(loop.gnc.init(p).ok);
   GncCommands c;
   c.has_mode_request = true;
