@@ -541,7 +541,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
   }
-  // 5b. Identification excitation (gnc/estimation/README.md §I.6, I22-I27): a net force in the
+  // 5b. Identification excitation (gnc/estimation/README.md §I.6, X1-X6): a net force in the
   // null space of B_hat, added within the channels' box, while r is not yet known. Healthy RCS
   // only (no latched fault, no closed valve, no suspicion); the torque on the model is unchanged.
   excite_status_ = ExcitationStatus{};

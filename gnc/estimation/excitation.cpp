@@ -61,7 +61,7 @@ void IdentificationExcitation::step_model() {
       g_inv_ = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
       break;
     }
-    case 2:  // N = M' G^-1 [0; I3]   (I23), and H = G^-1 M for the projector
+    case 2:  // N = M' G^-1 [0; I3]   (X2), and H = G^-1 M for the projector
       n_ = m_.transpose() * g_inv_.rightCols<3>();
       h_ = g_inv_ * m_;
       break;
@@ -115,7 +115,7 @@ bool IdentificationExcitation::wanted(double max_r_sigma, int unobservable,
 
 Vec3 IdentificationExcitation::force(std::uint32_t window_index) const {
   if (n_directions_ == 0) return Vec3::Zero();
-  return directions_[window_index % static_cast<std::uint32_t>(n_directions_)];  // (I24)
+  return directions_[window_index % static_cast<std::uint32_t>(n_directions_)];  // (X3)
 }
 
 ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, const Vec8& hi,
@@ -125,8 +125,8 @@ ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, 
   if (!ready()) return s;
   s.active = true;
   elapsed_ += dt;
-  Vec8 du = n_ * f;  // (I23), z = 0
-  // (I25) A channel already at its bound that du would push further leaves the excitation: the
+  Vec8 du = n_ * f;  // (X2), z = 0
+  // (X4) A channel already at its bound that du would push further leaves the excitation: the
   // kernel Z moves the null-space force off it (up to two such channels; more leave it to gamma).
   int blocked[2] = {-1, -1};
   int nb = 0;
@@ -159,7 +159,7 @@ ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, 
     }
   }
   s.blocked = static_cast<std::uint8_t>(nb);
-  // (I26) the largest fraction of du that fits every channel's box.
+  // (X5) the largest fraction of du that fits every channel's box.
   double gamma = 1.0;
   for (int i = 0; i < kChannels; ++i) {
     if (du(i) > 0.0) gamma = std::min(gamma, std::max(0.0, hi(i) - u(i)) / du(i));

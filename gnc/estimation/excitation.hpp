@@ -1,17 +1,17 @@
-// Identification excitation (gnc/estimation/README.md §I.6, Eqs. I22-I27): a deliberate net force
+// Identification excitation (gnc/estimation/README.md §I.6, Eqs. X1-X6): a deliberate net force
 // added to the allocator's channel forces in the null space of the model's torque map B_hat, so it
 // makes no torque on the current model (the control law is not disturbed), while a wrong r_hat
 // turns it into the torque (r - r_hat) x F that the identifier needs to see r (§I.3 item 2).
 //
 // Per physical channel c the "+" thruster pushes along d_c, so the channels' net force is E u with
 // E = [d_0 ... d_7] (3x8). The excitation is
-//   Delta u = N F + Z z,   [B_hat; E] N = [0; I3],   [B_hat; E] Z = 0          (I23)
+//   Delta u = N F + Z z,   [B_hat; E] N = [0; I3],   [B_hat; E] Z = 0          (X2)
 // N is the minimum-norm right inverse's force block and Z (8x2) an orthonormal basis of the
 // kernel of M = [B_hat; E] (rank 6 for the SPEC §4 layout). z = 0 unless a channel already sits at
 // its bound and Delta u would push it further: then z removes that channel (up to two) from the
-// excitation (I25), and a last scale gamma in [0, 1] keeps every channel in its box (I26).
+// excitation (X4), and a last scale gamma in [0, 1] keeps every channel in its box (X5).
 // The force F cycles through +x, -x, +y, -y, +z, -z (F_B), one direction per identification
-// window (I24): every component of r is normal to four of the six, and a constant unmodelled
+// window (X3): every component of r is normal to four of the six, and a constant unmodelled
 // torque (a gyro bias's gyroscopic term, a disturbance) cancels between a window and the next.
 //
 // N and Z depend only on B_hat and E: they are computed once per model change, spread over
@@ -33,7 +33,7 @@ using Mat82 = Eigen::Matrix<double, kChannels, 2>;
 
 struct ExcitationConfig {
   bool enabled{false};          // off for the study's strategies
-  // Amplitude of F along each body axis, N (I27 sizes it); an axis at 0 is left out of the cycle.
+  // Amplitude of F along each body axis, N (X6 sizes it); an axis at 0 is left out of the cycle.
   Vec3 force_n{100.0, 100.0, 400.0};
   double duration_s{600.0};     // at most this long in all (s of excitation)
   double r_sigma_stop_m{0.005}; // stop once every 1 sigma of r_hat is below this (and none unobservable)
@@ -53,8 +53,8 @@ ExcitationConfigCheck validate(const ExcitationConfig& c);
 struct ExcitationStatus {
   bool active{false};          // the excitation was asked for this tick
   Vec3 force{Vec3::Zero()};    // net force asked, N (F_B)
-  double gamma{0.0};           // the fraction that fitted the channels' box (I26)
-  std::uint8_t blocked{0};     // channels removed from the excitation at their bound (I25)
+  double gamma{0.0};           // the fraction that fitted the channels' box (X5)
+  std::uint8_t blocked{0};     // channels removed from the excitation at their bound (X4)
 };
 
 class IdentificationExcitation {
@@ -76,11 +76,11 @@ class IdentificationExcitation {
   // r_sigma_stop_m in every direction (max_r_sigma: largest 1 sigma of r_hat; unobservable:
   // directions of r the data have not shown).
   bool wanted(double max_r_sigma, int unobservable, double identified_s) const;
-  // The force of window `window_index` (I24): +x, -x, +y, -y, +z, -z with the axes' amplitudes
+  // The force of window `window_index` (X3): +x, -x, +y, -y, +z, -z with the axes' amplitudes
   // (axes at zero amplitude skipped).
   Vec3 force(std::uint32_t window_index) const;
   // Adds the excitation for net force f to the allocated channel forces u (effective force, as
-  // B_hat multiplies) within lo <= u <= hi (I25, I26), and counts dt of excitation time. Returns
+  // B_hat multiplies) within lo <= u <= hi (X4, X5), and counts dt of excitation time. Returns
   // what was done; u is unchanged when !ready().
   ExcitationStatus apply(const Vec3& f, const Vec8& lo, const Vec8& hi, double dt, Vec8& u);
   // Seconds of excitation spent so far.
@@ -88,8 +88,8 @@ class IdentificationExcitation {
   // Back to no excitation spent (a declared change: r must be learned again).
   void restart() { elapsed_ = 0.0; }
 
-  const Mat83& force_map() const { return n_; }  // N of (I23)
-  const Mat82& kernel() const { return z_; }     // Z of (I23)
+  const Mat83& force_map() const { return n_; }  // N of (X2)
+  const Mat82& kernel() const { return z_; }     // Z of (X2)
 
  private:
   ExcitationConfig config_{};

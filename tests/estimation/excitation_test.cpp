@@ -52,7 +52,7 @@ struct Rig {
 TEST(IdentificationExcitation, IsTorqueFreeOnTheModelAndMakesTheAskedForce) {
   Rig rig;
   rig.ready();
-  // (I23) closed form: B_hat N = 0, E N = I, B_hat Z = E Z = 0, Z orthonormal.
+  // (X2) closed form: B_hat N = 0, E N = I, B_hat Z = E Z = 0, Z orthonormal.
   for (int k = 0; k < 3; ++k) {
     const Vec8 n = rig.ex.force_map().col(k);
     EXPECT_LT(torque_of(rig.rcs, rig.r_hat, n).norm(), 1e-9) << "column " << k;
@@ -140,7 +140,7 @@ TEST(IdentificationExcitation, StaysOffUntilTheBasisIsReadyAndStopsWhenROrTimeIs
 
 // The study's saturating allocation: Eq. (53) rescaled so that the peak channel sits at u_max.
 // The excitation never leaves the box, keeps the torque, makes gamma F; the channel at its bound
-// is taken out of the excitation (I25), so gamma stays large where z = 0 would have to give 0.
+// is taken out of the excitation (X4), so gamma stays large where z = 0 would have to give 0.
 TEST(IdentificationExcitation, KeepsTheChannelBoundsWhenTheAllocationSaturates) {
   Rig rig(150.0);
   rig.ready();
