@@ -205,6 +205,19 @@ GncConfig load_gnc(const std::string& path) {
     ic.j_confident_rel = r.positive("inertia_confident_rel");
     ic.r_confident = r.positive("offset_confident_m");
     ic.k_confident = r.positive("strength_confident");
+    if (r.has("excitation")) {  // README §I.6 (optional; off when absent)
+      MapReader x = r.map("excitation");
+      gnc::ExcitationConfig& xc = id.excitation;
+      xc.enabled = x.boolean("enabled");
+      xc.force_n = x.vec3("force_n");
+      if (!(xc.force_n.minCoeff() >= 0.0 && xc.force_n.maxCoeff() > 0.0)) {
+        x.fail("force_n", "every amplitude must be >= 0 and one > 0");
+      }
+      xc.duration_s = x.non_negative("duration_s");
+      xc.r_sigma_stop_m = x.positive("r_sigma_stop_m");
+      if (x.has("start_after_s")) xc.start_after_s = x.non_negative("start_after_s");
+      x.finish();
+    }
     r.finish();
   }
 

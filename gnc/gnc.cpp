@@ -21,6 +21,13 @@ void Gnc::configure_components() {
   // B_hat from the estimated r_SO/BCM (SPEC §4); validate() has checked its rank.
   alloc_.configure(torque_matrix(params_.rcs, params_.mass_hat.r_so_bcm), params_.rcs.u_max,
                    params_.allocator);
+  // The excitation's null-space basis follows the table's B_hat; computed over the next ticks
+  // (IdentificationExcitation::step_model), off until then.
+  if (excitation_on()) excite_.set_model(alloc_.b_hat(), params_.rcs);
+}
+
+bool Gnc::excitation_on() const {
+  return params_.identification.enabled && params_.identification.excitation.enabled;
 }
 
 ParamCheck Gnc::init(const GncParams& params) {
@@ -33,6 +40,10 @@ ParamCheck Gnc::init(const GncParams& params) {
   // The identifier starts from this table's model as its prior; a later table switch keeps its
   // estimate (set_params).
   if (params_.identification.enabled) ident_.configure(build_identifier_config(params_));
+  excite_.configure(params_.identification.excitation);
+  excite_.restart();
+  if (excitation_on()) excite_.set_model(alloc_.b_hat(), params_.rcs);
+  excite_status_ = ExcitationStatus{};
   fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
   fdi_.clear(-1);
   valve_open_ = {{true, true, true, true}};
@@ -100,7 +111,9 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
     mekf_.reset();
   }
   if (!params_.identification.enabled) candidate_status_ = ModelCandidate::kDisabled;
+  excite_.configure(params_.identification.excitation);  // keeps the excitation time spent
   if (identification_started) {
+    excite_.restart();
     ident_.configure(build_identifier_config(params_));
     candidate_status_ = ModelCandidate::kNotConfident;
     candidate_windows_ = 0;
@@ -108,6 +121,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   } else if (model_changed && declared_change) {
     candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
     ident_.reinflate_all();
+    excite_.restart();  // r is to be learned again
   }
   release_fault_model();
   refresh_fault_model();
@@ -448,6 +462,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // window is evaluated is held by the detector until the evaluation ends (F10). The refresh
     // (a 3x3 inverse and eigenvalues, 16 columns) waits for a tick that neither latches the
     // identifier's window nor carries a heavy step of the detector.
+    // The excitation's basis stages (after a model change) take the same quiet ticks.
+    excite_quiet_ = !fdi_busy && !window_latched;
     if (fault_model_stale_ && !fdi_busy && !window_latched) {
       refresh_fault_model();
       fault_model_stale_ = false;
@@ -513,8 +529,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   Vec8 u = Vec8::Zero();
   AllocatorStatus status;
   const bool enabled = actuating(modes_.mode());
+  AllocatorLimits limits;
   if (enabled) {
-    alloc_.allocate(u_c, allocation_limits(), u, status);
+    limits = allocation_limits();
+    alloc_.allocate(u_c, limits, u, status);
     if (status.reduced_authority && !reduced_reported_) {
       out.events.push(ModeEvent{EventId::kReducedAuthority, modes_.mode(), modes_.mode(),
                                 TransitionCheck::kOk, static_cast<std::int16_t>(status.rank),
@@ -524,6 +542,26 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   } else {
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
+  }
+  // 5b. Identification excitation (gnc/estimation/README.md §I.6, X1-X6): a net force in the
+  // null space of B_hat, added within the channels' box, while r is not yet known. Healthy RCS
+  // only (no latched fault, no closed valve, no suspicion); the torque on the model is unchanged.
+  excite_status_ = ExcitationStatus{};
+  if (excitation_on()) {
+    if (excite_quiet_) excite_.step_model();
+    if (enabled && !(params_.fdi.enabled && fdi_.suspecting())) {
+      const AllocatorLimits& lim = limits;
+      const bool healthy = (lim.lo.array() < 0.0).all() && (lim.hi.array() > 0.0).all() &&
+                           (lim.bias.array() == 0.0).all();
+      const IdentifierEstimate& e = ident_.estimate();
+      const double identified_s =
+          static_cast<double>(ident_.counters().windows) * params_.identification.config.window_s;
+      if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable,
+                                    identified_s)) {
+        excite_status_ = excite_.apply(excite_.force(ident_.counters().windows), lim.lo, lim.hi,
+                                       params_.dt, u);
+      }
+    }
   }
   Vec8 force = Vec8::Zero();
   for (int c = 0; c < kChannels; ++c) {

@@ -64,9 +64,13 @@ class Gnc {
   // (gnc/fdi/README.md (F9)).
   std::array<bool, kPods> commanded_valves() const;
   std::uint32_t model_adoptions() const { return adoptions_; }
+  // The identification excitation (gnc/estimation/README.md §I.6) and what it did this tick.
+  const IdentificationExcitation& excitation() const { return excite_; }
+  const ExcitationStatus& excitation_status() const { return excite_status_; }
 
  private:
   void configure_components();
+  bool excitation_on() const;  // identification and its excitation both enabled
   // Validate and install; declared_change: a table from outside (the identifier re-inflates).
   ParamCheck apply_params(const GncParams& params, bool declared_change);
   bool differs(const GncParams& p, const IdentifiedModel& m) const;  // beyond the confidence bounds
@@ -82,6 +86,9 @@ class Gnc {
   StateFilter filter_{};
   Mekf mekf_{};
   Identifier ident_{};
+  IdentificationExcitation excite_{};
+  ExcitationStatus excite_status_{};
+  bool excite_quiet_{false};  // this tick neither latches a window nor carries a detector step
   FaultDetector fdi_{};
   std::array<bool, kPods> valve_open_{{true, true, true, true}};  // commanded this tick
   std::array<bool, kPods> last_valve_{{true, true, true, true}};  // over the previous tick

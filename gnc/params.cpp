@@ -200,6 +200,10 @@ ParamCheck validate(const GncParams& p) {
     const IdentifierConfigCheck ic = validate(build_identifier_config(p));
     if (!ic.ok) return bad(ic.field, ic.reason);
   }
+  if (id.excitation.enabled) {
+    const ExcitationConfigCheck xc = validate(id.excitation);
+    if (!xc.ok) return bad(xc.field, xc.reason);
+  }
 
   if (p.fdi.enabled) {
     const Check fc = validate(p.fdi);

@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 
+#include "gnc/estimation/excitation.hpp"
 #include "gnc/model/rcs.hpp"
 #include "gnc/types.hpp"
 
@@ -379,6 +380,9 @@ struct IdentificationParams {
   // The identifier's tuning. Its dt, thruster geometry and priors (j0, r0, k0) are not read from
   // here: they are the active table's dt, rcs and mass_hat, filled in by build_identifier_config.
   IdentifierConfig config{};
+  // Identification excitation (README §I.6): a torque-free net force while r is not yet known.
+  // Needs `enabled` above; off by default (the study's strategies).
+  ExcitationConfig excitation{};
 };
 
 }  // namespace rocksteady::gnc

@@ -33,6 +33,7 @@ gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& stra
   if (strategy.identify) {
     p.identification.enabled = true;
     p.identification.adopt = gnc::ModelAdoption::kAuto;
+    if (strategy.excite) p.identification.excitation.enabled = true;
   }
   if (strategy.fdi) p.fdi.enabled = true;
   return p;

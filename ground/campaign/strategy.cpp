@@ -47,9 +47,11 @@ std::optional<Strategy> parse_strategy(const std::string& name) {
   while (at != std::string::npos) {
     const std::size_t next = name.find(':', at + 1);
     const std::string mod = name.substr(at + 1, next == std::string::npos ? next : next - at - 1);
-    bool& flag = mod == "mekf" ? s->mekf : mod == "id" ? id_given : s->fdi;
-    if ((mod != "mekf" && mod != "id" && mod != "fdi") || flag) return std::nullopt;
-    if (mod == "id") s->identify = true;
+    const bool id_mod = mod == "id" || mod == "idx";
+    bool& flag = mod == "mekf" ? s->mekf : id_mod ? id_given : s->fdi;
+    if ((mod != "mekf" && !id_mod && mod != "fdi") || flag) return std::nullopt;
+    if (id_mod) s->identify = true;
+    if (mod == "idx") s->excite = true;
     flag = true;
     at = next;
   }

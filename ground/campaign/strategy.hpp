@@ -25,9 +25,11 @@ struct Strategy {
   ReferenceKind reference{ReferenceKind::kDpdRef};
   PlanHorizon horizon{PlanHorizon::kDefault};
   // Modifiers beyond the study (name suffixes): ":mekf" flies the MEKF instead of the case's
-  // estimator; ":id" runs the on-line identification with automatic model adoption.
+  // estimator; ":id" runs the on-line identification with automatic model adoption; ":idx" the
+  // same with the identification excitation (gnc/estimation/README.md §I.6).
   bool mekf{false};
   bool identify{false};
+  bool excite{false};
   bool fdi{false};  // ":fdi": thruster fault detection and isolation on
   // A plan before the run (uplinked before the first tick).
   bool needs_trajectory() const { return reference == ReferenceKind::kFuelOptimal; }
@@ -38,7 +40,8 @@ struct Strategy {
 // Laws: ntcl, el, integral, adaptive, so3, feedforward; references: dpd_ref, fuel_optimal,
 // fuel_optimal_study (the fuel-optimal plan with the study's horizon), replan (identification on
 // the D+PD reference, then on-line fuel-optimal re-planning; implies ":id"); optional suffixes ":mekf",
-// ":id" and ":fdi" in any order ("ntcl+dpd_ref:mekf:id", "dpd:id:fdi").
+// ":id" (or ":idx", with the identification excitation) and ":fdi" in any order
+// ("ntcl+dpd_ref:mekf:id", "dpd:idx:fdi").
 std::optional<Strategy> parse_strategy(const std::string& name);
 // The six columns of the study's results table, in its order.
 const std::vector<std::string>& study_strategy_names();

@@ -60,6 +60,13 @@ TEST(ReplanStrategy, NameParsesWithIdentificationImplied) {
   EXPECT_TRUE(parse_strategy("ntcl+replan:mekf").has_value());
   EXPECT_FALSE(parse_strategy("ntcl+replan:id:id").has_value());
   EXPECT_FALSE(parse_strategy("dpd+replan").has_value());  // D+PD cannot track
+  // ":idx": identification with its excitation (gnc/estimation/README.md §I.6); one of the two.
+  const auto x = parse_strategy("dpd:idx");
+  ASSERT_TRUE(x.has_value());
+  EXPECT_TRUE(x->identify);
+  EXPECT_TRUE(x->excite);
+  EXPECT_FALSE(parse_strategy("dpd:id")->excite);
+  EXPECT_FALSE(parse_strategy("dpd:id:idx").has_value());
 }
 
 // The latency: every plan made from the telemetry at t reaches the flight no earlier than

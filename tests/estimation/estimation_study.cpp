@@ -4,6 +4,9 @@
 // Farrenkopf steady state. Ground tool: prints a table, asserts nothing.
 //
 //   estimation_study CONFIG_DIR
+//   estimation_study CONFIG_DIR excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M]]]
+//     the seven cases with the flight's identifier settings, without and with the identification
+//     excitation (README §I.6), and the fuel each run spent
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -11,6 +14,7 @@
 #include <Eigen/Dense>
 
 #include "estimation_truth.hpp"
+#include "gnc/estimation/excitation.hpp"
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/estimation/mekf.hpp"
 #include "gnc/estimation/state_filter.hpp"
@@ -42,14 +46,27 @@ Vec3 dpd(const Vec3& omega, const Vec4& beta, bool& pd) {
   return pd ? Vec3(-10.0 * b.head<3>() - 1e4 * omega) : Vec3(-1e4 * omega);
 }
 
+bool g_estimate_bias = false;  // "estimate_bias" on the command line: b estimated, not considered
+
 struct Errors {
-  double j, r, k, j_sigma_rel, r_sigma, nees_j, nees_r;
+  double j, r, k, j_sigma_rel, r_sigma, nees_j, nees_r, r_sigma_max;
+};
+
+struct Outcome {
+  Errors e[5];
+  double fuel_kg{0.0};
+  double excitation_s{0.0};
+  double gamma_mean{0.0};
 };
 
 // window_s <= 0: the flight's window for the case (gnc.yaml, quiet or noisy sensors).
 // gyro_bias > 0: the plant's gyro gets a constant bias of that norm.
-void identification(const std::string& dir, int case_number, gnc::IdentifierMode mode,
-                    double window_s, double k_prior_sigma, double gyro_bias = 0.0) {
+// excitation: the identification excitation's settings (README §I.6); off unless enabled.
+Outcome identification(const std::string& dir, int case_number, gnc::IdentifierMode mode,
+                       double window_s, double k_prior_sigma, double gyro_bias = 0.0,
+                       const gnc::ExcitationConfig& excitation = gnc::ExcitationConfig{},
+                       bool print = true) {
+  Outcome out;
   config::RunSetup run =
       config::load_run(dir + "/mission.yaml", dir + "/gnc.yaml",
                        dir + "/cases/case" + std::to_string(case_number) + ".yaml");
@@ -76,18 +93,26 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
   c.gate_chi2 = run.flight.identification.config.gate_chi2;
   c.second_order_noise = run.flight.identification.config.second_order_noise;
   c.gate_reinflate_after = run.flight.identification.config.gate_reinflate_after;
+  c.gyro_bias_estimated = run.flight.identification.config.gyro_bias_estimated || g_estimate_bias;
   const gnc::IdentifierConfigCheck check = gnc::validate(c);
   if (!check.ok) {
     std::printf("bad identifier config: %s: %s\n", check.field, check.reason);
-    return;
+    return out;
   }
+  gnc::IdentificationExcitation ex;
+  ex.configure(excitation);
+  ex.set_model(b_hat, run.flight.rcs);
+  for (int i = 0; i < gnc::IdentificationExcitation::kModelStages; ++i) ex.step_model();
+  const Vec8 lo = Vec8::Constant(-run.flight.rcs.u_max), hi = Vec8::Constant(run.flight.rcs.u_max);
+  double gamma_sum = 0.0;
+  long excited_ticks = 0;
   gnc::Identifier id;
   id.configure(c);
   Vec8 previous = Vec8::Zero();
   bool pd = false;
   const double marks[] = {60.0, 300.0, 600.0, 1000.0, 3000.0};
   constexpr int kMarks = 5;
-  Errors e[kMarks];
+  Errors* e = out.e;
   int m = 0;
   const int ticks = static_cast<int>(std::lround(3000.0 / c.dt));
   for (int k = 0; k <= ticks; ++k) {
@@ -109,12 +134,23 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
       const Vec3 dr = est.r - r_true;
       e[m].nees_j = da.dot(id.inertia_covariance().ldlt().solve(da));
       e[m].nees_r = dr.dot(id.offset_covariance().ldlt().solve(dr));
+      e[m].r_sigma_max = est.r_sigma.maxCoeff();
       ++m;
     }
-    const Vec8 u = allocate(b_hat, dpd(s.gyro.rate, s.star.quat, pd), run.flight.rcs.u_max);
+    Vec8 u = allocate(b_hat, dpd(s.gyro.rate, s.star.quat, pd), run.flight.rcs.u_max);
+    if (ex.wanted(id.estimate().r_sigma.maxCoeff(), id.observability().offset_unobservable,
+                  static_cast<double>(id.counters().windows) * c.window_s)) {
+      const gnc::ExcitationStatus xs = ex.apply(ex.force(id.counters().windows), lo, hi, c.dt, u);
+      gamma_sum += xs.gamma;
+      ++excited_ticks;
+    }
     plant.advance(u, true);
     previous = plant.applied_force();
+    out.fuel_kg += gnc::fuel_rate(previous, run.flight.isp_s, run.flight.g0) * c.dt;
   }
+  out.excitation_s = ex.elapsed();
+  out.gamma_mean = excited_ticks > 0 ? gamma_sum / static_cast<double>(excited_ticks) : 0.0;
+  if (!print) return out;
   std::printf("case %d %-10s T=%2.0f s k0 1s %.2f bias %.0e |", case_number,
               mode == gnc::IdentifierMode::kJoint ? "joint" : "concurrent", window_s, k_prior_sigma,
               gyro_bias);
@@ -124,6 +160,31 @@ void identification(const std::string& dir, int case_number, gnc::IdentifierMode
   }
   std::printf(" r unobs %d, refused %u, gated %u\n", id.observability().offset_unobservable,
               id.counters().inertia_refused, id.counters().windows_gated);
+  return out;
+}
+
+// The seven cases without and with the excitation: markdown rows for the design note.
+void excitation_table(const std::string& dir, const gnc::ExcitationConfig& x) {
+  std::printf("excitation F (%.0f, %.0f, %.0f) N, after %.0f s, at most %.0f s, stop at r 1s %.3f m%s\n",
+              x.force_n(0), x.force_n(1), x.force_n(2), x.start_after_s, x.duration_s, x.r_sigma_stop_m,
+              g_estimate_bias ? ", gyro bias estimated" : "");
+  std::printf("| case | excitation | 60 s | 300 s | 600 s | 1000 s | 3000 s | fuel 3000 s (kg) | excited (s) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  for (int cs = 1; cs <= 7; ++cs) {
+    gnc::ExcitationConfig off = x;
+    off.enabled = false;
+    const Outcome a = identification(dir, cs, gnc::IdentifierMode::kJoint, 0.0, 0.01, 0.0, off, false);
+    const Outcome b = identification(dir, cs, gnc::IdentifierMode::kJoint, 0.0, 0.01, 0.0, x, false);
+    for (const Outcome* o : {&a, &b}) {
+      std::printf("| %d | %s |", cs, o == &a ? "off" : "on");
+      for (const Errors& e : o->e) {
+        std::printf(" %.1e · %.3f (%.3f) · %.3f |", e.j, e.r, e.r_sigma_max, e.k);
+      }
+      std::printf(" %.2f | %.0f (gamma %.2f) |\n", o->fuel_kg, o->excitation_s, o->gamma_mean);
+    }
+    std::printf("| %d | cost | | | | | | %+.2f | |\n", cs, b.fuel_kg - a.fuel_kg);
+    std::fflush(stdout);
+  }
 }
 
 void hold(const std::string& dir, int case_number, double gyro_bias, double bias_rw) {
@@ -205,11 +266,43 @@ void hold(const std::string& dir, int case_number, double gyro_bias, double bias
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: %s CONFIG_DIR\n", argv[0]);
+  if (argc > 2 && std::string(argv[argc - 1]) == "estimate_bias") {
+    g_estimate_bias = true;
+    --argc;
+  }
+  if (argc < 2 || (argc > 2 && std::string(argv[2]) != "excitation") || argc > 6) {
+    std::fprintf(stderr, "usage: %s CONFIG_DIR [excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M]]]]\n",
+                 argv[0]);
     return 2;
   }
   const std::string dir = argv[1];
+  if (argc > 2) {
+    // The flight's excitation settings (gnc.yaml), then the command line's.
+    gnc::ExcitationConfig x =
+        config::load_run(dir + "/mission.yaml", dir + "/gnc.yaml", dir + "/cases/case1.yaml")
+            .flight.identification.excitation;
+    x.enabled = true;
+    if (argc > 3) {  // "F" or "Fx,Fy,Fz"
+      const std::string a = argv[3];
+      const std::size_t c1 = a.find(',');
+      if (c1 == std::string::npos) {
+        x.force_n = Vec3::Constant(std::stod(a));
+      } else {
+        const std::size_t c2 = a.find(',', c1 + 1);
+        x.force_n = Vec3(std::stod(a.substr(0, c1)), std::stod(a.substr(c1 + 1, c2 - c1 - 1)),
+                         std::stod(a.substr(c2 + 1)));
+      }
+    }
+    if (argc > 4) x.duration_s = std::stod(argv[4]);
+    if (argc > 5) x.r_sigma_stop_m = std::stod(argv[5]);
+    const gnc::ExcitationConfigCheck xc = gnc::validate(x);
+    if (!xc.ok) {
+      std::fprintf(stderr, "bad excitation: %s: %s\n", xc.field, xc.reason);
+      return 2;
+    }
+    excitation_table(dir, x);
+    return 0;
+  }
   for (int cs = 1; cs <= 7; ++cs) {
     identification(dir, cs, gnc::IdentifierMode::kJoint, 0.0, 0.01);  // the flight's window
   }

@@ -138,6 +138,67 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
   delete loop;
 }
 
+// The identification excitation (gnc/estimation/README.md §I.6) on, with both allocators: its
+// basis computed over ticks after init and again after a model adoption, the saturated path (the
+// small vehicle's 2 N channels, so the channel at its bound leaves the excitation), and the stop.
+TEST(ZeroAllocation, NoHeapWithTheIdentificationExcitation) {
+  for (AllocatorKind kind : {AllocatorKind::kPseudoInverse, AllocatorKind::kL1}) {
+    GncParams truth = test::small_vehicle_params();
+    auto* loop = new test::SmallLoop(truth);
+    GncParams p = truth;
+    p.mass_hat.j_ast(0, 0) *= 1.3;
+    p.mass_hat.r_so_bcm += Vec3(0.05, -0.04, 0.045);
+    p.law = LawId::kNtcl;
+    p.allocator = kind;
+    IdentificationParams& id = p.identification;
+    id.enabled = true;
+    id.adopt = ModelAdoption::kAuto;
+    id.adopt_interval_s = 5.0;
+    id.config.window_s = 2.0;
+    id.config.j_prior_sigma = 5.0;
+    id.config.r_prior_sigma = 0.5;
+    id.config.k_prior_sigma = 0.01;
+    id.config.disturbance_sigma = 1e-4;
+    id.config.torque_floor = 1e-4;
+    id.config.min_torque_impulse = 0.05;
+    id.config.min_force_impulse = 0.02;
+    id.config.min_thruster_impulse = 0.005;
+    id.excitation.enabled = true;
+    id.excitation.force_n = Vec3(3.0, 3.0, 6.0);
+    id.excitation.duration_s = 40.0;
+    id.excitation.r_sigma_stop_m = 1e-3;
+    loop->body.omega *= 4.0;  // a long saturated despin
+    ASSERT_TRUE(loop->gnc.init(p).ok);
+    long counted = -1;
+    double gamma_min = 1.0;
+    int blocked = 0;
+    int excited = 0;
+    {
+      Armed armed;
+      GncCommands c;
+      c.has_mode_request = true;
+      c.mode_request = Mode::kDetumble;
+      loop->tick(c);
+      for (int i = 0; i < 1200; ++i) {
+        loop->tick();
+        const ExcitationStatus& s = loop->gnc.excitation_status();
+        if (s.active) {
+          ++excited;
+          gamma_min = std::fmin(gamma_min, s.gamma);
+          blocked += s.blocked > 0 ? 1 : 0;
+        }
+      }
+      counted = rocksteady::test::heap_allocations();
+    }
+    EXPECT_EQ(counted, 0) << to_string(kind);
+    EXPECT_GE(loop->gnc.model_adoptions(), 1u) << to_string(kind);
+    EXPECT_GT(excited, 100) << to_string(kind);
+    EXPECT_GT(blocked, 0) << to_string(kind) << ": the saturated path ran";
+    EXPECT_LT(gamma_min, 1.0) << to_string(kind);
+    delete loop;
+  }
+}
+
 TEST(ZeroAllocation, NoHeapWhenATrajectoryIsStagedAndSwitchedAtATickBoundary) {
   const GncParams p = test::small_vehicle_params();
   auto* loop = new test::SmallLoop(p);

@@ -1,0 +1,174 @@
+#include "gnc/estimation/excitation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+namespace rocksteady::gnc {
+
+namespace {
+bool finite_positive(double x) { return std::isfinite(x) && x > 0.0; }
+constexpr double kRankTol = 1e-10;   // pivot of M M' (relative to the largest) counted as zero
+constexpr double kBoundTol = 1e-9;   // a channel within this fraction of its bound is at the bound
+}  // namespace
+
+ExcitationConfigCheck validate(const ExcitationConfig& c) {
+  if (!(c.force_n.allFinite() && c.force_n.minCoeff() >= 0.0 && c.force_n.maxCoeff() > 0.0)) {
+    return {false, "identification.excitation.force_n", "must be finite, >= 0, one axis > 0"};
+  }
+  if (!(std::isfinite(c.duration_s) && c.duration_s >= 0.0)) {
+    return {false, "identification.excitation.duration_s", "must be >= 0 and finite"};
+  }
+  if (!(std::isfinite(c.start_after_s) && c.start_after_s >= 0.0)) {
+    return {false, "identification.excitation.start_after_s", "must be >= 0 and finite"};
+  }
+  if (!finite_positive(c.r_sigma_stop_m)) {
+    return {false, "identification.excitation.r_sigma_stop_m", "must be positive and finite"};
+  }
+  return {};
+}
+
+void IdentificationExcitation::configure(const ExcitationConfig& c) {
+  config_ = c;
+  n_directions_ = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(c.force_n(axis) > 0.0)) continue;
+    for (const double sign : {1.0, -1.0}) {
+      directions_[n_directions_] = Vec3::Zero();
+      directions_[n_directions_](axis) = sign * c.force_n(axis);
+      ++n_directions_;
+    }
+  }
+}
+
+void IdentificationExcitation::set_model(const Mat38& b_hat, const RcsLayout& rcs) {
+  m_.topRows<3>() = b_hat;
+  for (int c = 0; c < kChannels; ++c) m_.block<3, 1>(3, c) = rcs.channel_direction[c];
+  stage_ = 0;
+  valid_ = false;
+}
+
+void IdentificationExcitation::step_model() {
+  switch (stage_) {
+    case 0:  // G = M M' (6x6)
+      g_ = m_ * m_.transpose();
+      break;
+    case 1: {  // G^-1 (LDLT, fixed size)
+      const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(g_);
+      const Vec6 d = ldlt.vectorD();
+      valid_ = ldlt.info() == Eigen::Success && d.allFinite() && d.minCoeff() > kRankTol * d.maxCoeff();
+      g_inv_ = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
+      break;
+    }
+    case 2:  // N = M' G^-1 [0; I3]   (X2), and H = G^-1 M for the projector
+      n_ = m_.transpose() * g_inv_.rightCols<3>();
+      h_ = g_inv_ * m_;
+      break;
+    case 3:  // the projector on the kernel of M: P = I - M' G^-1 M
+      p_ = Eigen::Matrix<double, kChannels, kChannels>::Identity() - m_.transpose() * h_;
+      break;
+    case 4: {  // Z: Gram-Schmidt on P's two largest columns (rank 8 - 6 = 2)
+      for (int k = 0; k < 2; ++k) {
+        int best = 0;
+        double best_norm = -1.0;
+        for (int j = 0; j < kChannels; ++j) {
+          Vec8 v = p_.col(j);
+          if (k == 1) v -= z_.col(0) * z_.col(0).dot(v);
+          const double nv = v.norm();
+          if (nv > best_norm) {
+            best_norm = nv;
+            best = j;
+          }
+        }
+        Vec8 v = p_.col(best);
+        if (k == 1) v -= z_.col(0) * z_.col(0).dot(v);
+        if (!(best_norm > 1e-6)) {
+          valid_ = false;
+          z_.col(k).setZero();
+        } else {
+          z_.col(k) = v / v.norm();
+        }
+      }
+      break;
+    }
+    case 5:  // checks: B_hat N = 0, E N = I, M Z = 0 (to rounding)
+      if (valid_) {
+        const double scale = std::max(1.0, m_.cwiseAbs().maxCoeff());
+        Eigen::Matrix<double, 6, 3> target = Eigen::Matrix<double, 6, 3>::Zero();
+        target.bottomRows<3>().setIdentity();
+        valid_ = (m_ * n_ - target).cwiseAbs().maxCoeff() < 1e-9 * scale * (1.0 + n_.cwiseAbs().maxCoeff()) &&
+                 (m_ * z_).cwiseAbs().maxCoeff() < 1e-9 * scale;
+      }
+      break;
+    default:
+      return;
+  }
+  ++stage_;
+}
+
+bool IdentificationExcitation::wanted(double max_r_sigma, int unobservable,
+                                      double identified_s) const {
+  return config_.enabled && ready() && n_directions_ > 0 && identified_s >= config_.start_after_s && elapsed_ < config_.duration_s &&
+         (unobservable > 0 || !(max_r_sigma <= config_.r_sigma_stop_m));
+}
+
+Vec3 IdentificationExcitation::force(std::uint32_t window_index) const {
+  if (n_directions_ == 0) return Vec3::Zero();
+  return directions_[window_index % static_cast<std::uint32_t>(n_directions_)];  // (X3)
+}
+
+ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, const Vec8& hi,
+                                                 double dt, Vec8& u) {
+  ExcitationStatus s;
+  s.force = f;
+  if (!ready()) return s;
+  s.active = true;
+  elapsed_ += dt;
+  Vec8 du = n_ * f;  // (X2), z = 0
+  // (X4) A channel already at its bound that du would push further leaves the excitation: the
+  // kernel Z moves the null-space force off it (up to two such channels; more leave it to gamma).
+  int blocked[2] = {-1, -1};
+  int nb = 0;
+  for (int i = 0; i < kChannels && nb < 2; ++i) {
+    const double tol = kBoundTol * std::max(1.0, std::max(hi(i), -lo(i)));
+    if ((du(i) > 0.0 && u(i) >= hi(i) - tol) || (du(i) < 0.0 && u(i) <= lo(i) + tol)) {
+      blocked[nb++] = i;
+    }
+  }
+  if (nb == 2) {
+    Eigen::Matrix2d a;
+    a.row(0) = z_.row(blocked[0]);
+    a.row(1) = z_.row(blocked[1]);
+    const double det = a.determinant();
+    if (std::fabs(det) > 1e-6) {
+      const Eigen::Vector2d z = -a.inverse() * Eigen::Vector2d(du(blocked[0]), du(blocked[1]));
+      du += z_ * z;
+      du(blocked[0]) = 0.0;
+      du(blocked[1]) = 0.0;
+    } else {
+      nb = 1;  // the two rows are dependent: remove the first only
+    }
+  }
+  if (nb == 1) {
+    const Eigen::RowVector2d a = z_.row(blocked[0]);
+    const double na = a.squaredNorm();
+    if (na > 1e-12) {
+      du -= z_ * (a.transpose() * (du(blocked[0]) / na));
+      du(blocked[0]) = 0.0;
+    }
+  }
+  s.blocked = static_cast<std::uint8_t>(nb);
+  // (X5) the largest fraction of du that fits every channel's box.
+  double gamma = 1.0;
+  for (int i = 0; i < kChannels; ++i) {
+    if (du(i) > 0.0) gamma = std::min(gamma, std::max(0.0, hi(i) - u(i)) / du(i));
+    if (du(i) < 0.0) gamma = std::min(gamma, std::min(0.0, lo(i) - u(i)) / du(i));
+  }
+  gamma = std::max(0.0, gamma);
+  for (int i = 0; i < kChannels; ++i) u(i) = std::min(hi(i), std::max(lo(i), u(i) + gamma * du(i)));
+  s.gamma = gamma;
+  return s;
+}
+
+}  // namespace rocksteady::gnc

@@ -1,0 +1,111 @@
+// Identification excitation (gnc/estimation/README.md §I.6, Eqs. X1-X6): a deliberate net force
+// added to the allocator's channel forces in the null space of the model's torque map B_hat, so it
+// makes no torque on the current model (the control law is not disturbed), while a wrong r_hat
+// turns it into the torque (r - r_hat) x F that the identifier needs to see r (§I.3 item 2).
+//
+// Per physical channel c the "+" thruster pushes along d_c, so the channels' net force is E u with
+// E = [d_0 ... d_7] (3x8). The excitation is
+//   Delta u = N F + Z z,   [B_hat; E] N = [0; I3],   [B_hat; E] Z = 0          (X2)
+// N is the minimum-norm right inverse's force block and Z (8x2) an orthonormal basis of the
+// kernel of M = [B_hat; E] (rank 6 for the SPEC §4 layout). z = 0 unless a channel already sits at
+// its bound and Delta u would push it further: then z removes that channel (up to two) from the
+// excitation (X4), and a last scale gamma in [0, 1] keeps every channel in its box (X5).
+// The force F cycles through +x, -x, +y, -y, +z, -z (F_B), one direction per identification
+// window (X3): every component of r is normal to four of the six, and a constant unmodelled
+// torque (a gyro bias's gyroscopic term, a disturbance) cancels between a window and the next.
+//
+// N and Z depend only on B_hat and E: they are computed once per model change, spread over
+// kModelStages ticks (set_model, then step_model once a tick); the excitation stays off until
+// they are ready. Per tick: 24 multiply-adds for N F, a scan of the eight channels and eight
+// divisions for gamma (a 2x2 solve more when the allocation saturates).
+//
+// Flight code: fixed-size Eigen, no heap, no exceptions, no I/O.
+#pragma once
+
+#include <cstdint>
+
+#include "gnc/model/rcs.hpp"
+#include "gnc/types.hpp"
+
+namespace rocksteady::gnc {
+
+using Mat82 = Eigen::Matrix<double, kChannels, 2>;
+
+struct ExcitationConfig {
+  bool enabled{false};          // off for the study's strategies
+  // Amplitude of F along each body axis, N (X6 sizes it); an axis at 0 is left out of the cycle.
+  Vec3 force_n{100.0, 100.0, 400.0};
+  double duration_s{600.0};     // at most this long in all (s of excitation)
+  double r_sigma_stop_m{0.005}; // stop once every 1 sigma of r_hat is below this (and none unobservable)
+  // Start only after this much identification (closed windows times their length, s): the first
+  // windows, with r_hat still up to 1 m off, would fit the excitation's torque into J (README §I.6).
+  double start_after_s{0.0};
+};
+
+struct ExcitationConfigCheck {
+  bool ok{true};
+  const char* field{""};
+  const char* reason{""};
+};
+ExcitationConfigCheck validate(const ExcitationConfig& c);
+
+// What one tick's excitation did.
+struct ExcitationStatus {
+  bool active{false};          // the excitation was asked for this tick
+  Vec3 force{Vec3::Zero()};    // net force asked, N (F_B)
+  double gamma{0.0};           // the fraction that fitted the channels' box (X5)
+  std::uint8_t blocked{0};     // channels removed from the excitation at their bound (X4)
+};
+
+class IdentificationExcitation {
+ public:
+  static constexpr int kModelStages = 6;
+  static constexpr int kDirections = 6;
+
+  // New settings; the excitation time already spent is kept (restart() clears it).
+  void configure(const ExcitationConfig& c);
+  const ExcitationConfig& config() const { return config_; }
+  // A new model (B_hat of the active table, the layout's channel directions): N and Z are
+  // recomputed over the next kModelStages calls of step_model(); until then ready() is false.
+  void set_model(const Mat38& b_hat, const RcsLayout& rcs);
+  // One stage of the model computation (no-op once ready). Call once a tick.
+  void step_model();
+  bool ready() const { return stage_ == kModelStages && valid_; }
+  // Whether the excitation should run: enabled, model ready, at least start_after_s of
+  // identification done (identified_s), less than duration_s spent, and r not yet known to
+  // r_sigma_stop_m in every direction (max_r_sigma: largest 1 sigma of r_hat; unobservable:
+  // directions of r the data have not shown).
+  bool wanted(double max_r_sigma, int unobservable, double identified_s) const;
+  // The force of window `window_index` (X3): +x, -x, +y, -y, +z, -z with the axes' amplitudes
+  // (axes at zero amplitude skipped).
+  Vec3 force(std::uint32_t window_index) const;
+  // Adds the excitation for net force f to the allocated channel forces u (effective force, as
+  // B_hat multiplies) within lo <= u <= hi (X4, X5), and counts dt of excitation time. Returns
+  // what was done; u is unchanged when !ready().
+  ExcitationStatus apply(const Vec3& f, const Vec8& lo, const Vec8& hi, double dt, Vec8& u);
+  // Seconds of excitation spent so far.
+  double elapsed() const { return elapsed_; }
+  // Back to no excitation spent (a declared change: r must be learned again).
+  void restart() { elapsed_ = 0.0; }
+
+  const Mat83& force_map() const { return n_; }  // N of (X2)
+  const Mat82& kernel() const { return z_; }     // Z of (X2)
+
+ private:
+  ExcitationConfig config_{};
+  Eigen::Matrix<double, 6, kChannels> m_{Eigen::Matrix<double, 6, kChannels>::Zero()};
+  Eigen::Matrix<double, 6, 6> g_{Eigen::Matrix<double, 6, 6>::Zero()};      // G = M M'
+  Eigen::Matrix<double, 6, 6> g_inv_{Eigen::Matrix<double, 6, 6>::Zero()};  // G^-1
+  Eigen::Matrix<double, 6, kChannels> h_{Eigen::Matrix<double, 6, kChannels>::Zero()};  // G^-1 M
+  Eigen::Matrix<double, kChannels, kChannels> p_{
+      Eigen::Matrix<double, kChannels, kChannels>::Zero()};  // I - M'(MM')^-1 M
+  Mat83 n_{Mat83::Zero()};
+  Mat82 z_{Mat82::Zero()};
+  Vec3 directions_[kDirections]{};
+  int n_directions_{0};
+  int stage_{kModelStages};
+  bool valid_{false};
+  double elapsed_{0.0};
+};
+
+}  // namespace rocksteady::gnc
