@@ -32,6 +32,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   // The identifier starts from this table's model as its prior; a later table switch keeps its
   // estimate (set_params).
   if (params_.identification.enabled) ident_.configure(build_identifier_config(params_));
+  fault_torque_scored_ = 0;
   fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
   fdi_.clear(-1);
   valve_open_ = {{true, true, true, true}};
@@ -101,6 +102,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   if (!params_.identification.enabled) candidate_status_ = ModelCandidate::kDisabled;
   if (identification_started) {
     ident_.configure(build_identifier_config(params_));
+    fault_torque_scored_ = 0;
     candidate_status_ = ModelCandidate::kNotConfident;
     candidate_windows_ = 0;
     fault_model_stale_ = false;
@@ -423,6 +425,16 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
     ident_.update(in, !fdi_busy);
+    // (F14) The identifier's stuck-on evidence (I23), once per scored window.
+    const IdentifierFaultTorque& ft = ident_.fault_torque();
+    if (ft.scored != fault_torque_scored_) {
+      fault_torque_scored_ = ft.scored;
+      StuckOnEvidence ev;
+      ev.fitted = ft.fitted;
+      ev.chi2_zero = ft.chi2_zero;
+      ev.chi2_jet = ft.chi2_jet;
+      fdi_.identified_evidence(ev);
+    }
     bool window_latched = false;
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       window_latched = true;
