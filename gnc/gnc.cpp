@@ -433,6 +433,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       ev.fitted = ft.fitted;
       ev.chi2_zero = ft.chi2_zero;
       ev.chi2_jet = ft.chi2_jet;
+      ev.chi2_column = ft.chi2_column;
       fdi_.identified_evidence(ev);
     }
     bool window_latched = false;

@@ -190,7 +190,8 @@ void Identifier::configure(const IdentifierConfig& c) {
     return 1 + (kIdParams + g - 1) / g + 1 + 1 + (kIdParams + r - 1) / r +
            (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
            (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1 +
-           (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick;
+           (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick +
+           (kIdParams + kSettleRowsPerTick - 1) / kSettleRowsPerTick;
   };
   gain_rows_per_tick_ = 4;
   cov_rows_per_tick_ = 1;
@@ -232,6 +233,9 @@ void Identifier::reset() {
   ft_ = IdentifierFaultTorque{};
   ft_.d_cov = p_all_.block<3, 3>(kIdD, kIdD);
   fault_jet_next_ = 0;
+  settle_streak_ = 0;
+  d_held_zero_ = false;
+  settle_ = SettleStep{};
   reference_.fill(true);
   joint_ = JointStep{};
   anchor_ = AnchorStep{};
@@ -262,6 +266,7 @@ void reinflate_block(Eigen::Matrix<double, N, N>& p, int first, int n, double va
 void Identifier::reinflate_inertia() {
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.j_prior_sigma * c_.j_prior_sigma;
@@ -273,6 +278,7 @@ void Identifier::reinflate_inertia() {
 void Identifier::reinflate_offset() {
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.r_prior_sigma * c_.r_prior_sigma;
@@ -285,6 +291,7 @@ void Identifier::reinflate_thruster(int i) {
   if (i < 0 || i >= kThrusters) return;
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;
   joint_.started = false;
   const double v = c_.k_prior_sigma * c_.k_prior_sigma;
@@ -308,9 +315,13 @@ void Identifier::reinflate_fault_torque() {
   // too: d goes back to its prior covariance; the estimate is kept as the starting point.
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;
   joint_.started = false;
+  finish_settle();
   reinflate_block<kIdParams>(p_all_, kIdD, 3, c_.fault_torque_sigma * c_.fault_torque_sigma);
+  d_held_zero_ = false;
+  settle_streak_ = 0;
   ++counters_.reinflations;
 }
 
@@ -445,6 +456,8 @@ bool Identifier::joint_gain_rows() {
       reinflate_block<kIdParams>(p_all_, kIdR, 3, c_.r_prior_sigma * c_.r_prior_sigma);
       reinflate_block<kIdParams>(p_all_, kIdK, kThrusters, c_.k_prior_sigma * c_.k_prior_sigma);
       reinflate_block<kIdParams>(p_all_, kIdD, 3, c_.fault_torque_sigma * c_.fault_torque_sigma);
+      d_held_zero_ = false;
+      settle_streak_ = 0;
       ++counters_.reinflations;
       ++counters_.gate_reinflations;
     }
@@ -784,9 +797,25 @@ void Identifier::step_phase() {
       if (fault_jet_next_ >= kThrusters) {
         ++ft_.scored;
         phase_ = Phase::kIdle;
+        // (I24) d settled at zero?
+        if (ft_.fitted) {
+          const double gate = c_.gate_chi2 > 0.0 ? c_.gate_chi2 : 16.27;
+          const double settled = 0.1 * c_.fault_torque_sigma;
+          const bool quiet = ft_.chi2_zero < gate &&
+                             ft_.d_cov.diagonal().maxCoeff() <= settled * settled;
+          settle_streak_ = quiet ? settle_streak_ + 1 : 0;
+          if (settle_streak_ >= kSettleWindows) {
+            settle_streak_ = 0;
+            start_settle();
+            if (settle_.pending) phase_ = Phase::kSettle;
+          }
+        }
       }
       break;
     }
+    case Phase::kSettle:
+      if (settle_rows()) phase_ = Phase::kIdle;
+      break;
     case Phase::kIdle:
       break;
   }
@@ -1076,6 +1105,7 @@ void Identifier::score_fault_torque(int first, int n) {
     ft_.d = d_;
     ft_.d_cov = p_dd;
     ft_.fitted = window_fitted_;
+    ft_.held_zero = d_held_zero_;
     const Eigen::LDLT<Mat3> l(p_dd);
     ft_.chi2_zero = l.info() == Eigen::Success && l.isPositive() ? d_.dot(l.solve(d_)) : 0.0;
   }
@@ -1090,12 +1120,69 @@ void Identifier::score_fault_torque(int first, int n) {
     const double p_kk = p_all_(kIdK + i, kIdK + i);
     const Mat3 ap_rd = a * p_dr.transpose();
     const Vec3 ap_rk = a * p_rk;
-    Mat3 cov = p_dd + ap_rd + ap_rd.transpose() + a * p_rr * a.transpose() +
-               p_dk * c.transpose() + c * p_dk.transpose() + ap_rk * c.transpose() +
-               c * ap_rk.transpose() + p_kk * (c * c.transpose());
+    // The column's own covariance (r and k_i), then with d's terms.
+    const Mat3 col_cov = a * p_rr * a.transpose() + ap_rk * c.transpose() +
+                         c * ap_rk.transpose() + p_kk * (c * c.transpose());
+    const Vec3 col = u_max * k_(i) * arm;
+    const Eigen::LDLT<Mat3> lc(col_cov);
+    ft_.chi2_column[static_cast<std::size_t>(i)] =
+        lc.info() == Eigen::Success && lc.isPositive() ? col.dot(lc.solve(col)) : 0.0;
+    const Mat3 cov = p_dd + ap_rd + ap_rd.transpose() + col_cov + p_dk * c.transpose() +
+                     c * p_dk.transpose();
     const Eigen::LDLT<Mat3> l(cov);
     ft_.chi2_jet[static_cast<std::size_t>(i)] =
         l.info() == Eigen::Success && l.isPositive() ? t.dot(l.solve(t)) : 1e300;
+  }
+}
+
+void Identifier::start_settle() {
+  // (I24) The perfect pseudo-measurement d = 0: x <- x - P_:d P_dd^-1 d, P <- P - P_:d P_dd^-1 P_d:
+  // (the state now, the covariance a block of rows per tick in settle_rows).
+  const Mat3 p_dd = p_all_.block<3, 3>(kIdD, kIdD);
+  const Eigen::LDLT<Mat3> l(p_dd);
+  if (l.info() != Eigen::Success || !l.isPositive()) return;
+  settle_.pd = p_all_.middleCols<3>(kIdD);
+  settle_.g = settle_.pd * l.solve(Mat3::Identity());
+  VecId x;
+  x << a_, r_, k_, b_, d_;
+  x -= settle_.g * d_;
+  const Mat3 j = inertia_matrix(x.head<6>());
+  if (!j.allFinite() || Eigen::LLT<Mat3>(j).info() != Eigen::Success) return;  // (I14)
+  a_ = x.head<6>();
+  r_ = x.segment<3>(kIdR);
+  k_ = x.segment<kThrusters>(kIdK);
+  b_ = x.segment<3>(kIdB);
+  d_.setZero();
+  settle_.rows = 0;
+  settle_.pending = true;
+  d_held_zero_ = true;
+}
+
+bool Identifier::settle_rows() {
+  if (!settle_.pending) return true;
+  // Element (i, j) loses g(lo) . pd(hi), lo = min(i, j): the same product for (j, i), so P stays
+  // exactly symmetric whichever rows are done first.
+  const int first = settle_.rows;
+  const int n = std::min(kSettleRowsPerTick, kIdParams - first);
+  for (int i = first; i < first + n; ++i) {
+    for (int j = 0; j < kIdParams; ++j) {
+      const int lo = i < j ? i : j;
+      const int hi = i < j ? j : i;
+      p_all_(i, j) -= settle_.g.row(lo).dot(settle_.pd.row(hi));
+    }
+  }
+  settle_.rows = first + n;
+  if (settle_.rows < kIdParams) return false;
+  settle_.pending = false;
+  // d is out of the state: exactly zero rows and columns (no gain, no uncertainty).
+  p_all_.middleRows<3>(kIdD).setZero();
+  p_all_.middleCols<3>(kIdD).setZero();
+  sync_blocks();
+  return true;
+}
+
+void Identifier::finish_settle() {
+  while (!settle_rows()) {
   }
 }
 

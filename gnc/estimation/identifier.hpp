@@ -217,6 +217,11 @@ struct IdentifierFaultTorque {
   // (d-hat - u_max k_i (p_i + r) x e_i)' C_i^-1 (...), C_i from the joint covariance of d, r
   // and k_i: d against thruster i stuck on (3 dof).
   std::array<double, kThrusters> chi2_jet{};
+  // u_max k_i (p_i + r) x e_i against zero with its covariance from r and k_i: how far thruster
+  // i's stuck-on torque stands out of the model's uncertainty (a jet near the centre of mass, or
+  // whose arm r makes uncertain, cannot be told from no fault).
+  std::array<double, kThrusters> chi2_column{};
+  bool held_zero{false};  // d was settled at zero (I24) and is out of the state
 };
 
 class Identifier {
@@ -272,12 +277,30 @@ class Identifier {
     Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
   };
   enum class Phase : std::uint8_t {
-    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore
+    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
   static constexpr int kFaultJetsPerTick = 4;
   int fault_jet_next_{0};
   bool window_fitted_{false};  // the latched window's step updated the estimate
+  // (I24) d settled at zero: once d-hat has stayed consistent with zero (chi-square below the
+  // gate) with a 1 sigma below a tenth of its prior for kSettleWindows fitted windows, the
+  // pseudo-measurement d = 0 is applied (its information returns to J, r and k) and d is held
+  // out of the state until the gate or a declared change re-inflates it.
+  static constexpr int kSettleWindows = 3;
+  static constexpr int kSettleRowsPerTick = 7;
+  int settle_streak_{0};
+  bool d_held_zero_{false};
+  struct SettleStep {
+    bool pending{false};
+    int rows{0};
+    Eigen::Matrix<double, kIdParams, 3> pd{Eigen::Matrix<double, kIdParams, 3>::Zero()};  // P_:d
+    Eigen::Matrix<double, kIdParams, 3> g{Eigen::Matrix<double, kIdParams, 3>::Zero()};   // P_:d P_dd^-1
+  };
+  SettleStep settle_{};
+  void start_settle();   // (I24) the state, and the rank-3 covariance term's factors
+  bool settle_rows();    // ... a block of rows of the covariance (true when done)
+  void finish_settle();  // ... every remaining row
   void score_fault_torque(int first, int n);  // (I23) thrusters [first, first + n)
   IdentifierFaultTorque ft_{};
 

@@ -194,6 +194,7 @@ void FaultDetector::identified_evidence(const StuckOnEvidence& e) {
     }
   }
   const bool pass = e.fitted && best >= 0 && e.chi2_zero > p_.identified_zero_chi2 &&
+                    e.chi2_column[static_cast<std::size_t>(best)] > p_.identified_zero_chi2 &&
                     c1 < p_.identified_match_chi2 && c2 - c1 > p_.identified_margin_chi2;
   if (!e.fitted) return;  // a gated or refused window neither adds nor breaks a streak
   if (!pass) {

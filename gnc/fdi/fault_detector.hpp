@@ -56,7 +56,9 @@ struct FaultDetectorParams {
   // (estimation README I22) scored against each stuck-on column (I23). Thruster i is confirmed
   // stuck on when, in identified_windows fitted windows in a row, d-hat is at least
   // identified_zero_chi2 from zero (3 dof), within identified_match_chi2 of thruster i's torque,
-  // and every other thruster's chi-square exceeds i's by identified_margin_chi2.
+  // thruster i's torque itself at least identified_zero_chi2 from zero (with the model's
+  // uncertainty of it), and every other thruster's chi-square exceeds i's by
+  // identified_margin_chi2.
   bool identified_isolation{false};
   double identified_zero_chi2{100.0};
   double identified_match_chi2{16.27};  // chi-square(3) at 0.999
@@ -69,6 +71,7 @@ struct StuckOnEvidence {
   bool fitted{false};      // the window updated the identifier's estimate
   double chi2_zero{0.0};   // fault torque against zero
   std::array<double, kThrusters> chi2_jet{};  // fault torque against thruster i stuck on
+  std::array<double, kThrusters> chi2_column{};  // thruster i's stuck-on torque against zero
 };
 
 Check validate(const FaultDetectorParams& p);
