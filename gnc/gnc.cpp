@@ -420,7 +420,11 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     in.force = last_force_;
     // While the detector suspects a fault it has not isolated, the identifier does not fit it
     // into J, r and k: those windows are discarded (gnc/fdi/README.md (F7)).
-    in.force_valid = !(params_.fdi.enabled && fdi_.suspecting());
+    // With the stuck-on isolation inside identification (F14), a suspected stuck-on is what the
+    // identifier's fault torque d (I22) absorbs, so its windows are kept: they are the evidence.
+    const bool stuck_on_suspected = fdi_.status().best >= 0 && fdi_.status().best < kThrusters;
+    in.force_valid = !(params_.fdi.enabled && fdi_.suspecting() &&
+                       !(params_.fdi.identified_isolation && stuck_on_suspected));
     // The identifier's step blocks stay off the fault detector's heavy evaluation steps
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();

@@ -1124,9 +1124,11 @@ void Identifier::score_fault_torque(int first, int n) {
     const Mat3 col_cov = a * p_rr * a.transpose() + ap_rk * c.transpose() +
                          c * ap_rk.transpose() + p_kk * (c * c.transpose());
     const Vec3 col = u_max * k_(i) * arm;
-    const Eigen::LDLT<Mat3> lc(col_cov);
-    ft_.chi2_column[static_cast<std::size_t>(i)] =
-        lc.info() == Eigen::Success && lc.isPositive() ? col.dot(lc.solve(col)) : 0.0;
+    // Along the column's own direction (S(e_i) makes col_cov rank-deficient without k's term):
+    // (|col|^2)^2 / col' C col, the squared ratio of its length to its 1 sigma there.
+    const double c2 = col.squaredNorm();
+    const double var = col.dot(col_cov * col);
+    ft_.chi2_column[static_cast<std::size_t>(i)] = var > 0.0 ? c2 * c2 / var : 0.0;
     const Mat3 cov = p_dd + ap_rd + ap_rd.transpose() + col_cov + p_dk * c.transpose() +
                      c * p_dk.transpose();
     const Eigen::LDLT<Mat3> l(cov);

@@ -217,7 +217,8 @@ struct IdentifierFaultTorque {
   // (d-hat - u_max k_i (p_i + r) x e_i)' C_i^-1 (...), C_i from the joint covariance of d, r
   // and k_i: d against thruster i stuck on (3 dof).
   std::array<double, kThrusters> chi2_jet{};
-  // u_max k_i (p_i + r) x e_i against zero with its covariance from r and k_i: how far thruster
+  // u_max k_i (p_i + r) x e_i against zero along its own direction, with its covariance from r
+  // and k_i (1 dof, (|col|^2)^2 / col' C col): how far thruster
   // i's stuck-on torque stands out of the model's uncertainty (a jet near the centre of mass, or
   // whose arm r makes uncertain, cannot be told from no fault).
   std::array<double, kThrusters> chi2_column{};
