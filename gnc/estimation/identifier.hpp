@@ -281,7 +281,7 @@ class Identifier {
     kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
-  static constexpr int kFaultJetsPerTick = 4;
+  static constexpr int kFaultJetsPerTick = 2;
   int fault_jet_next_{0};
   bool window_fitted_{false};  // the latched window's step updated the estimate
   // (I24) d settled at zero: once d-hat has stayed consistent with zero (chi-square below the
