@@ -305,8 +305,11 @@ void Identifier::reinflate_all() {
   reinflate_inertia();
   reinflate_offset();
   for (int i = 0; i < kThrusters; ++i) reinflate_thruster(i);
-  reinflate_fault_torque();
-  counters_.reinflations -= 3 + kThrusters;
+  // (I22) d too, unless it was settled at zero (I24): a fault the detector isolated while d was
+  // out of the state was never in d, and is gone with its valve.
+  const bool d_live = !d_held_zero_;
+  if (d_live) reinflate_fault_torque();
+  counters_.reinflations -= (d_live ? 3 : 2) + kThrusters;
   ++counters_.reinflations;
 }
 
