@@ -42,9 +42,10 @@ BENCHMARK(BM_MekfUpdate);
 // identifier taken just before that tick (the copy is timed too: see BM_IdentifierCopy, subtract
 // it).
 struct IdentifierRig {
-  explicit IdentifierRig(IdentifierMode mode) {
+  explicit IdentifierRig(IdentifierMode mode, double fault_torque_sigma = 0.0) {
     IdentifierConfig c;
     c.mode = mode;
+    c.fault_torque_sigma = fault_torque_sigma;  // (I22)-(I24) the fault torque and its scores
     c.rcs = study_rcs_layout(200.0);
     c.j0 = total_inertia(study_true_mass_properties());
     c.window_s = 2.0;  // 20 ticks
@@ -80,8 +81,9 @@ struct IdentifierRig {
   long k{0};
 };
 
-void BM_IdentifierTick(benchmark::State& state, IdentifierMode mode, int phase) {
-  IdentifierRig rig(mode);
+void BM_IdentifierTick(benchmark::State& state, IdentifierMode mode, int phase,
+                       double fault_torque_sigma = 0.0) {
+  IdentifierRig rig(mode, fault_torque_sigma);
   for (int w = 0; w < 5; ++w) rig.to_phase(8);  // a few windows in
   if (phase == 0) {
     for (auto _ : state) {
@@ -107,6 +109,23 @@ BENCHMARK_CAPTURE(BM_IdentifierTick, joint_apply_finish_tick, IdentifierMode::kJ
 BENCHMARK_CAPTURE(BM_IdentifierTick, joint_anchor_tick, IdentifierMode::kJoint, 5);
 BENCHMARK_CAPTURE(BM_IdentifierTick, joint_report_tick, IdentifierMode::kJoint, 6);
 BENCHMARK_CAPTURE(BM_IdentifierTick, joint_accumulate_tick, IdentifierMode::kJoint, 8);
+// With the fault torque d (I22): every tick of the window cycle (the scores of I23 are the last
+// ticks; the 20-tick rig's window takes bigger row blocks than the flight's 200-tick one).
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_joint_average, IdentifierMode::kJoint, 0, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_1, IdentifierMode::kJoint, 1, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_2, IdentifierMode::kJoint, 2, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_3, IdentifierMode::kJoint, 3, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_4, IdentifierMode::kJoint, 4, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_5, IdentifierMode::kJoint, 5, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_6, IdentifierMode::kJoint, 6, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_7, IdentifierMode::kJoint, 7, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_8, IdentifierMode::kJoint, 8, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_9, IdentifierMode::kJoint, 9, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_10, IdentifierMode::kJoint, 10, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_11, IdentifierMode::kJoint, 11, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_12, IdentifierMode::kJoint, 12, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_13, IdentifierMode::kJoint, 13, 2000.0);
+BENCHMARK_CAPTURE(BM_IdentifierTick, fault_tick_14, IdentifierMode::kJoint, 14, 2000.0);
 BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_average, IdentifierMode::kConcurrent, 0);
 BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_j_tick, IdentifierMode::kConcurrent, 1);
 BENCHMARK_CAPTURE(BM_IdentifierTick, concurrent_r_tick, IdentifierMode::kConcurrent, 3);

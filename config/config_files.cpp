@@ -237,6 +237,16 @@ GncConfig load_gnc(const std::string& path) {
     fd.model_sigmas = r.non_negative("model_sigmas");
     fd.probe_after_windows = r.integer("probe_after_windows");
     fd.probe_windows = r.integer("probe_windows");
+    // (F14) stuck-on isolation inside identification; optional keys (off when absent).
+    if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
+    if (r.has("identified_zero_chi2")) fd.identified_zero_chi2 = r.positive("identified_zero_chi2");
+    if (r.has("identified_match_chi2")) {
+      fd.identified_match_chi2 = r.positive("identified_match_chi2");
+    }
+    if (r.has("identified_margin_chi2")) {
+      fd.identified_margin_chi2 = r.non_negative("identified_margin_chi2");
+    }
+    if (r.has("identified_windows")) fd.identified_windows = r.integer("identified_windows");
     p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
     r.finish();
   }

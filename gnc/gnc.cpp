@@ -44,6 +44,7 @@ ParamCheck Gnc::init(const GncParams& params) {
   excite_.restart();
   if (excitation_on()) excite_.set_model(alloc_.b_hat(), params_.rcs);
   excite_status_ = ExcitationStatus{};
+  fault_torque_scored_ = 0;
   fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
   fdi_.clear(-1);
   valve_open_ = {{true, true, true, true}};
@@ -115,6 +116,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   if (identification_started) {
     excite_.restart();
     ident_.configure(build_identifier_config(params_));
+    fault_torque_scored_ = 0;
     candidate_status_ = ModelCandidate::kNotConfident;
     candidate_windows_ = 0;
     fault_model_stale_ = false;
@@ -434,11 +436,26 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     in.force = last_force_;
     // While the detector suspects a fault it has not isolated, the identifier does not fit it
     // into J, r and k: those windows are discarded (gnc/fdi/README.md (F7)).
-    in.force_valid = !(params_.fdi.enabled && fdi_.suspecting());
+    // With the stuck-on isolation inside identification (F14), a suspected stuck-on is what the
+    // identifier's fault torque d (I22) absorbs, so its windows are kept: they are the evidence.
+    const bool stuck_on_suspected = fdi_.status().best >= 0 && fdi_.status().best < kThrusters;
+    in.force_valid = !(params_.fdi.enabled && fdi_.suspecting() &&
+                       !(params_.fdi.identified_isolation && stuck_on_suspected));
     // The identifier's step blocks stay off the fault detector's heavy evaluation steps
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
     ident_.update(in, !fdi_busy);
+    // (F14) The identifier's stuck-on evidence (I23), once per scored window.
+    const IdentifierFaultTorque& ft = ident_.fault_torque();
+    if (ft.scored != fault_torque_scored_) {
+      fault_torque_scored_ = ft.scored;
+      StuckOnEvidence ev;
+      ev.fitted = ft.fitted;
+      ev.chi2_zero = ft.chi2_zero;
+      ev.chi2_jet = ft.chi2_jet;
+      ev.chi2_column = ft.chi2_column;
+      fdi_.identified_evidence(ev);
+    }
     bool window_latched = false;
     if (ident_.counters().windows != candidate_windows_) {  // once per window, not per tick
       window_latched = true;

@@ -120,6 +120,7 @@ class Gnc {
   FaultModel fault_model_given_{};
   bool fault_model_held_{false};
   std::uint32_t gate_reinflations_seen_{0};
+  std::uint32_t fault_torque_scored_{0};  // (F14) identifier fault-torque scores passed on
   GncParams candidate_{};  // scratch for the automatic adoption (too large for a tick's stack)
 };
 

@@ -35,6 +35,15 @@ IdentifierConfig build_identifier_config(const GncParams& p) {
   c.j0 = total_inertia(p.mass_hat);
   c.r0 = p.mass_hat.r_so_bcm;
   c.k0 = p.rcs.strength;
+  // (I22) With the detector's stuck-on isolation inside identification (F14), the identifier
+  // carries a constant fault torque whose prior 1 sigma is the largest single-jet torque.
+  c.fault_torque_sigma = 0.0;
+  if (p.fdi.enabled && p.fdi.identified_isolation) {
+    for (int i = 0; i < kThrusters; ++i) {
+      const Vec3 arm = (thruster_position(p.rcs, i) + c.r0).cross(thruster_direction(p.rcs, i));
+      c.fault_torque_sigma = std::fmax(c.fault_torque_sigma, arm.norm() * p.rcs.u_max);
+    }
+  }
   return c;
 }
 

@@ -137,6 +137,12 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   }
   if (!finite_non_negative(c.gate_chi2)) return bad("gate_chi2", "must be >= 0 (0: no gate)");
   if (c.gate_reinflate_after < 1) return bad("gate_reinflate_after", "must be >= 1");
+  if (!finite_non_negative(c.fault_torque_sigma)) {
+    return bad("fault_torque_sigma", "must be >= 0 and finite (0: no fault torque state)");
+  }
+  if (c.fault_torque_sigma > 0.0 && c.mode != IdentifierMode::kJoint) {
+    return bad("fault_torque_sigma", "the fault torque state (I22) needs the joint mode");
+  }
   if (!finite_non_negative(c.disturbance_sigma)) {
     return bad("disturbance_sigma", "must be >= 0 and finite");
   }
@@ -183,7 +189,9 @@ void Identifier::configure(const IdentifierConfig& c) {
   const auto ticks_for = [](int g, int r) {
     return 1 + (kIdParams + g - 1) / g + 1 + 1 + (kIdParams + r - 1) / r +
            (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
-           (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1;
+           (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1 +
+           (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick +
+           (kIdParams + kSettleRowsPerTick - 1) / kSettleRowsPerTick;
   };
   gain_rows_per_tick_ = 4;
   cov_rows_per_tick_ = 1;
@@ -219,6 +227,15 @@ void Identifier::reset() {
   p_all_.block<3, 3>(kIdR, kIdR) = p_r_;
   p_all_.block<kThrusters, kThrusters>(kIdK, kIdK) = p_k_;
   p_all_.block<3, 3>(kIdB, kIdB) = p_b_;
+  d_.setZero();
+  p_all_.block<3, 3>(kIdD, kIdD) =
+      c_.fault_torque_sigma * c_.fault_torque_sigma * Mat3::Identity();
+  ft_ = IdentifierFaultTorque{};
+  ft_.d_cov = p_all_.block<3, 3>(kIdD, kIdD);
+  fault_jet_next_ = 0;
+  settle_streak_ = 0;
+  d_held_zero_ = false;
+  settle_ = SettleStep{};
   reference_.fill(true);
   joint_ = JointStep{};
   anchor_ = AnchorStep{};
@@ -249,6 +266,7 @@ void reinflate_block(Eigen::Matrix<double, N, N>& p, int first, int n, double va
 void Identifier::reinflate_inertia() {
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.j_prior_sigma * c_.j_prior_sigma;
@@ -260,6 +278,7 @@ void Identifier::reinflate_inertia() {
 void Identifier::reinflate_offset() {
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   const double v = c_.r_prior_sigma * c_.r_prior_sigma;
@@ -272,6 +291,7 @@ void Identifier::reinflate_thruster(int i) {
   if (i < 0 || i >= kThrusters) return;
   joint_finish_covariance();
   finish_anchor();
+  finish_settle();
   joint_.pending = false;
   joint_.started = false;
   const double v = c_.k_prior_sigma * c_.k_prior_sigma;
@@ -285,7 +305,26 @@ void Identifier::reinflate_all() {
   reinflate_inertia();
   reinflate_offset();
   for (int i = 0; i < kThrusters; ++i) reinflate_thruster(i);
-  counters_.reinflations -= 2 + kThrusters;
+  // (I22) d too, unless it was settled at zero (I24): a fault the detector isolated while d was
+  // out of the state was never in d, and is gone with its valve.
+  const bool d_live = !d_held_zero_;
+  if (d_live) reinflate_fault_torque();
+  counters_.reinflations -= (d_live ? 3 : 2) + kThrusters;
+  ++counters_.reinflations;
+}
+
+void Identifier::reinflate_fault_torque() {
+  // (I22) A declared change (a confirmed fault, its valve closed) changes the constant torque
+  // too: d goes back to its prior covariance; the estimate is kept as the starting point.
+  joint_finish_covariance();
+  finish_anchor();
+  finish_settle();
+  joint_.pending = false;
+  joint_.started = false;
+  finish_settle();
+  reinflate_block<kIdParams>(p_all_, kIdD, 3, c_.fault_torque_sigma * c_.fault_torque_sigma);
+  d_held_zero_ = false;
+  settle_streak_ = 0;
   ++counters_.reinflations;
 }
 
@@ -342,12 +381,14 @@ void Identifier::joint_gain() {
   // (joint_covariance_step), so no tick carries more than a block of the 28-parameter step.
   joint_.pending = false;
   joint_.started = false;
+  window_fitted_ = false;
   const Vec3 force = net_force_impulse();
   const Mat316 phi_k = strength_regressor();
   const Vec3 tau = phi_k * k_;
   // (I17): the rate carries a bias b: e = A_J a - G(a) b - tau, G(a) b = [S(m) L(b) + S(b) L(m)] a.
   const Mat3 g = bias_jacobian();
-  joint_.e0 = latched_.a_j * a_ - g * b_ - tau;
+  // (I22): a constant torque d adds W d, W = ∫ w dt.
+  joint_.e0 = latched_.a_j * a_ - g * b_ - tau - latched_.weight * d_;
   exc_.inertia_motion = latched_.a_j.norm() * a_.norm() >= torque_threshold();
   exc_.inertia_scale = tau.norm() >= torque_threshold();
   exc_.offset = force.norm() >= c_.min_force_impulse;
@@ -363,6 +404,7 @@ void Identifier::joint_gain() {
   h.middleCols<3>(kIdR) = skew(force);
   h.middleCols<kThrusters>(kIdK) = -phi_k;
   h.middleCols<3>(kIdB) = -g;
+  h.middleCols<3>(kIdD) = -latched_.weight * Mat3::Identity();
 
   // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
   VecId& d = joint_.d;
@@ -416,6 +458,9 @@ bool Identifier::joint_gain_rows() {
       reinflate_block<kIdParams>(p_all_, kIdJ, 6, c_.j_prior_sigma * c_.j_prior_sigma);
       reinflate_block<kIdParams>(p_all_, kIdR, 3, c_.r_prior_sigma * c_.r_prior_sigma);
       reinflate_block<kIdParams>(p_all_, kIdK, kThrusters, c_.k_prior_sigma * c_.k_prior_sigma);
+      reinflate_block<kIdParams>(p_all_, kIdD, 3, c_.fault_torque_sigma * c_.fault_torque_sigma);
+      d_held_zero_ = false;
+      settle_streak_ = 0;
       ++counters_.reinflations;
       ++counters_.gate_reinflations;
     }
@@ -435,7 +480,7 @@ void Identifier::joint_apply() {
   if (!joint_.pending) return;
   joint_.pending = false;
   VecId x;
-  x << a_, r_, k_, b_;
+  x << a_, r_, k_, b_, d_;
   x -= joint_.k * joint_.e0;
   // Guards (I14): J positive definite and physical, r within bounds; else the update is refused
   // and the covariance left as it was.
@@ -463,6 +508,7 @@ void Identifier::joint_apply() {
   r_ = x.segment<3>(kIdR);
   k_ = x.segment<kThrusters>(kIdK);
   b_ = x.segment<3>(kIdB);
+  d_ = x.segment<3>(kIdD);
   for (int i = 0; i < kThrusters; ++i) {
     const double clamped = std::fmin(std::fmax(k_(i), c_.k_min), c_.k_max);
     if (clamped != k_(i)) {
@@ -470,6 +516,7 @@ void Identifier::joint_apply() {
       ++counters_.strength_clamped;
     }
   }
+  window_fitted_ = true;
   ++counters_.inertia_updates;
   if (exc_.offset) ++counters_.offset_updates;
   if (joint_.any_thruster) ++counters_.strength_updates;
@@ -531,11 +578,13 @@ void Identifier::joint_finish_covariance() {
     joint_.sym_rows = kIdParams;
   }
   // No variance above its prior (no wind-up while a direction is not excited).
-  const double caps[4] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
+  const double caps[5] = {c_.j_prior_sigma * c_.j_prior_sigma, c_.r_prior_sigma * c_.r_prior_sigma,
                           c_.k_prior_sigma * c_.k_prior_sigma,
-                          c_.gyro_bias_sigma * c_.gyro_bias_sigma};
+                          c_.gyro_bias_sigma * c_.gyro_bias_sigma,
+                          c_.fault_torque_sigma * c_.fault_torque_sigma};
   for (int i = 0; i < kIdParams; ++i) {
-    const double cap = caps[i < kIdR ? 0 : (i < kIdK ? 1 : (i < kIdB ? 2 : 3))];
+    const double cap =
+        caps[i < kIdR ? 0 : (i < kIdK ? 1 : (i < kIdB ? 2 : (i < kIdD ? 3 : 4)))];
     if (p_all_(i, i) > cap) {
       const double f = std::sqrt(cap / p_all_(i, i));
       p_all_.row(i) *= f;
@@ -570,7 +619,7 @@ void Identifier::anchor_scale() {
     const double cpc = c.dot(pc);
     if (!(cpc > 0.0)) return;
     VecId x;
-    x << a_, r_, k_, b_;
+    x << a_, r_, k_, b_, d_;
     x -= pc * ((c.dot(x) - b) / cpc);
     // P -= P c c'P / (c'P c), a block of rows per tick from the next tick on (anchor_rows).
     anchor_.pc = pc;
@@ -581,6 +630,7 @@ void Identifier::anchor_scale() {
     r_ = x.segment<3>(kIdR);
     k_ = x.segment<kThrusters>(kIdK);
     b_ = x.segment<3>(kIdB);
+    d_ = x.segment<3>(kIdD);
   } else {
     const Vec16 ck = c.segment<kThrusters>(kIdK);
     const Vec16 pc = p_k_ * ck;
@@ -740,7 +790,34 @@ void Identifier::step_phase() {
       // applies from here on.
       apply_bias_changes();
       report();
-      phase_ = Phase::kIdle;
+      fault_jet_next_ = 0;
+      phase_ = c_.fault_torque_sigma > 0.0 ? Phase::kFaultScore : Phase::kIdle;
+      break;
+    case Phase::kFaultScore: {
+      const int n = std::min(kFaultJetsPerTick, kThrusters - fault_jet_next_);
+      score_fault_torque(fault_jet_next_, n);
+      fault_jet_next_ += n;
+      if (fault_jet_next_ >= kThrusters) {
+        ++ft_.scored;
+        phase_ = Phase::kIdle;
+        // (I24) d settled at zero?
+        if (ft_.fitted) {
+          const double gate = c_.gate_chi2 > 0.0 ? c_.gate_chi2 : 16.27;
+          const double settled = 0.1 * c_.fault_torque_sigma;
+          const bool quiet = ft_.chi2_zero < gate &&
+                             ft_.d_cov.diagonal().maxCoeff() <= settled * settled;
+          settle_streak_ = quiet ? settle_streak_ + 1 : 0;
+          if (settle_streak_ >= kSettleWindows) {
+            settle_streak_ = 0;
+            start_settle();
+            if (settle_.pending) phase_ = Phase::kSettle;
+          }
+        }
+      }
+      break;
+    }
+    case Phase::kSettle:
+      if (settle_rows()) phase_ = Phase::kIdle;
       break;
     case Phase::kIdle:
       break;
@@ -1011,11 +1088,106 @@ void Identifier::report() {
 
   // Residual of the last window with the latest estimates (I12).
   if (latched_.weight > 0.0) {
-    const Vec3 res = latched_.a_j * a_ - bias_jacobian() * b_ - model_torque_impulse(k_, r_);
+    const Vec3 res = latched_.a_j * a_ - bias_jacobian() * b_ - model_torque_impulse(k_, r_) -
+                     latched_.weight * d_;
     est_.residual_torque = res / latched_.weight;
     // Against the window's innovation covariance before the update (joint: S; concurrent: the
     // inertia group's noise plus its own consider term).
     est_.residual_chi2 = res.dot(residual_cov_.ldlt().solve(res));
+  }
+}
+
+void Identifier::score_fault_torque(int first, int n) {
+  // (I23) d-hat against "thruster i stuck on": t_i = d - u_max k_i (p_i + r) x e_i, linearised in
+  // (d, r, k_i): dt/dd = I, dt/dr = u_max k_i S(e_i), dt/dk_i = -u_max (p_i + r) x e_i, and
+  // chi2_i = t_i' (M_i P_(d,r,k_i) M_i')^-1 t_i with the joint covariance (cross terms included).
+  const Mat3 p_dd = p_all_.block<3, 3>(kIdD, kIdD);
+  const Mat3 p_dr = p_all_.block<3, 3>(kIdD, kIdR);
+  const Mat3 p_rr = p_all_.block<3, 3>(kIdR, kIdR);
+  if (first == 0) {
+    ft_.d = d_;
+    ft_.d_cov = p_dd;
+    ft_.fitted = window_fitted_;
+    ft_.held_zero = d_held_zero_;
+    const Eigen::LDLT<Mat3> l(p_dd);
+    ft_.chi2_zero = l.info() == Eigen::Success && l.isPositive() ? d_.dot(l.solve(d_)) : 0.0;
+  }
+  const double u_max = c_.rcs.u_max;
+  for (int i = first; i < first + n; ++i) {
+    const Vec3 arm = (p_pos_[i] + r_).cross(e_[i]);
+    const Vec3 t = d_ - u_max * k_(i) * arm;
+    const Mat3 a = u_max * k_(i) * skew(e_[i]);  // dt/dr
+    const Vec3 c = -u_max * arm;                  // dt/dk_i
+    const Vec3 p_dk = p_all_.block<3, 1>(kIdD, kIdK + i);
+    const Vec3 p_rk = p_all_.block<3, 1>(kIdR, kIdK + i);
+    const double p_kk = p_all_(kIdK + i, kIdK + i);
+    const Mat3 ap_rd = a * p_dr.transpose();
+    const Vec3 ap_rk = a * p_rk;
+    // The column's own covariance (r and k_i), then with d's terms.
+    const Mat3 col_cov = a * p_rr * a.transpose() + ap_rk * c.transpose() +
+                         c * ap_rk.transpose() + p_kk * (c * c.transpose());
+    const Vec3 col = u_max * k_(i) * arm;
+    // Along the column's own direction (S(e_i) makes col_cov rank-deficient without k's term):
+    // (|col|^2)^2 / col' C col, the squared ratio of its length to its 1 sigma there.
+    const double c2 = col.squaredNorm();
+    const double var = col.dot(col_cov * col);
+    ft_.chi2_column[static_cast<std::size_t>(i)] = var > 0.0 ? c2 * c2 / var : 0.0;
+    const Mat3 cov = p_dd + ap_rd + ap_rd.transpose() + col_cov + p_dk * c.transpose() +
+                     c * p_dk.transpose();
+    const Eigen::LDLT<Mat3> l(cov);
+    ft_.chi2_jet[static_cast<std::size_t>(i)] =
+        l.info() == Eigen::Success && l.isPositive() ? t.dot(l.solve(t)) : 1e300;
+  }
+}
+
+void Identifier::start_settle() {
+  // (I24) The perfect pseudo-measurement d = 0: x <- x - P_:d P_dd^-1 d, P <- P - P_:d P_dd^-1 P_d:
+  // (the state now, the covariance a block of rows per tick in settle_rows).
+  const Mat3 p_dd = p_all_.block<3, 3>(kIdD, kIdD);
+  const Eigen::LDLT<Mat3> l(p_dd);
+  if (l.info() != Eigen::Success || !l.isPositive()) return;
+  settle_.pd = p_all_.middleCols<3>(kIdD);
+  settle_.g = settle_.pd * l.solve(Mat3::Identity());
+  VecId x;
+  x << a_, r_, k_, b_, d_;
+  x -= settle_.g * d_;
+  const Mat3 j = inertia_matrix(x.head<6>());
+  if (!j.allFinite() || Eigen::LLT<Mat3>(j).info() != Eigen::Success) return;  // (I14)
+  a_ = x.head<6>();
+  r_ = x.segment<3>(kIdR);
+  k_ = x.segment<kThrusters>(kIdK);
+  b_ = x.segment<3>(kIdB);
+  d_.setZero();
+  settle_.rows = 0;
+  settle_.pending = true;
+  d_held_zero_ = true;
+}
+
+bool Identifier::settle_rows() {
+  if (!settle_.pending) return true;
+  // Element (i, j) loses g(lo) . pd(hi), lo = min(i, j): the same product for (j, i), so P stays
+  // exactly symmetric whichever rows are done first.
+  const int first = settle_.rows;
+  const int n = std::min(kSettleRowsPerTick, kIdParams - first);
+  for (int i = first; i < first + n; ++i) {
+    for (int j = 0; j < kIdParams; ++j) {
+      const int lo = i < j ? i : j;
+      const int hi = i < j ? j : i;
+      p_all_(i, j) -= settle_.g.row(lo).dot(settle_.pd.row(hi));
+    }
+  }
+  settle_.rows = first + n;
+  if (settle_.rows < kIdParams) return false;
+  settle_.pending = false;
+  // d is out of the state: exactly zero rows and columns (no gain, no uncertainty).
+  p_all_.middleRows<3>(kIdD).setZero();
+  p_all_.middleCols<3>(kIdD).setZero();
+  sync_blocks();
+  return true;
+}
+
+void Identifier::finish_settle() {
+  while (!settle_rows()) {
   }
 }
 

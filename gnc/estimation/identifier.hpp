@@ -45,13 +45,15 @@ Vec3 thruster_position(const RcsLayout& l, int i);
 // drops.
 enum class IdentifierMode : std::uint8_t { kConcurrent = 0, kJoint = 1 };
 
-// Joint state [a (6); r (3); k (16); b (3)]: b is the bias of the rate the identifier is given
-// (I17). Index of each group's first parameter:
+// Joint state [a (6); r (3); k (16); b (3); d (3)]: b is the bias of the rate the identifier is
+// given (I17), d an unknown constant body-frame torque (I22: a stuck-on thruster present while the
+// model is identified). Index of each group's first parameter:
 inline constexpr int kIdJ = 0;
 inline constexpr int kIdR = 6;
 inline constexpr int kIdK = 9;
 inline constexpr int kIdB = 9 + kThrusters;
-inline constexpr int kIdParams = 6 + 3 + kThrusters + 3;
+inline constexpr int kIdD = 9 + kThrusters + 3;
+inline constexpr int kIdParams = 6 + 3 + kThrusters + 3 + 3;
 using VecId = Eigen::Matrix<double, kIdParams, 1>;
 using MatId = Eigen::Matrix<double, kIdParams, kIdParams>;
 
@@ -89,6 +91,12 @@ struct IdentifierConfig {
   // (consistency from far priors; slower to become confident while r and k are both uncertain).
   bool second_order_noise{false};
   int gate_reinflate_after{3};
+  // (I22, kJoint) An unknown constant body-frame torque d (N m) joins the window equation,
+  // prior 1 sigma per axis fault_torque_sigma (the largest single-jet torque): a stuck-on thruster
+  // present while the model is identified is then fitted as d instead of breaking J, r and k,
+  // and d-hat with its covariance is the evidence for the 16 stuck-on hypotheses (I23), scored
+  // after each window (fault_torque()). 0: no such state (d held at zero).
+  double fault_torque_sigma{0.0};
   double disturbance_sigma{0.57735026918962576};
   double disturbance_corr_s{10.0};
   double torque_floor{0.1};
@@ -200,6 +208,24 @@ struct IdentifierEstimate {
   double residual_chi2{0.0};
 };
 
+// (I23) The stuck-on evidence of the fault torque d (I22), scored after each window.
+struct IdentifierFaultTorque {
+  std::uint32_t scored{0};       // windows scored so far (changes when a new score is out)
+  bool fitted{false};            // the scored window updated the estimate (not gated, not refused)
+  Vec3 d{Vec3::Zero()};          // d-hat, N m (F_B)
+  Mat3 d_cov{Mat3::Zero()};      // its covariance
+  double chi2_zero{0.0};         // d-hat' P_d^-1 d-hat: d against zero (3 dof)
+  // (d-hat - u_max k_i (p_i + r) x e_i)' C_i^-1 (...), C_i from the joint covariance of d, r
+  // and k_i: d against thruster i stuck on (3 dof).
+  std::array<double, kThrusters> chi2_jet{};
+  // u_max k_i (p_i + r) x e_i against zero along its own direction, with its covariance from r
+  // and k_i (1 dof, (|col|^2)^2 / col' C col): how far thruster
+  // i's stuck-on torque stands out of the model's uncertainty (a jet near the centre of mass, or
+  // whose arm r makes uncertain, cannot be told from no fault).
+  std::array<double, kThrusters> chi2_column{};
+  bool held_zero{false};  // d was settled at zero (I24) and is out of the state
+};
+
 class Identifier {
  public:
   // Takes a validated config; sets the estimates to the priors.
@@ -218,7 +244,8 @@ class Identifier {
   void reinflate_inertia();
   void reinflate_offset();
   void reinflate_thruster(int i);
-  void reinflate_all();
+  void reinflate_all();  // also the fault torque d (I22)
+  void reinflate_fault_torque();
   // The rate given from the next window on has `delta` subtracted beyond what was subtracted so
   // far (e.g. a new gyro-bias estimate from the attitude filter): the bias state follows,
   // b <- b - delta, once the step of the window already closed (which used the old rate) is done.
@@ -237,6 +264,7 @@ class Identifier {
   const Mat3& offset_covariance() const { return p_r_; }
   const Mat16& strength_covariance() const { return p_k_; }
   const Mat3& bias_covariance() const { return p_b_; }
+  const IdentifierFaultTorque& fault_torque() const { return ft_; }
 
  private:
   // The data of one window, latched at its end.
@@ -251,8 +279,32 @@ class Identifier {
     Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
   };
   enum class Phase : std::uint8_t {
-    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport
+    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore, kSettle
   };
+  // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
+  static constexpr int kFaultJetsPerTick = 2;
+  int fault_jet_next_{0};
+  bool window_fitted_{false};  // the latched window's step updated the estimate
+  // (I24) d settled at zero: once d-hat has stayed consistent with zero (chi-square below the
+  // gate) with a 1 sigma below a tenth of its prior for kSettleWindows fitted windows, the
+  // pseudo-measurement d = 0 is applied (its information returns to J, r and k) and d is held
+  // out of the state until the gate or a declared change re-inflates it.
+  static constexpr int kSettleWindows = 3;
+  static constexpr int kSettleRowsPerTick = 7;
+  int settle_streak_{0};
+  bool d_held_zero_{false};
+  struct SettleStep {
+    bool pending{false};
+    int rows{0};
+    Eigen::Matrix<double, kIdParams, 3> pd{Eigen::Matrix<double, kIdParams, 3>::Zero()};  // P_:d
+    Eigen::Matrix<double, kIdParams, 3> g{Eigen::Matrix<double, kIdParams, 3>::Zero()};   // P_:d P_dd^-1
+  };
+  SettleStep settle_{};
+  void start_settle();   // (I24) the state, and the rank-3 covariance term's factors
+  bool settle_rows();    // ... a block of rows of the covariance (true when done)
+  void finish_settle();  // ... every remaining row
+  void score_fault_torque(int first, int n);  // (I23) thrusters [first, first + n)
+  IdentifierFaultTorque ft_{};
 
   void accumulate(const IdentifierInput& in);
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
@@ -302,6 +354,7 @@ class Identifier {
   Mat16 p_k_{Mat16::Identity()};
   Vec3 b_{Vec3::Zero()};
   Mat3 p_b_{Mat3::Zero()};
+  Vec3 d_{Vec3::Zero()};  // (I22) constant body torque, N m
   Vec3 bias_shift_{Vec3::Zero()};           // shift_rate_bias not yet applied (a step is running)
   Vec3 bias_consider_sigma_{Vec3::Zero()};  // consider_rate_bias not yet applied
   bool bias_consider_pending_{false};

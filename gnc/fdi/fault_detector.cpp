@@ -30,6 +30,18 @@ Check validate(const FaultDetectorParams& p) {
   if (p.probe_windows < 0 || p.probe_windows > 1000) {
     return bad("fdi.probe_windows", "must be in [0, 1000]");
   }
+  if (!finite_positive(p.identified_zero_chi2)) {
+    return bad("fdi.identified_zero_chi2", "must be positive");
+  }
+  if (!finite_positive(p.identified_match_chi2)) {
+    return bad("fdi.identified_match_chi2", "must be positive");
+  }
+  if (!finite_non_negative(p.identified_margin_chi2)) {
+    return bad("fdi.identified_margin_chi2", "must be >= 0");
+  }
+  if (p.identified_windows < 1 || p.identified_windows > 1000) {
+    return bad("fdi.identified_windows", "must be in [1, 1000]");
+  }
   return Check{};
 }
 
@@ -144,6 +156,9 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
 }
 
 void FaultDetector::clear(int thruster) {
+  identified_confirm_ = -1;
+  st_.identified_best = -1;
+  st_.identified_streak = 0;
   if (thruster < 0) {
     st_.confirmed_on = 0;
     st_.confirmed_off = 0;
@@ -160,9 +175,55 @@ void FaultDetector::clear(int thruster) {
   st_.probe_pod = -1;
 }
 
+void FaultDetector::identified_evidence(const StuckOnEvidence& e) {
+  if (!p_.enabled || !p_.identified_isolation) return;
+  // (F14): the best-matching thruster not already latched, and the runner-up.
+  int best = -1;
+  double c1 = 1e300;  // its chi-square
+  double c2 = 1e300;  // the runner-up's
+  for (int i = 0; i < kThrusters; ++i) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    const double c = e.chi2_jet[static_cast<std::size_t>(i)];
+    if (!(c >= 0.0)) continue;  // NaN or negative: no evidence
+    if (c < c1) {
+      c2 = c1;
+      c1 = c;
+      best = i;
+    } else if (c < c2) {
+      c2 = c;
+    }
+  }
+  const bool pass = e.fitted && best >= 0 && e.chi2_zero > p_.identified_zero_chi2 &&
+                    e.chi2_column[static_cast<std::size_t>(best)] > p_.identified_zero_chi2 &&
+                    c1 < p_.identified_match_chi2 && c2 - c1 > p_.identified_margin_chi2;
+  if (!e.fitted) return;  // a gated or refused window neither adds nor breaks a streak
+  if (!pass) {
+    st_.identified_best = -1;
+    st_.identified_streak = 0;
+    return;
+  }
+  st_.identified_streak = best == st_.identified_best ? st_.identified_streak + 1 : 1;
+  st_.identified_best = best;
+  if (st_.identified_streak >= p_.identified_windows) identified_confirm_ = best;
+}
+
 FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   pending_ = FaultEvents{};
   if (!p_.enabled) return pending_;
+  if (identified_confirm_ >= 0) {
+    // (F14) The identifier isolated a stuck-on jet: the same latch and event as (F6).
+    const int thruster = identified_confirm_;
+    identified_confirm_ = -1;
+    st_.identified_best = -1;
+    st_.identified_streak = 0;
+    if (((st_.confirmed_on >> thruster) & 1u) == 0) {
+      declare(thruster, FaultKind::kStuckOn);
+      ++st_.identified_confirmations;
+      pending_.confirmed = true;
+      pending_.thruster = thruster;
+      pending_.kind = FaultKind::kStuckOn;
+    }
+  }
   // (F10) One step of the closed window's evaluation per tick, whatever this tick's data; a model
   // that arrived meanwhile is taken once it is done (before this tick's sample, like any other).
   if (eval_phase_ != 0) {

@@ -52,6 +52,26 @@ struct FaultDetectorParams {
   // this many windows, its pod's valve is closed for probe_windows windows (0: never).
   int probe_after_windows{1};
   int probe_windows{3};
+  // (F14) Stuck-on isolation inside identification: the identifier's constant fault torque d
+  // (estimation README I22) scored against each stuck-on column (I23). Thruster i is confirmed
+  // stuck on when, in identified_windows fitted windows in a row, d-hat is at least
+  // identified_zero_chi2 from zero (3 dof), within identified_match_chi2 of thruster i's torque,
+  // thruster i's torque itself at least identified_zero_chi2 from zero (with the model's
+  // uncertainty of it), and every other thruster's chi-square exceeds i's by
+  // identified_margin_chi2.
+  bool identified_isolation{false};
+  double identified_zero_chi2{100.0};
+  double identified_match_chi2{16.27};  // chi-square(3) at 0.999
+  double identified_margin_chi2{25.0};
+  int identified_windows{2};
+};
+
+// (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
+struct StuckOnEvidence {
+  bool fitted{false};      // the window updated the identifier's estimate
+  double chi2_zero{0.0};   // fault torque against zero
+  std::array<double, kThrusters> chi2_jet{};  // fault torque against thruster i stuck on
+  std::array<double, kThrusters> chi2_column{};  // thruster i's stuck-on torque against zero
 };
 
 Check validate(const FaultDetectorParams& p);
@@ -96,6 +116,11 @@ struct FaultDetectorStatus {
   int probe_pod{-1};              // (F9) pod whose valve the detector asks closed for a test, -1 none
   std::uint32_t probes{0};        // isolation tests started
   int ambiguous_with{-1};         // the alternative the leader could not be told from, -1 none
+  // (F14) The identifier's evidence: the thruster whose stuck-on torque it matches best (-1 none)
+  // and how many fitted windows in a row it has passed the isolation test.
+  int identified_best{-1};
+  int identified_streak{0};
+  std::uint32_t identified_confirmations{0};  // faults confirmed through (F14)
 };
 
 // Raised by update(); the caller turns them into events.
@@ -126,6 +151,9 @@ class FaultDetector {
   // Ground overrides and what the flight does after isolation.
   void declare(int thruster, FaultKind kind);  // latches it (as if confirmed)
   void clear(int thruster);                    // -1: every thruster
+  // (F14) Evidence from the identifier's fault torque, after each of its windows. A stuck-on it
+  // isolates is confirmed on the next update (the same event and latch as (F6)).
+  void identified_evidence(const StuckOnEvidence& e);
   const FaultDetectorStatus& status() const { return st_; }
   std::uint16_t confirmed_on() const { return st_.confirmed_on; }
   std::uint16_t confirmed_off() const { return st_.confirmed_off; }
@@ -248,6 +276,7 @@ class FaultDetector {
   int probe_left_{0};
   FaultDetectorStatus st_{};
   FaultEvents pending_{};
+  int identified_confirm_{-1};  // (F14) thruster to confirm stuck on at the next update
 };
 
 }  // namespace rocksteady::gnc

@@ -74,7 +74,7 @@ TEST(EstimationHeap, IdentifierUpdatesAllocateNothingInEveryPhase) {
 // The flight's settings (I17-I21): the rate bias carried (considered and estimated), the
 // second-order term, the innovation gate (forced to refuse and re-inflate by a tiny threshold), and
 // the bias corrections from upstream.
-TEST(EstimationHeap, IdentifierWithBiasGateAndSecondOrderTermAllocatesNothing) {
+TEST(EstimationHeap, IdentifierWithBiasGateSecondOrderTermAndFaultTorqueAllocatesNothing) {
   for (bool estimated : {false, true}) {
     for (double gate : {16.27, 1e-9}) {
       IdentifierConfig c;
@@ -86,6 +86,7 @@ TEST(EstimationHeap, IdentifierWithBiasGateAndSecondOrderTermAllocatesNothing) {
       c.gyro_bias_estimated = estimated;
       c.second_order_noise = true;
       c.gate_chi2 = gate;
+      c.fault_torque_sigma = 2000.0;  // (I22)-(I23): the fault torque and its per-window scores
       Identifier id;
       id.configure(c);
       IdentifierInput in;
@@ -106,6 +107,7 @@ TEST(EstimationHeap, IdentifierWithBiasGateAndSecondOrderTermAllocatesNothing) {
       }
       EXPECT_EQ(counted, 0);
       EXPECT_GT(id.counters().windows, 15u);
+      EXPECT_GT(id.fault_torque().scored, 10u);
       if (gate < 1.0) {
         EXPECT_GT(id.counters().gate_reinflations, 0u);
       }

@@ -5,6 +5,7 @@
 
 #include "heap_counter.hpp"
 
+#include <cmath>
 #include <cstdlib>
 
 #include "gnc/gnc.hpp"
@@ -240,6 +241,75 @@ TEST(ZeroAllocation, NoHeapWhenATrajectoryIsStagedAndSwitchedAtATickBoundary) {
   delete stale;
   delete replan;
   delete first;
+  delete loop;
+}
+
+// gnc/fdi/README.md (F14), estimation README (I22)-(I23): the identifier's fault torque state,
+// its per-window scoring of the 16 stuck-on columns and the detector's confirmation from it, with
+// channel 1's "+" jet stuck on from the first tick: no heap in any tick.
+TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {
+  GncParams truth = test::small_vehicle_params();
+  auto* loop = new test::SmallLoop(truth);
+  GncParams p = truth;
+  p.mass_hat.j_ast(0, 0) *= 1.3;
+  p.mass_hat.r_so_bcm += Vec3(0.05, -0.04, 0.045);
+  p.law = LawId::kNtcl;
+  IdentificationParams& id = p.identification;
+  id.enabled = true;
+  id.config.window_s = 2.0;
+  id.config.j_prior_sigma = 5.0;
+  id.config.r_prior_sigma = 0.5;
+  id.config.k_prior_sigma = 0.01;
+  id.config.disturbance_sigma = 1e-4;
+  id.config.torque_floor = 1e-4;
+  id.config.min_torque_impulse = 0.05;
+  id.config.min_force_impulse = 0.02;
+  id.config.min_thruster_impulse = 0.005;
+  id.config.gate_chi2 = 16.27;
+  id.config.second_order_noise = true;
+  p.fdi.enabled = true;
+  p.fdi.identified_isolation = true;
+  p.fdi.identified_zero_chi2 = 25.0;  // the small vehicle reaches HOLD within ~40 s: decide sooner
+  loop->body.omega *= 2.0;
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  constexpr int kChannel = 1;
+  const int pod = truth.rcs.channel_pod[kChannel];
+  const double u_max = truth.rcs.u_max;
+  long counted = -1;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    for (int i = 0; i < 2400; ++i) {
+      loop->gnc.step(loop->sample(), i == 0 ? c : GncCommands{}, loop->out);
+      Vec8 f = loop->out.command.force;
+      // The "+" jet at u_max whatever is commanded; a "-" command still fires the "-" jet.
+      if (loop->out.command.valve_open[static_cast<std::size_t>(pod)]) {
+        f(kChannel) = u_max + std::fmin(f(kChannel), 0.0);
+      }
+      loop->body.step(p.dt, loop->b_true * f);
+      loop->t += p.dt;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  // The new path ran under the counter: windows scored against the 16 columns, and the
+  // confirmation it raised (the valve closure and the identifier's re-inflation with it).
+  EXPECT_EQ(loop->gnc.fault_detector().status().identified_confirmations, 1u);
+  EXPECT_EQ(loop->gnc.fault_detector().confirmed_on(), 1u << (2 * kChannel));
+  EXPECT_GT(loop->gnc.identifier().fault_torque().scored, 10u)
+      << "windows " << loop->gnc.identifier().counters().windows << " discarded "
+      << loop->gnc.identifier().counters().windows_discarded << " gated "
+      << loop->gnc.identifier().counters().windows_gated << " confirmed on "
+      << loop->gnc.fault_detector().confirmed_on() << " identified "
+      << loop->gnc.fault_detector().status().identified_confirmations << " mode "
+      << to_string(loop->gnc.mode()) << " |w| " << loop->body.omega.norm() << " chi2 zero "
+      << loop->gnc.identifier().fault_torque().chi2_zero << " jet "
+      << loop->gnc.identifier().fault_torque().chi2_jet[2] << " d "
+      << loop->gnc.identifier().fault_torque().d.transpose() << " col "
+      << (loop->b_true.col(kChannel) * u_max).transpose() << " fitted "
+      << loop->gnc.identifier().fault_torque().fitted;
   delete loop;
 }
 

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "gnc/gnc.hpp"
 #include "gnc/math/rotation.hpp"
@@ -292,6 +293,125 @@ TEST(GncFdi, InhibitedIsolationConfirmsButKeepsTheValveOpen) {
   for (bool v : out.command.valve_open) EXPECT_TRUE(v);
   // The stuck jet's torque is flown as a known bias: the allocator's achieved torque includes it.
   EXPECT_GT(out.telemetry.alloc.torque_achieved.norm(), 0.0);
+}
+
+// gnc/fdi/README.md (F14), estimation README (I22)-(I23): a stuck-on jet present from the start
+// of identification. The flight starts from a wrong table (J 10 % off about two axes, r 0.4 m
+// off) with the flight's identifier settings (20 s windows, the innovation gate, J, r, k priors
+// as in gnc.yaml); the truth's jet fires at u_max from the first tick. The identifier fits the
+// jet's torque as its constant fault torque d, and the detector isolates the jet from d-hat's
+// match to its column. Without (F14) nothing is ever confirmed in the same time: the model never
+// converges around the unmodelled jet.
+struct IdentifiedRun {
+  int confirmed_tick{-1};
+  std::uint16_t confirmed_on{0};
+  std::uint16_t confirmed_off{0};
+  int first_thruster{-1};
+  FaultKind first_kind{FaultKind::kNone};
+  std::uint32_t identified_confirmations{0};
+  std::uint32_t scored{0};
+  double max_chi2_zero{0.0};  // healthy: the largest d-hat against zero seen
+  bool valve_closed{false};
+};
+
+GncParams identified_params(bool identified_isolation) {
+  GncParams p = study_gnc_params(200.0);
+  p.law = LawId::kNtcl;
+  p.fdi.enabled = true;
+  p.fdi.gyro_sigma = 1e-7;
+  p.fdi.identified_isolation = identified_isolation;
+  IdentificationParams& id = p.identification;
+  id.enabled = true;
+  id.adopt = ModelAdoption::kOff;
+  IdentifierConfig& c = id.config;  // gnc.yaml's identification settings
+  c.window_s = 20.0;
+  c.j_prior_sigma = 1e7;
+  c.r_prior_sigma = 1.0;
+  c.k_prior_sigma = 0.01;
+  c.second_order_noise = true;
+  c.gate_chi2 = 16.27;
+  c.gate_reinflate_after = 3;
+  return p;
+}
+
+IdentifiedRun fly_identified(int stuck_on, bool identified_isolation, int ticks) {
+  const GncParams truth_params = identified_params(identified_isolation);
+  Truth truth(truth_params);
+  truth.body.omega = V3(0.012, -0.018, 0.025);
+  truth.stuck_on = stuck_on;  // from the first tick: before anything is identified
+  Mat3 j_table = total_inertia(truth_params.mass_hat);
+  j_table(0, 0) *= 1.1;
+  j_table(1, 1) *= 0.9;
+  const GncParams p = with_model(truth_params, j_table,
+                                 truth_params.mass_hat.r_so_bcm + Vec3(0.3, -0.2, 0.2),
+                                 truth_params.rcs.strength);
+  auto* gnc = new Gnc;  // (large: off the test's stack)
+  IdentifiedRun run;
+  EXPECT_TRUE(gnc->init(p).ok);
+  GncOutput out;
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  double t = 0.0;
+  for (int k = 0; k < ticks; ++k) {
+    gnc->step(truth.sample(t), k == 0 ? c : GncCommands{}, out);
+    for (int e = 0; e < out.events.count; ++e) {
+      const ModeEvent& ev = out.events.items[e];
+      if (ev.id == EventId::kFaultConfirmed && run.confirmed_tick < 0) {
+        run.confirmed_tick = k;
+        run.first_thruster = ev.arg0;
+        run.first_kind = static_cast<FaultKind>(ev.arg1);
+      }
+      if (ev.id == EventId::kValveClosed) run.valve_closed = true;
+    }
+    run.max_chi2_zero = std::fmax(run.max_chi2_zero, gnc->identifier().fault_torque().chi2_zero);
+    truth.advance(out.command, p.dt);
+    t += p.dt;
+    if (stuck_on >= 0 && run.confirmed_tick >= 0 && k > run.confirmed_tick + 10) break;
+  }
+  run.confirmed_on = gnc->fault_detector().confirmed_on();
+  run.confirmed_off = gnc->fault_detector().confirmed_off();
+  run.identified_confirmations = gnc->fault_detector().status().identified_confirmations;
+  run.scored = gnc->identifier().fault_torque().scored;
+  delete gnc;
+  return run;
+}
+
+void expect_isolated_in_identification(int thruster) {
+  constexpr int kTicks = 30000;  // 3000 s
+  const IdentifiedRun on = fly_identified(thruster, true, kTicks);
+  ASSERT_GE(on.confirmed_tick, 0) << "thruster " << thruster << " never confirmed (scored "
+                                  << on.scored << " windows)";
+  EXPECT_EQ(on.first_thruster, thruster);
+  EXPECT_EQ(on.first_kind, FaultKind::kStuckOn);
+  EXPECT_EQ(on.confirmed_on, 1u << thruster);
+  EXPECT_EQ(on.confirmed_off, 0u);
+  // Through (F14), or through the bank (F6) once the fault torque (I22) let the model converge
+  // around the jet (whichever comes first; both latch the same way).
+  std::printf("thruster %d confirmed at %.1f s, %s\n", thruster, on.confirmed_tick * 0.1,
+              on.identified_confirmations > 0 ? "from the fault torque (F14)" : "by the bank (F6)");
+  EXPECT_TRUE(on.valve_closed);                // the same latch path: its pod's valve closes
+  // The feature switched off: the same flight confirms nothing.
+  const IdentifiedRun off = fly_identified(thruster, false, kTicks);
+  EXPECT_LT(off.confirmed_tick, 0) << "without (F14) thruster " << off.first_thruster;
+  EXPECT_EQ(off.confirmed_on | off.confirmed_off, 0u);
+}
+
+TEST(GncFdiIdentified, TangentialJetStuckOnFromTheStartIsIsolatedToItself) {
+  expect_isolated_in_identification(4);  // channel 2 "+", pod 1, in-plane
+}
+
+TEST(GncFdiIdentified, AxialJetStuckOnFromTheStartIsIsolatedToItself) {
+  expect_isolated_in_identification(6);  // channel 3 "+", pod 1, along +z
+}
+
+TEST(GncFdiIdentified, AHealthyIdentificationNeverConfirms) {
+  const IdentifiedRun run = fly_identified(-1, true, 30000);
+  EXPECT_LT(run.confirmed_tick, 0) << "thruster " << run.first_thruster;
+  EXPECT_EQ(run.confirmed_on | run.confirmed_off, 0u);
+  EXPECT_EQ(run.identified_confirmations, 0u);
+  EXPECT_GT(run.scored, 100u);  // the identifier scored its fault torque all along
+  EXPECT_LT(run.max_chi2_zero, identified_params(true).fdi.identified_zero_chi2);
 }
 
 }  // namespace
