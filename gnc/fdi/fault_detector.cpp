@@ -98,6 +98,7 @@ void FaultDetector::reset() {
   suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
+  end_probe_verdict();
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   st_ = FaultDetectorStatus{};
@@ -152,6 +153,7 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
+  end_probe_verdict();
   st_.probe_pod = -1;
 }
 
@@ -172,6 +174,7 @@ void FaultDetector::clear(int thruster) {
   suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
+  end_probe_verdict();
   st_.probe_pod = -1;
 }
 
@@ -433,6 +436,8 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   st_.residual = slope * n;  // rate change over the window that the model does not explain
   st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
   ++st_.windows;
+  eval_open_fraction_ =
+      probe_tested_pod_ >= 0 ? w.tp[static_cast<std::size_t>(probe_tested_pod_)] / (n * dt_) : 1.0;
 }
 
 void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
@@ -449,6 +454,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
       score_[k] = 0.0;
       pool_llr_[k] = 0.0;
       pool_energy_[k] = 0.0;
+      window_llr_[k] = 0.0;
       continue;
     }
     const Vec3& b = b_[k % static_cast<std::size_t>(kThrusters)];
@@ -459,6 +465,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     const double cc = w.sum_cc[k] - w.sum_c[k] * w.sum_c[k] / n;
     const double ss = b.squaredNorm() * cc;
     const double llr = (sr - 0.5 * ss) / var;
+    window_llr_[k] = llr;
     lambda_[k] += llr;
     info_[k] += cc / var;
     const double energy = ss / var;
@@ -547,7 +554,38 @@ void FaultDetector::decide() {
     pending_.suspected = true;
   }
   // An isolation test runs its course; the valve reopens after it unless a confirmation closes it.
-  if (probe_left_ > 0 && --probe_left_ == 0) st_.probe_pod = -1;
+  // The windows that follow are flown with the valve open again (F9): a stuck-on jet on the tested
+  // pod fires whatever is commanded and its signature returns, whereas a stuck-off alternative
+  // shows only where its jet is commanded. So no new test starts before probe_after_windows
+  // windows have been seen with the valve open.
+  bool probe_ended = false;
+  if (probe_left_ > 0) {
+    // (F15) A window flown with the tested pod closed throughout: quiet or not.
+    if (eval_open_fraction_ <= 0.0) {
+      if (st_.chi2 > p_.suspect_chi2) {
+        probe_loud_ = true;
+      } else {
+        ++probe_quiet_;
+      }
+    }
+    if (--probe_left_ == 0) {
+      st_.probe_pod = -1;
+      ambiguous_windows_ = 0;
+      probe_ended = true;
+      verdict_pending_ = true;
+    }
+  } else if (verdict_pending_ && eval_open_fraction_ >= 0.5) {
+    // (F15) The first window flown mostly with the tested pod open again.
+    const int h = probe_verdict();
+    end_probe_verdict();
+    if (h >= 0) {
+      declare(h, FaultKind::kStuckOn);
+      pending_.confirmed = true;
+      pending_.thruster = h;
+      pending_.kind = FaultKind::kStuckOn;
+      return;
+    }
+  }
   if (best < 0) {
     reset_episode();  // every hypothesis exonerated: the next episode starts afresh
     return;
@@ -585,14 +623,43 @@ void FaultDetector::decide() {
       pod = pod_g;
     }
   }
-  if (pod < 0 || p_.probe_windows == 0) return;
+  if (pod < 0 || p_.probe_windows == 0 || probe_left_ > 0 || probe_ended) return;
   ++ambiguous_windows_;
   if (probe_left_ == 0 && ambiguous_windows_ >= p_.probe_after_windows) {
     st_.probe_pod = pod;
     probe_left_ = p_.probe_windows;
     ++st_.probes;
     ambiguous_windows_ = 0;
+    end_probe_verdict();
+    probe_tested_pod_ = pod;
   }
+}
+
+int FaultDetector::probe_verdict() const {
+  // (F15) The unexplained motion followed the tested pod's valve: gone in every window flown with
+  // the valve closed (at least one), back in the first window with it open. A stuck-off jet shows
+  // only where it is commanded, not where a valve is, so the motion is a stuck-on jet of that pod:
+  // the one whose signature explains the reopened window best, ahead of every other hypothesis
+  // (any pod, any kind) by margin_llr in that window alone.
+  if (probe_loud_ || probe_quiet_ == 0 || st_.chi2 <= p_.suspect_chi2) return -1;
+  int best = -1;
+  double best_llr = -1e300;
+  double second = -1e300;
+  for (int h = 0; h < kHypotheses; ++h) {
+    const double l = window_llr_[static_cast<std::size_t>(h)];
+    if (l > best_llr) {
+      second = best_llr;
+      best_llr = l;
+      best = h;
+    } else if (l > second) {
+      second = l;
+    }
+  }
+  if (best < 0 || best >= kThrusters || pod_[static_cast<std::size_t>(best)] != probe_tested_pod_) {
+    return -1;
+  }
+  if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  return best;
 }
 
 double FaultDetector::cross(int h, int g) const {
