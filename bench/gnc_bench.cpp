@@ -69,9 +69,11 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.estimator.kind = EstimatorKind::kMekf;
   p.mekf.gyro_arw = 1e-6;
   p.mekf.star_sigma = 4e-4;
+  p.mekf.rate_cutoff = 0.02 * 3.14159265358979323846;  // the rate stage (M8), as flown
   p.identification.enabled = true;
   p.identification.adopt = ModelAdoption::kAuto;
   p.fdi.enabled = fdi;
+  p.fdi.identified_isolation = fdi;  // (F14) the identifier's fault torque, as flown
   p.mode.auto_hold = false;
   Gnc gnc;
   if (!gnc.init(p).ok) {

@@ -116,6 +116,7 @@ int firmware_main() {
     g_params.identification.enabled = true;
     g_params.identification.adopt = gnc::ModelAdoption::kAuto;
     g_params.fdi.enabled = true;
+    g_params.fdi.identified_isolation = true;  // (F14) the identifier's fault torque, as flown
   }
   const gnc::ParamCheck check = g_gnc.init(g_params);
   if (!check.ok) {
