@@ -672,6 +672,9 @@ void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
   e.windows_gated = ic.windows_gated;
   e.gate_reinflations = ic.gate_reinflations;
   e.guard_refusals = ic.inertia_refused + ic.offset_refused;
+  e.excitation_active = excite_status_.active;
+  e.excitation_force = excite_status_.force;
+  e.excitation_gamma = excite_status_.gamma;
   e.candidate = candidate_status_;
 }
 

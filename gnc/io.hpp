@@ -170,6 +170,9 @@ struct EstimationTelemetry {
   std::uint32_t windows_gated{0};       // windows refused by the innovation gate (I18)
   std::uint32_t gate_reinflations{0};   // J, r, k re-inflated after gated windows in a row (I18)
   std::uint32_t guard_refusals{0};      // updates refused by the guards (I14)
+  bool excitation_active{false};        // (X1-X6) the identification excitation flew this tick
+  Vec3 excitation_force{Vec3::Zero()};  // N, the net force it asked for (F_B), before gamma
+  double excitation_gamma{0.0};         // the fraction of it that fitted the channels' box (X5)
   ModelCandidate candidate{ModelCandidate::kDisabled};
   std::uint32_t adoptions{0};           // identified models adopted into the active table
 };

@@ -129,6 +129,9 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   m.id_windows_gated = e.windows_gated;
   m.id_gate_reinflations = e.gate_reinflations;
   m.id_guard_refusals = e.guard_refusals;
+  m.id_excitation_active = e.excitation_active ? 1 : 0;
+  put(e.excitation_force, m.id_excitation_force);
+  m.id_excitation_gamma = e.excitation_gamma;
   m.id_candidate = static_cast<std::int8_t>(e.candidate);
   m.model_adoptions = e.adoptions;
   const gnc::FdiTelemetry& f = g.fdi;

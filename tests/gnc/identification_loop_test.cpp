@@ -246,6 +246,9 @@ struct DespinRun {
   double max_model_torque_gap{0.0};  // |B_hat F_commanded - torque_achieved| over the run, N m
   double max_force{0.0};             // largest |commanded channel force|, N
   double fuel_kg{0.0};
+  int telemetry_active_ticks{0};     // ticks whose telemetry reports the excitation flying
+  double max_telemetry_force{0.0};   // largest |asked force| the telemetry reports, N
+  double min_active_gamma{1.0};
 };
 DespinRun despin_identification(bool excite, AllocatorKind allocator) {
   const GncParams truth = study_gnc_params(200.0);
@@ -295,6 +298,12 @@ DespinRun despin_identification(bool excite, AllocatorKind allocator) {
     run.max_model_torque_gap = std::fmax(
         run.max_model_torque_gap, (b_hat * f - loop.out.telemetry.alloc.torque_achieved).norm());
     run.max_force = std::fmax(run.max_force, f.cwiseAbs().maxCoeff());
+    const EstimationTelemetry& et = loop.out.telemetry.est;
+    if (et.excitation_active) {
+      ++run.telemetry_active_ticks;
+      run.min_active_gamma = std::fmin(run.min_active_gamma, et.excitation_gamma);
+    }
+    run.max_telemetry_force = std::fmax(run.max_telemetry_force, et.excitation_force.norm());
   }
   EXPECT_EQ(loop.gnc.mode(), Mode::kDetumble);
   const IdentifierEstimate& e = loop.gnc.identifier().estimate();
@@ -315,6 +324,14 @@ TEST(GncIdentification, ExcitationRecoversTheOffsetWithin600sOfDespin) {
                    static_cast<int>(1000.0 * (on.fuel_kg - off.fuel_kg)));
     EXPECT_GT(off.r_error, 0.02) << to_string(a) << ": the rig must need the excitation";
     EXPECT_EQ(off.excited_s, 0.0);
+    // The telemetry shows the excitation exactly while it flies: none without it; with it, one
+    // active tick per tick of excitation time, a force of one axis's amplitude (100 or 400 N).
+    EXPECT_EQ(off.telemetry_active_ticks, 0);
+    EXPECT_EQ(off.max_telemetry_force, 0.0);
+    EXPECT_NEAR(on.telemetry_active_ticks * 0.1, on.excited_s, 0.1 + 1e-9);
+    EXPECT_NEAR(on.max_telemetry_force, 400.0, 1e-9);
+    EXPECT_GE(on.min_active_gamma, 0.0);
+    EXPECT_LE(on.min_active_gamma, 1.0);
     EXPECT_LE(on.r_error, 0.02) << to_string(a) << " (1 sigma " << on.r_sigma << ")";
     EXPECT_GT(on.excited_s, 60.0);
     // Torque-free on the model: the forces flown make the torque the allocator achieved.
