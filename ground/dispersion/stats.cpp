@@ -117,9 +117,8 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
     }
     return std::nullopt;
   };
-  std::vector<int> cases{0};
+  std::vector<int> cases{0};  // 0: every case, then each study case of the plan
   for (int c : spec.faults.case_numbers) cases.push_back(c);
-  if (spec.faults.case_numbers.empty()) cases = {0};
   for (std::size_t k = 0; k < spec.strategies.size(); ++k) {
     for (plant::FaultKind kind : spec.faults.kinds) {
       for (double onset : spec.faults.onsets_s) {
