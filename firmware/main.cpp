@@ -11,6 +11,8 @@
 //                 the HOLD phase without simulating the despin); success = HOLD kept throughout
 //   modules=all   every flight-core module on (the budget of DEVELOPERS.md): the MEKF, on-line
 //                 identification with automatic model adoption, fault detection, the L1 allocator
+//   excite=on     with modules=all: the identification excitation too (an option, off in gnc.yaml;
+//                 gnc/estimation/README.md §I.6), with gnc.yaml's settings
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -46,6 +48,7 @@ struct Options {
   bool require_hold{true};
   bool start_hold{false};
   bool all_modules{false};
+  bool excite{false};
 };
 
 // Parses "key=value" tokens of the semihosting command line (unknown tokens are ignored).
@@ -72,6 +75,7 @@ Options parse_options() {
     if (const char* v = value_of("goal=")) o.require_hold = std::strncmp(v, "despin", 6) != 0;
     if (const char* v = value_of("start=")) o.start_hold = std::strncmp(v, "hold", 4) == 0;
     if (const char* v = value_of("modules=")) o.all_modules = std::strncmp(v, "all", 3) == 0;
+    if (const char* v = value_of("excite=")) o.excite = std::strncmp(v, "on", 2) == 0;
   }
   return o;
 }
@@ -96,6 +100,64 @@ __attribute__((noinline)) std::uint32_t step_measuring_stack(const gnc::SensorSa
   return static_cast<std::uint32_t>(sp - board::lowest_stack_address_used());
 }
 
+// What a tick did, for the list of the largest ticks: counters before and after the step.
+struct Snapshot {
+  std::uint32_t windows{0};
+  std::uint32_t scored{0};
+  std::uint32_t adoptions{0};
+  std::uint32_t reinflations{0};
+  bool held_zero{false};
+  int fdi_best{-1};
+  bool fdi_suspecting{false};
+  std::uint32_t valves{0};
+};
+
+Snapshot snapshot() {
+  Snapshot s;
+  const auto& id = g_gnc.identifier();
+  s.windows = id.counters().windows;
+  s.scored = id.fault_torque().scored;
+  s.held_zero = id.fault_torque().held_zero;
+  s.reinflations = id.counters().reinflations;
+  s.adoptions = g_gnc.model_adoptions();
+  s.fdi_best = g_gnc.fault_detector().status().best;
+  s.fdi_suspecting = g_gnc.fault_detector().suspecting();
+  for (std::size_t p = 0; p < g_gnc.valve_open().size(); ++p) {
+    if (g_gnc.valve_open()[p]) s.valves |= 1U << p;
+  }
+  return s;
+}
+
+struct Events {
+  char text[12]{};
+};
+
+Events tick_events(const Snapshot& a, const Snapshot& b) {
+  Events e;
+  std::size_t n = 0;
+  auto add = [&e, &n](bool on, char c) {
+    if (on && n + 1 < sizeof(e.text)) e.text[n++] = c;
+  };
+  add(b.windows != a.windows, 'W');
+  add(b.scored != a.scored, 'S');
+  add(b.held_zero != a.held_zero, 'Z');
+  add(b.adoptions != a.adoptions, 'A');
+  add(b.reinflations != a.reinflations, 'R');
+  add(b.valves != a.valves, 'V');
+  add(b.fdi_best != a.fdi_best || b.fdi_suspecting != a.fdi_suspecting, 'F');
+  if (n == 0) e.text[n++] = '-';
+  e.text[n] = '\0';
+  return e;
+}
+
+struct TickNote {
+  std::uint32_t k{0};
+  std::uint32_t counts{0};
+  std::uint8_t mode{0};
+  Events what{};
+};
+constexpr std::size_t kWorst = 8;
+
 }  // namespace
 
 // Trace markers (see the header comment): distinct, never inlined.
@@ -117,6 +179,13 @@ int firmware_main() {
     g_params.identification.adopt = gnc::ModelAdoption::kAuto;
     g_params.fdi.enabled = true;
     g_params.fdi.identified_isolation = true;  // (F14) the identifier's fault torque, as flown
+    if (opt.excite) {  // gnc.yaml's excitation settings (§I.6)
+      g_params.identification.excitation.enabled = true;
+      g_params.identification.excitation.force_n = gnc::Vec3(100.0, 100.0, 400.0);
+      g_params.identification.excitation.duration_s = 600.0;
+      g_params.identification.excitation.r_sigma_stop_m = 0.005;
+      g_params.identification.excitation.start_after_s = 60.0;
+    }
   }
   const gnc::ParamCheck check = g_gnc.init(g_params);
   if (!check.ok) {
@@ -144,7 +213,8 @@ int firmware_main() {
   line.str("firmware: Cortex-M7 (fpv5-d16), sizeof(Gnc)=").u32(sizeof(gnc::Gnc))
       .str(" B, sizeof(GncParams)=").u32(sizeof(gnc::GncParams))
       .str(" B, dt=").fix(g_params.dt, 2).str(" s, run ").u32(opt.seconds).str(" s")
-      .str(opt.all_modules ? ", modules: MEKF + identification + FDI + L1" : ", modules: study");
+      .str(opt.all_modules ? ", modules: MEKF + identification + FDI + L1" : ", modules: study")
+      .str(opt.all_modules && opt.excite ? " + excitation" : "");
   line.flush();
 
   const double dt = g_params.dt;
@@ -162,6 +232,12 @@ int firmware_main() {
   std::uint64_t counts_total[gnc::kModeCount] = {};
   std::uint32_t counts_max[gnc::kModeCount] = {};
   std::uint32_t counted[gnc::kModeCount] = {};
+  TickNote worst[kWorst] = {};
+  std::uint32_t over_budget = 0;
+  // The 20000-instruction budget in counts (instructions per count from the calibration loop).
+  const std::uint32_t budget_counts =
+      cal_counts > 0 ? static_cast<std::uint32_t>(20000.0 * cal_counts / (2.0 * kCalIterations))
+                     : 0xFFFFFFFFU;
 
   line.str("  t [s]     |w| [rad/s]  mode      fuel [kg]");
   line.flush();
@@ -180,15 +256,30 @@ int firmware_main() {
       if (k == 0) stack_first = used;
       if (used > stack_max) stack_max = used;
     } else {
+      const Snapshot before = snapshot();
       const std::uint32_t c0 = board::counter_now();
       rs_probe_begin();
       g_gnc.step(s, cmd, g_out);
       rs_probe_end();
       const std::uint32_t c = board::counter_elapsed(c0, board::counter_now());
       const auto m = static_cast<std::size_t>(g_gnc.mode());
+      if (c > worst[kWorst - 1].counts) {  // keep the kWorst largest, with what the tick did
+        TickNote n;
+        n.k = k;
+        n.counts = c;
+        n.mode = static_cast<std::uint8_t>(m);
+        n.what = tick_events(before, snapshot());
+        std::size_t i = kWorst - 1;
+        while (i > 0 && worst[i - 1].counts < c) {
+          worst[i] = worst[i - 1];
+          --i;
+        }
+        worst[i] = n;
+      }
       counts_total[m] += c;
       counted[m] += 1U;
       if (c > counts_max[m]) counts_max[m] = c;
+      if (c > budget_counts) ++over_budget;
     }
     const gnc::Vec3 torque = b_true * g_out.command.force;
     body.step(dt, torque);
@@ -230,6 +321,22 @@ int firmware_main() {
         .fix(mean * insn_per_count, 0).str(", max ")
         .fix(counts_max[m] * insn_per_count, 0)
         .str(" over ").u32(counted[m]).str(" ticks");
+    line.flush();
+  }
+
+  // The largest ticks, with what happened on them (W: an identification window closed, S: the
+  // identifier's fault-torque score came out, Z: the fault torque was settled at zero, A: a model
+  // was adopted, R: the identifier re-inflated, V: a valve moved, F: the fault detector's best
+  // hypothesis or suspicion changed, -: none of these).
+  line.str("ticks over the 20000-instruction budget: ").u32(over_budget).str(" of ")
+      .u32(ticks);
+  line.flush();
+  line.str("largest ticks (tick, mode, instructions, events):");
+  line.flush();
+  for (const TickNote& n : worst) {
+    if (n.counts == 0) continue;
+    line.str("  ").u32(n.k).str("  ").str(gnc::to_string(static_cast<gnc::Mode>(n.mode)))
+        .str("  ").fix(n.counts * insn_per_count, 0).str("  ").str(n.what.text);
     line.flush();
   }
 

@@ -191,7 +191,7 @@ void Identifier::configure(const IdentifierConfig& c) {
            (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
            (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1 +
            (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick +
-           (kIdParams + kSettleRowsPerTick - 1) / kSettleRowsPerTick;
+           1 + (kIdParams + kSettleRowsPerTick - 1) / kSettleRowsPerTick;
   };
   gain_rows_per_tick_ = 4;
   cov_rows_per_tick_ = 1;
@@ -800,8 +800,9 @@ void Identifier::step_phase() {
       if (fault_jet_next_ >= kThrusters) {
         ++ft_.scored;
         phase_ = Phase::kIdle;
-        // (I24) d settled at zero?
-        if (ft_.fitted) {
+        // (I24) d settled at zero? (Only while d is in the state: once held at zero, d-hat and
+        // its covariance are exactly zero and would read as "quiet" on every window.)
+        if (ft_.fitted && !d_held_zero_) {
           const double gate = c_.gate_chi2 > 0.0 ? c_.gate_chi2 : 16.27;
           const double settled = 0.1 * c_.fault_torque_sigma;
           const bool quiet = ft_.chi2_zero < gate &&
@@ -809,13 +810,16 @@ void Identifier::step_phase() {
           settle_streak_ = quiet ? settle_streak_ + 1 : 0;
           if (settle_streak_ >= kSettleWindows) {
             settle_streak_ = 0;
-            start_settle();
-            if (settle_.pending) phase_ = Phase::kSettle;
+            phase_ = Phase::kSettleStart;  // its own tick (the Cortex-M7 tick budget)
           }
         }
       }
       break;
     }
+    case Phase::kSettleStart:
+      start_settle();
+      phase_ = settle_.pending ? Phase::kSettle : Phase::kIdle;
+      break;
     case Phase::kSettle:
       if (settle_rows()) phase_ = Phase::kIdle;
       break;
@@ -1143,6 +1147,7 @@ void Identifier::score_fault_torque(int first, int n) {
 void Identifier::start_settle() {
   // (I24) The perfect pseudo-measurement d = 0: x <- x - P_:d P_dd^-1 d, P <- P - P_:d P_dd^-1 P_d:
   // (the state now, the covariance a block of rows per tick in settle_rows).
+  if (d_held_zero_) return;
   const Mat3 p_dd = p_all_.block<3, 3>(kIdD, kIdD);
   const Eigen::LDLT<Mat3> l(p_dd);
   if (l.info() != Eigen::Success || !l.isPositive()) return;
@@ -1161,6 +1166,7 @@ void Identifier::start_settle() {
   settle_.rows = 0;
   settle_.pending = true;
   d_held_zero_ = true;
+  ++counters_.fault_torque_settles;
 }
 
 bool Identifier::settle_rows() {

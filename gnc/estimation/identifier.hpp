@@ -188,6 +188,7 @@ struct IdentifierCounters {
   std::uint32_t reinflations{0};
   std::uint32_t windows_gated{0};      // refused by the innovation gate (I18)
   std::uint32_t gate_reinflations{0};  // ... re-inflations after too many in a row
+  std::uint32_t fault_torque_settles{0};  // d settled at zero and taken out of the state (I24)
 };
 
 struct IdentifierEstimate {
@@ -279,7 +280,8 @@ class Identifier {
     Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
   };
   enum class Phase : std::uint8_t {
-    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore, kSettle
+    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore,
+    kSettleStart, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
   static constexpr int kFaultJetsPerTick = 2;
@@ -290,7 +292,7 @@ class Identifier {
   // pseudo-measurement d = 0 is applied (its information returns to J, r and k) and d is held
   // out of the state until the gate or a declared change re-inflates it.
   static constexpr int kSettleWindows = 3;
-  static constexpr int kSettleRowsPerTick = 7;
+  static constexpr int kSettleRowsPerTick = 3;
   int settle_streak_{0};
   bool d_held_zero_{false};
   struct SettleStep {
@@ -368,7 +370,7 @@ class Identifier {
   // before the next window closes).
   int gain_rows_per_tick_{4};
   int cov_rows_per_tick_{1};
-  static constexpr int kSymmetriseRowsPerTick = 9;
+  static constexpr int kSymmetriseRowsPerTick = 5;
   struct JointStep {  // the gain over several ticks, applied on one, the covariance over several
     bool started{false};
     bool pending{false};
@@ -387,7 +389,7 @@ class Identifier {
     Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
   };
   JointStep joint_{};
-  static constexpr int kAnchorRowsPerTick = 7;
+  static constexpr int kAnchorRowsPerTick = 4;
   struct AnchorStep {  // the thrust-scale anchor's covariance term, a block of rows per tick
     bool pending{false};
     int rows{0};
