@@ -8,6 +8,7 @@
 //     the seven cases with the flight's identifier settings, without and with the identification
 //     excitation (README §I.6), and the fuel each run spent
 #include <cmath>
+#include <exception>
 #include <cstdio>
 #include <string>
 
@@ -263,9 +264,7 @@ void hold(const std::string& dir, int case_number, double gyro_bias, double bias
       b_err_30min / mekf.bias_sigma().maxCoeff(), mekf.bias_sigma().maxCoeff());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   if (argc > 2 && std::string(argv[argc - 1]) == "estimate_bias") {
     g_estimate_bias = true;
     --argc;
@@ -317,4 +316,16 @@ int main(int argc, char** argv) {
   hold(dir, 5, 5e-5, 0.0);
   hold(dir, 5, 5e-5, 1e-9);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // A bad configuration directory or number is reported, not thrown out of main.
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "estimation_study: %s\n", e.what());
+    return 2;
+  }
 }
