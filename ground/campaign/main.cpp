@@ -199,6 +199,10 @@ int main(int argc, char** argv) {
                     "replan strategies: re-plan when the identifier's model becomes confident "
                     "(true/false)")
         ->capture_default_str();
+    sub->add_option("--replan-adopt-sigmas", spec.replan.adopt_sigmas,
+                    "replan strategies: the flight adopts a confident identified model this many "
+                    "of its 1 sigma from its table (0: only beyond the confidence bounds)")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");
