@@ -170,8 +170,10 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
   if (!tl.omega_hat.allFinite()) return std::nullopt;
   if (flying_ == nullptr) {
     if (tl.mode == gnc::Mode::kSafe || tl.mode == gnc::Mode::kIdle) return std::nullopt;
+    // The confirmation counts until the first plan (not only before first_plan_s): with noisy
+    // sensors the inertia 1 sigma reaches early_j_rel after first_plan_s (cases 5 and 6: 360 s
+    // and 540 s), and the D+PD reference flown until first_plan_max_s costs more than the plan.
     if (policy_.early_plan_s > 0.0 && tl.t >= policy_.early_plan_s && !identified_ &&
-        tl.t < policy_.first_plan_s &&
         apriori_confirmed(flight_, tl.est, policy_.early_sigmas, policy_.early_j_rel,
                           policy_.early_r_m)) {
       return ReplanTrigger::kEarly;

@@ -38,7 +38,8 @@ namespace rocksteady::ground::planner {
 struct ReplanPolicy {
   double first_plan_s{300.0};       // identify at least this long before the first plan
   double first_plan_max_s{600.0};   // plan then even if the model is not confident yet
-  // Early plan for the a-priori model (<= 0: off): from early_plan_s on (before first_plan_s too),
+  // Early plan for the a-priori model (<= 0: off): from early_plan_s on until the first plan
+  // (before first_plan_s too, and after it while the identified model is not confident yet),
   // plan for the flight's table as soon as the identifier's estimate agrees with it: every
   // inertia and offset component within early_sigmas of its reported 1 sigma, with that 1 sigma
   // at most early_j_rel |J_hat| (inertia) and early_r_m (offset). A model that is confirmed this

@@ -243,6 +243,27 @@ TEST(Replanner, EarlyPlanForTheAPrioriModelOnlyOnceTheIdentifierConfirmsIt) {
   ASSERT_TRUE(d2.has_value());
   EXPECT_EQ(wait.records().front().trigger, ReplanTrigger::kFirst);
   EXPECT_NEAR(wait.records().front().t_state, 100.0, 1e-9);
+
+  // A confirmation that comes after first_plan_s, with no confident model and first_plan_max_s
+  // still ahead, plans then (early) instead of waiting for first_plan_max_s.
+  ReplanPolicy late_pol = pol;
+  late_pol.first_plan_s = 30.0;
+  late_pol.first_plan_max_s = 100.0;
+  late_pol.refuted_max_s = 0.0;
+  Replanner late(table, late_pol);
+  std::optional<Delivery> d3;
+  for (int k = 0; k < 2000 && !d3; ++k) {
+    t = k * table.dt;
+    gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+    // 1 sigma 3 % of |J| (not confirmed) until 60 s, then 0.01 % and agreeing.
+    const double s = t < 60.0 - 1e-9 ? 300.0 * sj : sj;
+    tl.est = report(table, s, 0.01, 0, 0.0);
+    d3 = late.update(tl);
+  }
+  ASSERT_TRUE(d3.has_value());
+  ASSERT_EQ(late.records().size(), 1u);
+  EXPECT_EQ(late.records().front().trigger, ReplanTrigger::kEarly);
+  EXPECT_NEAR(late.records().front().t_state, 60.0, 1e-9);
 }
 
 TEST(Replanner, ARefutedAPrioriModelIsNotPlannedForUntilRefutedMax) {
