@@ -87,6 +87,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     pol.early_r_m = o.early_r_m;
     pol.refuted_max_s = o.refuted_max_s;
     pol.on_identified = o.on_identified;
+    pol.adopt_wait_s = o.adopt_wait_s;
     replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
   }
 #else

@@ -100,6 +100,7 @@ struct ReplanOptions {
   // the table by more than this many of its 1 sigma is adopted, so that the NTCL tracks the plan
   // with the model it was planned for (0: only beyond the fixed confidence bounds, 1 % of |J|).
   double adopt_sigmas{3.0};
+  double adopt_wait_s{60.0};  // a confident model the flight does not fly yet: wait for its adoption
 };
 
 // One plan of the re-planner, and what the flight did with it.

@@ -298,5 +298,50 @@ TEST(Replanner, ARefutedAPrioriModelIsNotPlannedForUntilRefutedMax) {
   EXPECT_FALSE(refute[0].identified);
 }
 
+// adopt_wait_s: a confident identified model that refutes the flight's active model (here Jxx
+// 10 sigma = 0.5 % of |J| from the table) is planned for only once the flight has adopted it (the
+// adoption count in the telemetry), so that the NTCL tracks the plan with the plan's model; if no
+// adoption comes, at most adopt_wait_s after the model became confident. A model the flight's
+// table already agrees with is planned for at once.
+TEST(Replanner, AConfidentModelTheFlightDoesNotFlyYetIsPlannedForAfterItsAdoption) {
+  const gnc::GncParams table = case1_table();
+  ReplanPolicy pol = policy(0.0);
+  pol.first_plan_s = 10.0;
+  pol.first_plan_max_s = 200.0;  // the identified model decides the first plan's time
+  pol.adopt_wait_s = 60.0;
+  const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+  const double sj = 5e-4 * j.norm();
+  const Vec3 w(0.01, 0.02, 0.03);
+  // Confident from 20 s; adopted by the flight at `t_adopt` (< 0: never).
+  auto fly = [&](double dj, double t_adopt) {
+    Replanner rp(table, pol);
+    for (int k = 0; k < 3000; ++k) {
+      const double t = k * table.dt;
+      gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+      tl.est = report(table, sj, 0.01, 0, dj);
+      tl.est.inertia_confident = t >= 20.0 - 1e-9;
+      tl.est.offset_confident = tl.est.inertia_confident;
+      tl.est.adoptions = (t_adopt >= 0.0 && t >= t_adopt - 1e-9) ? 1u : 0u;
+      if (rp.update(tl)) break;
+    }
+    return rp.records();
+  };
+  const auto adopted = fly(10.0 * sj, 35.0);
+  ASSERT_EQ(adopted.size(), 1u);
+  EXPECT_TRUE(adopted[0].ok) << adopted[0].error;
+  EXPECT_TRUE(adopted[0].identified);
+  EXPECT_NEAR(adopted[0].t_state, 35.0, 1e-9);  // at the adoption, not at confidence (20 s)
+  const auto never = fly(10.0 * sj, -1.0);
+  ASSERT_EQ(never.size(), 1u);
+  EXPECT_NEAR(never[0].t_state, 80.0, 1e-9);  // confident at 20 s + adopt_wait_s
+  const auto agrees = fly(1.0 * sj, -1.0);   // within 3 sigma of the table: nothing to wait for
+  ASSERT_EQ(agrees.size(), 1u);
+  EXPECT_NEAR(agrees[0].t_state, 20.0, 1e-9);
+  pol.adopt_wait_s = 0.0;  // off: planned at confidence
+  const auto off = fly(10.0 * sj, 35.0);
+  ASSERT_EQ(off.size(), 1u);
+  EXPECT_NEAR(off[0].t_state, 20.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace rocksteady::ground::planner
