@@ -172,6 +172,7 @@ GncConfig load_gnc(const std::string& path) {
       r.fail("adopt", "expected off or auto, got '" + adopt + "'");
     }
     id.adopt_interval_s = r.positive("adopt_interval_s");
+    if (r.has("adopt_sigmas")) id.adopt_sigmas = r.non_negative("adopt_sigmas");
     gnc::IdentifierConfig& ic = id.config;
     const std::string mode = r.text("mode");
     if (mode == "joint") {

@@ -334,9 +334,26 @@ ModelCandidate Gnc::identified_model(IdentifiedModel& out) const {
 bool Gnc::differs(const GncParams& p, const IdentifiedModel& m) const {
   const IdentifierConfig& c = params_.identification.config;
   const Mat3 j = total_inertia(p.mass_hat);
-  return (m.j - j).norm() > c.j_confident_rel * j.norm() ||
-         (m.r - p.mass_hat.r_so_bcm).norm() > c.r_confident ||
-         (m.k - p.rcs.strength).cwiseAbs().maxCoeff() > c.k_confident;
+  if ((m.j - j).norm() > c.j_confident_rel * j.norm() ||
+      (m.r - p.mass_hat.r_so_bcm).norm() > c.r_confident ||
+      (m.k - p.rcs.strength).cwiseAbs().maxCoeff() > c.k_confident) {
+    return true;
+  }
+  // Resolved by the data: the table lies outside the estimate's adopt_sigmas box (per parameter,
+  // the identifier's 1 sigma; an unobservable offset direction keeps a large sigma and never
+  // counts).
+  const double n = params_.identification.adopt_sigmas;
+  if (!(n > 0.0)) return false;
+  const IdentifierEstimate& e = ident_.estimate();
+  const Vec6 dj = inertia_params(m.j) - inertia_params(j);
+  for (int i = 0; i < 6; ++i) {
+    if (e.j_sigma(i) > 0.0 && std::abs(dj(i)) > n * e.j_sigma(i)) return true;
+  }
+  const Vec3 dr = m.r - p.mass_hat.r_so_bcm;
+  for (int i = 0; i < 3; ++i) {
+    if (e.r_sigma(i) > 0.0 && std::abs(dr(i)) > n * e.r_sigma(i)) return true;
+  }
+  return false;
 }
 
 ModelCandidate Gnc::model_candidate(GncParams& out) const {

@@ -73,7 +73,8 @@ class Gnc {
   bool excitation_on() const;  // identification and its excitation both enabled
   // Validate and install; declared_change: a table from outside (the identifier re-inflates).
   ParamCheck apply_params(const GncParams& params, bool declared_change);
-  bool differs(const GncParams& p, const IdentifiedModel& m) const;  // beyond the confidence bounds
+  // Beyond the confidence bounds, or (adopt_sigmas > 0) beyond that many of the estimate's 1 sigma.
+  bool differs(const GncParams& p, const IdentifiedModel& m) const;
   void adopt_model(double t, ModeEvents& events);  // automatic policy, at the tick boundary
   void fill_estimation_telemetry(GncTelemetry& tl) const;
   void refresh_fault_model();

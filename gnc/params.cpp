@@ -202,6 +202,9 @@ ParamCheck validate(const GncParams& p) {
   if (!finite_positive(id.adopt_interval_s)) {
     return bad("identification.adopt_interval", "must be positive and finite");
   }
+  if (!finite_non_negative(id.adopt_sigmas)) {
+    return bad("identification.adopt_sigmas", "must be >= 0 and finite");
+  }
   if (!finite_non_negative(id.mekf_bias_sigma_floor)) {
     return bad("identification.mekf_bias_sigma_floor", "must be >= 0 and finite");
   }

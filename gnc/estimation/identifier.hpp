@@ -428,6 +428,11 @@ struct IdentificationParams {
   bool enabled{false};  // run the identifier in the tick
   ModelAdoption adopt{ModelAdoption::kOff};
   double adopt_interval_s{300.0};  // s, at least this long between two automatic adoptions
+  // > 0: a confident model also counts as changed when the identifier's own covariance sets it
+  // apart from the active table: some J_tot or r_SO/BCM parameter more than adopt_sigmas of its
+  // 1 sigma away (a difference inside the fixed confidence bounds, e.g. 0.2 % of |J|, that the
+  // data resolve). 0: changed only beyond the confidence bounds.
+  double adopt_sigmas{0.0};
   // With the MEKF, the 1 sigma of the bias left in the corrected rate is the MEKF's bias sigma,
   // but never below this (rad/s): the MEKF's bias sigma at convergence understates its error,
   // and the identifier takes the residual bias afresh each window (README I17).

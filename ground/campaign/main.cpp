@@ -199,6 +199,14 @@ int main(int argc, char** argv) {
                     "replan strategies: re-plan when the identifier's model becomes confident "
                     "(true/false)")
         ->capture_default_str();
+    sub->add_option("--replan-adopt-sigmas", spec.replan.adopt_sigmas,
+                    "replan strategies: the flight adopts a confident identified model this many "
+                    "of its 1 sigma from its table (0: only beyond the confidence bounds)")
+        ->capture_default_str();
+    sub->add_option("--replan-adopt-wait", spec.replan.adopt_wait_s,
+                    "replan strategies: a confident identified model that the flight does not fly "
+                    "yet is planned for after its adoption, waiting at most this long, s (0: off)")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");

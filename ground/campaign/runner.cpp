@@ -58,6 +58,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   PlantBinding ports(plant);
   FlightSetup fs;
   fs.params = flight_params(setup, strategy);
+  if (strategy.replans()) fs.params.identification.adopt_sigmas = options.replan.adopt_sigmas;
   fs.start_mode = strategy.needs_trajectory() ? gnc::Mode::kTrack : gnc::Mode::kDetumble;
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;
   flight.setup(fs, ports, ports);
@@ -86,6 +87,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     pol.early_r_m = o.early_r_m;
     pol.refuted_max_s = o.refuted_max_s;
     pol.on_identified = o.on_identified;
+    pol.adopt_wait_s = o.adopt_wait_s;
     replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
   }
 #else

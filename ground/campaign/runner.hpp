@@ -96,6 +96,11 @@ struct ReplanOptions {
   double early_r_m{1.0};           // each offset 1 sigma at most this (m)
   double refuted_max_s{3000.0};     // a-priori model refuted at first_plan_max_s: wait until then
   bool on_identified{true};        // re-plan when the identifier's model becomes confident
+  // The flight's adoption (gnc identification.adopt_sigmas): a confident model that differs from
+  // the table by more than this many of its 1 sigma is adopted, so that the NTCL tracks the plan
+  // with the model it was planned for (0: only beyond the fixed confidence bounds, 1 % of |J|).
+  double adopt_sigmas{3.0};
+  double adopt_wait_s{60.0};  // a confident model the flight does not fly yet: wait for its adoption
 };
 
 // One plan of the re-planner, and what the flight did with it.

@@ -173,6 +173,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-horizon", pol.min_horizon_s, "shortest horizon, s")->capture_default_str();
   app.add_option("--max-plans", pol.max_plans, "plans at most")->capture_default_str();
+  app.add_option("--adopt-wait", pol.adopt_wait_s,
+                 "a confident identified model the flight does not fly yet: wait at most this long "
+                 "for its adoption before planning for it, s (0: off)")
+      ->capture_default_str();
   app.add_option("--first-upload-id", first_upload_id, "upload id of the first plan")
       ->capture_default_str();
   app.add_option("--duration", duration, "exit after this many wall seconds (< 0: never)");

@@ -384,6 +384,8 @@ DispersionSpec load_spec(const std::string& path) {
     if (r.has("early_j_rel")) s.replan.early_j_rel = r.positive("early_j_rel");
     if (r.has("early_r_m")) s.replan.early_r_m = r.positive("early_r_m");
     if (r.has("refuted_max_s")) s.replan.refuted_max_s = r.non_negative("refuted_max_s");
+    if (r.has("adopt_sigmas")) s.replan.adopt_sigmas = r.non_negative("adopt_sigmas");
+    if (r.has("adopt_wait_s")) s.replan.adopt_wait_s = r.non_negative("adopt_wait_s");
     if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
       r.fail("first_plan_max_s", "must not be below first_plan_s");
     }

@@ -84,7 +84,18 @@ double nearest_sample_time(const gnc::TrajectoryTable& t, const gnc::Vec3& omega
 
 Replanner::Replanner(const gnc::GncParams& flight, const ReplanPolicy& policy,
                      std::int32_t first_upload_id)
-    : flight_(flight), model_(flight), policy_(policy), next_upload_id_(first_upload_id) {}
+    : flight_(flight),
+      model_(flight),
+      flown_(flight),
+      policy_(policy),
+      next_upload_id_(first_upload_id) {}
+
+bool Replanner::awaiting_adoption(const gnc::GncTelemetry& tl) const {
+  if (!identified_ || !(policy_.adopt_wait_s > 0.0)) return false;
+  if (tl.t - t_identified_ >= policy_.adopt_wait_s) return false;
+  const double inf = std::numeric_limits<double>::infinity();
+  return !apriori_confirmed(flown_, tl.est, policy_.early_sigmas, inf, inf);
+}
 
 gnc::Vec3 Replanner::predict(const gnc::GncTelemetry& tl, double ahead) const {
   if (flying_table_ != nullptr && tl.mode == gnc::Mode::kTrack && !resync_) {
@@ -116,7 +127,13 @@ gnc::Vec3 Replanner::predict(const gnc::GncTelemetry& tl, double ahead) const {
 std::optional<Delivery> Replanner::update(const gnc::GncTelemetry& tl) {
   if (const auto id = identified_params(flight_, tl.est)) {
     model_ = *id;
+    if (!identified_) t_identified_ = tl.t;
     identified_ = true;
+  }
+  if (tl.est.adoptions != adoptions_flown_) {
+    // The flight adopted its identified model at this boundary: the one in this telemetry.
+    adoptions_flown_ = tl.est.adoptions;
+    if (const auto id = identified_params(flight_, tl.est)) flown_ = *id;
   }
   if (resync_ && flying_table_ != nullptr) {
     // The flight switched at the boundary after the delivery and re-synchronised its plan clock
@@ -170,14 +187,17 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
   if (!tl.omega_hat.allFinite()) return std::nullopt;
   if (flying_ == nullptr) {
     if (tl.mode == gnc::Mode::kSafe || tl.mode == gnc::Mode::kIdle) return std::nullopt;
+    // The confirmation counts until the first plan (not only before first_plan_s): with noisy
+    // sensors the inertia 1 sigma reaches early_j_rel after first_plan_s (cases 5 and 6: 360 s
+    // and 540 s), and the D+PD reference flown until first_plan_max_s costs more than the plan.
     if (policy_.early_plan_s > 0.0 && tl.t >= policy_.early_plan_s && !identified_ &&
-        tl.t < policy_.first_plan_s &&
         apriori_confirmed(flight_, tl.est, policy_.early_sigmas, policy_.early_j_rel,
                           policy_.early_r_m)) {
       return ReplanTrigger::kEarly;
     }
     if (tl.t < policy_.first_plan_s) return std::nullopt;
     if (!identified_ && tl.t < policy_.first_plan_max_s) return std::nullopt;
+    if (awaiting_adoption(tl)) return std::nullopt;
     if (!identified_ && tl.t < policy_.refuted_max_s && tl.est.identifying &&
         tl.est.windows > 0 &&
         !apriori_confirmed(flight_, tl.est, policy_.early_sigmas,
@@ -198,7 +218,7 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
     return ReplanTrigger::kModelUpdate;
   }
   if (policy_.on_identified && identified_ && delivered_record_ < records_.size() &&
-      !records_[delivered_record_].identified) {
+      !records_[delivered_record_].identified && !awaiting_adoption(tl)) {
     return ReplanTrigger::kModelUpdate;
   }
   if (policy_.error_fraction > 0.0 && flying_table_ != nullptr) {

@@ -38,7 +38,8 @@ namespace rocksteady::ground::planner {
 struct ReplanPolicy {
   double first_plan_s{300.0};       // identify at least this long before the first plan
   double first_plan_max_s{600.0};   // plan then even if the model is not confident yet
-  // Early plan for the a-priori model (<= 0: off): from early_plan_s on (before first_plan_s too),
+  // Early plan for the a-priori model (<= 0: off): from early_plan_s on until the first plan
+  // (before first_plan_s too, and after it while the identified model is not confident yet),
   // plan for the flight's table as soon as the identifier's estimate agrees with it: every
   // inertia and offset component within early_sigmas of its reported 1 sigma, with that 1 sigma
   // at most early_j_rel |J_hat| (inertia) and early_r_m (offset). A model that is confirmed this
@@ -63,6 +64,11 @@ struct ReplanPolicy {
   double horizon_factor{kHorizonFactor};  // t_f = factor x shortest despin from the state,
   double min_horizon_s{0.0};              // the first plan at least this long (the least fuel
                                           // falls with t_f); re-plans keep its end
+  // Plan for the model the flight tracks with: once the identified model is confident, while it
+  // refutes the flight's active model (some J or r component beyond early_sigmas of its 1 sigma;
+  // the flight adopts such a model at its next boundary), the plan waits for the adoption, at
+  // most adopt_wait_s after the model became confident (<= 0: off).
+  double adopt_wait_s{60.0};
   double stop_rate_fraction{0.05};
   int max_plans{20};
 };
@@ -122,10 +128,15 @@ class Replanner {
   void plan_now(const gnc::GncTelemetry& tl, ReplanTrigger why);
   // The rate the flight will have `ahead` seconds after this telemetry.
   gnc::Vec3 predict(const gnc::GncTelemetry& tl, double ahead) const;
+  // The identified model is confident but the flight still flies a model it refutes.
+  bool awaiting_adoption(const gnc::GncTelemetry& tl) const;
 
   gnc::GncParams flight_;
   gnc::GncParams model_;
+  gnc::GncParams flown_;  // the flight's active model: the table, then each adopted model
+  std::uint32_t adoptions_flown_{0};
   bool identified_{false};
+  double t_identified_{0.0};
   ReplanPolicy policy_;
   std::int32_t next_upload_id_;
   std::vector<ReplanRecord> records_;

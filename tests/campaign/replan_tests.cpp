@@ -135,6 +135,25 @@ TEST(ReplanStrategy, RunIsDeterministic) {
   EXPECT_EQ(a.ticks, b.ticks);
 }
 
+// Case 2's a-priori model is 0.2 % of |J| off, inside the flight's fixed confidence bounds (1 %):
+// the identifier resolves it within 300 s, and with the replan strategies' adopt_sigmas the flight
+// adopts it (so its NTCL tracks the plan with the model the plan is for); without, it never does.
+TEST(ReplanStrategy, FlightAdoptsAResolvedSmallModelErrorWithAdoptSigmas) {
+  ASSERT_TRUE(have_planner());
+  const config::RunSetup s = config::load_run(kConfigs + "/mission.yaml", kConfigs + "/gnc.yaml",
+                                              kConfigs + "/cases/case2.yaml");
+  ReplanOptions on;  // the defaults
+  ASSERT_GT(on.adopt_sigmas, 0.0);
+  ReplanOptions off = on;
+  off.adopt_sigmas = 0.0;
+  const RunResult a = fly(s, on, 500.0, 0.0);
+  const RunResult b = fly(s, off, 500.0, 0.0);
+  ASSERT_EQ(a.status, RunStatus::kOk) << a.note;
+  ASSERT_EQ(b.status, RunStatus::kOk) << b.note;
+  EXPECT_GE(a.estimation.model_adoptions, 1u);
+  EXPECT_EQ(b.estimation.model_adoptions, 0u);
+}
+
 // The bare flight core has no uplink: the replan strategy says so instead of flying half a plan.
 TEST(ReplanStrategy, CoreOnlyFlightSideRefusesTheUplinkAndTheRunSaysWhy) {
   ASSERT_TRUE(have_planner());

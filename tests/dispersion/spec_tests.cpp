@@ -32,7 +32,8 @@ TEST(DispersionFiles, ReplanStrategyAndItsPolicyLoad) {
   const std::string text =
       replace_line(replace_line(base_spec(), "[dpd, ntcl+dpd_ref]", "[ntcl+dpd_ref, ntcl+replan]"),
                    "sampling: random",
-                   "sampling: random\nreplan: {latency_s: 25, period_s: 0, min_horizon_s: 1400}");
+                   "sampling: random\nreplan: {latency_s: 25, period_s: 0, min_horizon_s: 1400, "
+                   "adopt_sigmas: 4, adopt_wait_s: 30}");
   const DispersionSpec s = load_spec(test::write_temp("replan.yaml", text));
   ASSERT_EQ(s.strategies.size(), 2u);
   EXPECT_TRUE(s.strategies[1].replans());
@@ -40,6 +41,8 @@ TEST(DispersionFiles, ReplanStrategyAndItsPolicyLoad) {
   EXPECT_EQ(s.replan.latency_s, 25.0);
   EXPECT_EQ(s.replan.period_s, 0.0);
   EXPECT_EQ(s.replan.min_horizon_s, 1400.0);
+  EXPECT_EQ(s.replan.adopt_sigmas, 4.0);
+  EXPECT_EQ(s.replan.adopt_wait_s, 30.0);
   EXPECT_EQ(s.replan.first_plan_s, campaign::ReplanOptions{}.first_plan_s);  // default kept
 }
 

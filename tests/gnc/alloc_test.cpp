@@ -155,6 +155,7 @@ TEST(ZeroAllocation, NoHeapWithTheIdentificationExcitation) {
     id.enabled = true;
     id.adopt = ModelAdoption::kAuto;
     id.adopt_interval_s = 5.0;
+    id.adopt_sigmas = 3.0;  // the sigma test of the adoption runs in the tick too
     id.config.window_s = 2.0;
     id.config.j_prior_sigma = 5.0;
     id.config.r_prior_sigma = 0.5;

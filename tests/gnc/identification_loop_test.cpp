@@ -119,6 +119,60 @@ TEST(GncIdentification, AutomaticPolicyAdoptsTheIdentifiedModelAtABoundaryWithAn
   EXPECT_EQ(loop.out.telemetry.est.candidate, ModelCandidate::kUnchanged);
 }
 
+// identification.adopt_sigmas: a table error inside the fixed confidence bounds (0.9 % of |J_tot|,
+// below the 1 % that `differs` needs) that the identifier resolves is adopted only with the
+// sigma test on; without it the table stays, although the candidate is better.
+TEST(GncIdentification, AdoptSigmasAdoptsAResolvedErrorInsideTheConfidenceBounds) {
+  const GncParams truth = identifying_params(ModelAdoption::kAuto);
+  const Mat3 j_true = total_inertia(truth.mass_hat);
+  GncParams table = truth;
+  table.mass_hat.j_ast(0, 0) += 0.009 * j_true.norm();
+  const double table_err = (total_inertia(table.mass_hat) - j_true).norm();
+  ASSERT_LT(table_err, truth.identification.config.j_confident_rel * j_true.norm());
+  auto fly = [&](double sigmas, int ticks, Mat3& j_adopted, Vec6& sigma_at_adoption) {
+    GncParams t = table;
+    t.identification.adopt_sigmas = sigmas;
+    test::SmallLoop loop(truth);
+    EXPECT_TRUE(loop.gnc.init(t).ok);
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    loop.tick(c);
+    for (int k = 0; k < ticks; ++k) {
+      const Vec6 sigma = loop.gnc.identifier().estimate().j_sigma;
+      loop.tick();
+      if (count_events(loop.out, EventId::kModelAdopted) > 0) {
+        j_adopted = total_inertia(loop.gnc.params().mass_hat);
+        sigma_at_adoption = sigma;
+        return true;
+      }
+    }
+    return false;
+  };
+  Mat3 j_adopted = Mat3::Zero();
+  Vec6 sigma = Vec6::Zero();
+  EXPECT_FALSE(fly(0.0, 1200, j_adopted, sigma)) << "adopted inside the confidence bounds";
+  ASSERT_TRUE(fly(3.0, 1200, j_adopted, sigma)) << "the resolved error was not adopted in 60 s";
+  // What was adopted is nearer the truth than the table, and the table was beyond 3 sigma of it.
+  EXPECT_LT((j_adopted - j_true).norm(), 0.5 * table_err);
+  const Vec6 dj = inertia_params(total_inertia(table.mass_hat)) - inertia_params(j_adopted);
+  bool beyond = false;
+  for (int i = 0; i < 6; ++i) beyond = beyond || std::abs(dj(i)) > 3.0 * sigma(i);
+  EXPECT_TRUE(beyond);
+}
+
+TEST(GncIdentification, AdoptSigmasMustBeFiniteAndNonNegative) {
+  GncParams p = identifying_params(ModelAdoption::kAuto);
+  p.identification.adopt_sigmas = -1.0;
+  ParamCheck c = validate(p);
+  EXPECT_FALSE(c.ok);
+  EXPECT_STREQ(c.field, "identification.adopt_sigmas");
+  p.identification.adopt_sigmas = std::nan("");
+  EXPECT_FALSE(validate(p).ok);
+  p.identification.adopt_sigmas = 3.0;
+  EXPECT_TRUE(validate(p).ok);
+}
+
 // gnc/fdi/README.md (F12): when the identifier's innovation gate (I18) re-inflates J, r and k
 // because its windows stopped fitting (here a channel dies: its column of the true B goes to
 // zero), the fault detector keeps the model it had. Its residual noise (F5) stays where it was,

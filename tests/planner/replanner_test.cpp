@@ -243,6 +243,27 @@ TEST(Replanner, EarlyPlanForTheAPrioriModelOnlyOnceTheIdentifierConfirmsIt) {
   ASSERT_TRUE(d2.has_value());
   EXPECT_EQ(wait.records().front().trigger, ReplanTrigger::kFirst);
   EXPECT_NEAR(wait.records().front().t_state, 100.0, 1e-9);
+
+  // A confirmation that comes after first_plan_s, with no confident model and first_plan_max_s
+  // still ahead, plans then (early) instead of waiting for first_plan_max_s.
+  ReplanPolicy late_pol = pol;
+  late_pol.first_plan_s = 30.0;
+  late_pol.first_plan_max_s = 100.0;
+  late_pol.refuted_max_s = 0.0;
+  Replanner late(table, late_pol);
+  std::optional<Delivery> d3;
+  for (int k = 0; k < 2000 && !d3; ++k) {
+    t = k * table.dt;
+    gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+    // 1 sigma 3 % of |J| (not confirmed) until 60 s, then 0.01 % and agreeing.
+    const double s = t < 60.0 - 1e-9 ? 300.0 * sj : sj;
+    tl.est = report(table, s, 0.01, 0, 0.0);
+    d3 = late.update(tl);
+  }
+  ASSERT_TRUE(d3.has_value());
+  ASSERT_EQ(late.records().size(), 1u);
+  EXPECT_EQ(late.records().front().trigger, ReplanTrigger::kEarly);
+  EXPECT_NEAR(late.records().front().t_state, 60.0, 1e-9);
 }
 
 TEST(Replanner, ARefutedAPrioriModelIsNotPlannedForUntilRefutedMax) {
@@ -275,6 +296,51 @@ TEST(Replanner, ARefutedAPrioriModelIsNotPlannedForUntilRefutedMax) {
   EXPECT_NEAR(refute[0].t_state, 120.0, 1e-9);
   EXPECT_EQ(refute[0].trigger, ReplanTrigger::kFirst);
   EXPECT_FALSE(refute[0].identified);
+}
+
+// adopt_wait_s: a confident identified model that refutes the flight's active model (here Jxx
+// 10 sigma = 0.5 % of |J| from the table) is planned for only once the flight has adopted it (the
+// adoption count in the telemetry), so that the NTCL tracks the plan with the plan's model; if no
+// adoption comes, at most adopt_wait_s after the model became confident. A model the flight's
+// table already agrees with is planned for at once.
+TEST(Replanner, AConfidentModelTheFlightDoesNotFlyYetIsPlannedForAfterItsAdoption) {
+  const gnc::GncParams table = case1_table();
+  ReplanPolicy pol = policy(0.0);
+  pol.first_plan_s = 10.0;
+  pol.first_plan_max_s = 200.0;  // the identified model decides the first plan's time
+  pol.adopt_wait_s = 60.0;
+  const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+  const double sj = 5e-4 * j.norm();
+  const Vec3 w(0.01, 0.02, 0.03);
+  // Confident from 20 s; adopted by the flight at `t_adopt` (< 0: never).
+  auto fly = [&](double dj, double t_adopt) {
+    Replanner rp(table, pol);
+    for (int k = 0; k < 3000; ++k) {
+      const double t = k * table.dt;
+      gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+      tl.est = report(table, sj, 0.01, 0, dj);
+      tl.est.inertia_confident = t >= 20.0 - 1e-9;
+      tl.est.offset_confident = tl.est.inertia_confident;
+      tl.est.adoptions = (t_adopt >= 0.0 && t >= t_adopt - 1e-9) ? 1u : 0u;
+      if (rp.update(tl)) break;
+    }
+    return rp.records();
+  };
+  const auto adopted = fly(10.0 * sj, 35.0);
+  ASSERT_EQ(adopted.size(), 1u);
+  EXPECT_TRUE(adopted[0].ok) << adopted[0].error;
+  EXPECT_TRUE(adopted[0].identified);
+  EXPECT_NEAR(adopted[0].t_state, 35.0, 1e-9);  // at the adoption, not at confidence (20 s)
+  const auto never = fly(10.0 * sj, -1.0);
+  ASSERT_EQ(never.size(), 1u);
+  EXPECT_NEAR(never[0].t_state, 80.0, 1e-9);  // confident at 20 s + adopt_wait_s
+  const auto agrees = fly(1.0 * sj, -1.0);   // within 3 sigma of the table: nothing to wait for
+  ASSERT_EQ(agrees.size(), 1u);
+  EXPECT_NEAR(agrees[0].t_state, 20.0, 1e-9);
+  pol.adopt_wait_s = 0.0;  // off: planned at confidence
+  const auto off = fly(10.0 * sj, 35.0);
+  ASSERT_EQ(off.size(), 1u);
+  EXPECT_NEAR(off[0].t_state, 20.0, 1e-9);
 }
 
 }  // namespace
