@@ -99,6 +99,7 @@ void FaultDetector::reset() {
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
+  reset_probe_llr();
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   st_ = FaultDetectorStatus{};
@@ -154,6 +155,7 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
+  reset_probe_llr();
   st_.probe_pod = -1;
 }
 
@@ -175,6 +177,7 @@ void FaultDetector::clear(int thruster) {
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
+  reset_probe_llr();
   st_.probe_pod = -1;
 }
 
@@ -559,15 +562,13 @@ void FaultDetector::decide() {
   // shows only where its jet is commanded. So no new test starts before probe_after_windows
   // windows have been seen with the valve open.
   bool probe_ended = false;
+  if (probe_left_ > 0 || (verdict_pending_ && eval_open_fraction_ >= 0.5)) {
+    // (F16) Every window of the test, and the reopened one that reads it, adds its LLRs.
+    for (std::size_t h = 0; h < probe_llr_.size(); ++h) probe_llr_[h] += window_llr_[h];
+  }
   if (probe_left_ > 0) {
-    // (F15) A window flown with the tested pod closed throughout: quiet or not.
-    if (eval_open_fraction_ <= 0.0) {
-      if (st_.chi2 > p_.suspect_chi2) {
-        probe_loud_ = true;
-      } else {
-        ++probe_quiet_;
-      }
-    }
+    // (F15) A window flown with the tested pod closed throughout.
+    if (eval_open_fraction_ <= 0.0) ++probe_closed_;
     if (--probe_left_ == 0) {
       st_.probe_pod = -1;
       ambiguous_windows_ = 0;
@@ -622,11 +623,19 @@ void FaultDetector::decide() {
     } else if (blocking < kThrusters) {
       pod = pod_g;
     }
+  } else if (best < kThrusters && pod_b == probe_llr_pod_) {
+    // (F16) The tests of this pod are under way: their sum (T) decides between the pod's jets
+    // from the reopened windows, one more each test.
+    pod = pod_b;
   }
   if (pod < 0 || p_.probe_windows == 0 || probe_left_ > 0 || probe_ended) return;
   ++ambiguous_windows_;
   if (probe_left_ == 0 && ambiguous_windows_ >= p_.probe_after_windows) {
     st_.probe_pod = pod;
+    if (pod != probe_llr_pod_) {  // (F16) a test of another pod starts its own sum
+      probe_llr_.fill(0.0);
+      probe_llr_pod_ = pod;
+    }
     probe_left_ = p_.probe_windows;
     ++st_.probes;
     ambiguous_windows_ = 0;
@@ -641,12 +650,21 @@ int FaultDetector::probe_verdict() const {
   // only where it is commanded, not where a valve is, so the motion is a stuck-on jet of that pod:
   // the one whose signature explains the reopened window best, ahead of every other hypothesis
   // (any pod, any kind) by margin_llr in that window alone.
-  if (probe_loud_ || probe_quiet_ == 0 || st_.chi2 <= p_.suspect_chi2) return -1;
+  // (F16) "Ahead" is read on the LLR summed over the tests' windows (closed and reopened), not on
+  // the reopened window alone: in that window an axial jet and its mirror on the opposite pod
+  // (2 r_xy x e_z apart) explain the motion equally, whereas in the closed windows the mirror,
+  // behind an open valve, would have fired and did not (LLR -E/2 each).
+  // The test's likelihood already says whether the closed windows were quiet and the reopened one
+  // not (a stuck-on jet of the tested pod gains only in open windows; every other hypothesis is
+  // scored on the closed ones too), so no per-window chi-square bound is asked: a weak jet (a few
+  // sigma per window in cases 6-7) is decided over several consecutive tests of its pod. At least
+  // one window must have been flown with the pod closed throughout.
+  if (probe_closed_ == 0) return -1;
   int best = -1;
   double best_llr = -1e300;
   double second = -1e300;
   for (int h = 0; h < kHypotheses; ++h) {
-    const double l = window_llr_[static_cast<std::size_t>(h)];
+    const double l = probe_llr_[static_cast<std::size_t>(h)];
     if (l > best_llr) {
       second = best_llr;
       best_llr = l;

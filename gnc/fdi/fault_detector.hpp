@@ -274,22 +274,30 @@ class FaultDetector {
   std::array<double, kBasisPairs> cross_xx_{};  // per episode: sum_w (sum x~_a x~_b) / var
   int ambiguous_windows_{0};
   int probe_left_{0};
-  // (F15) The isolation test's outcome: the tested pod, whether every window flown with it closed
-  // throughout was quiet, and the verdict awaited from the first window after it reopens.
+  // (F15) The isolation test's outcome: the tested pod, how many windows were flown with it closed
+  // throughout, and the verdict awaited from the first window after it reopens.
   int probe_tested_pod_{-1};
-  int probe_quiet_{0};
-  bool probe_loud_{false};
+  int probe_closed_{0};
   bool verdict_pending_{false};
   double eval_open_fraction_{1.0};           // the evaluated window's open time of the tested pod
   std::array<double, kHypotheses> window_llr_{};  // the evaluated window's LLR per hypothesis
   void end_probe_verdict() {
     probe_tested_pod_ = -1;
-    probe_quiet_ = 0;
-    probe_loud_ = false;
+    probe_closed_ = 0;
     verdict_pending_ = false;
   }
   // (F15) The stuck-on hypothesis confirmed by a test's outcome, or -1.
   int probe_verdict() const;
+  // (F16) The tests' likelihood: each hypothesis's LLR summed over every window flown during the
+  // isolation tests of one pod (closed windows and reopened ones, consecutive tests of that pod
+  // adding up), and the pod (-1 none). A stuck-on jet of another pod loses ½E in each quiet closed
+  // window; one of the tested pod loses nothing there.
+  std::array<double, kHypotheses> probe_llr_{};
+  int probe_llr_pod_{-1};
+  void reset_probe_llr() {
+    probe_llr_.fill(0.0);
+    probe_llr_pod_ = -1;
+  }
   FaultDetectorStatus st_{};
   FaultEvents pending_{};
   int identified_confirm_{-1};  // (F14) thruster to confirm stuck on at the next update

@@ -344,6 +344,8 @@ struct AmbiguousRun {
   RunResult r;
   std::uint32_t probes{0};
   int probe_windows_closed{0};  // ticks with a pod closed for the test
+  std::vector<int> probe_ends;  // ticks at which an isolation test reopened its pod
+  std::vector<int> probe_pods;  // the pod of each test
 };
 
 AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
@@ -389,6 +391,9 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
     if (d.probe_pod() >= 0) {
       t.valve[static_cast<std::size_t>(d.probe_pod())] = false;
       ++out.probe_windows_closed;
+      if (out.probe_pods.size() == out.probe_ends.size()) out.probe_pods.push_back(d.probe_pod());
+    } else if (out.probe_pods.size() > out.probe_ends.size()) {
+      out.probe_ends.push_back(k);
     }
     Vec16 cmd = random_firing(rng);
     cmd(2) = cmd(3) = cmd(10) = cmd(11) = 0.0;  // channels 1 and 5 never commanded
@@ -414,6 +419,29 @@ TEST(FaultDetector, OppositePodAxialJetsAreNotConfusedWhenOnlyTheModelErrorSepar
   EXPECT_EQ(now.r.kind, FaultKind::kStuckOn);
   EXPECT_GE(now.probes, 1u);
   EXPECT_GT(now.probe_windows_closed, 0);
+}
+
+// (F16) The tests are read on the likelihood of all their windows. In a reopened window alone the
+// model's signature of the mirror jet 11 is exactly the truth's of 2 (the trap above), and the
+// window is a few sigma at most: the window-alone verdict (F15) never names 2, and the scores
+// settle it only after many tests. Over the closed windows 11, behind an open valve, would have
+// fired and did not: the sum over consecutive tests of pod 0 confirms 2 in a reopened window.
+TEST(FaultDetector, TheIsolationTestIsReadOverAllItsWindows) {
+  const AmbiguousRun run = fly_ambiguous(FaultDetectorParams{});
+  ASSERT_GE(run.r.confirmed_at, 0) << "not isolated";
+  EXPECT_EQ(run.r.thruster, 2);
+  EXPECT_EQ(run.r.kind, FaultKind::kStuckOn);
+  // Confirmed by a test of pod 0: in the window that reopens it (10 ticks) or its evaluation (4).
+  bool by_test = false;
+  for (std::size_t i = 0; i < run.probe_ends.size(); ++i) {
+    const int end = run.probe_ends[i];
+    if (run.probe_pods[i] == 0 && run.r.confirmed_at >= end &&
+        run.r.confirmed_at <= end + 10 + FaultDetector::kEvaluationSteps + 1) {
+      by_test = true;
+    }
+  }
+  EXPECT_TRUE(by_test) << "confirmed at tick " << run.r.confirmed_at << " after "
+                       << run.probe_ends.size() << " tests, not by a test's outcome";
 }
 
 TEST(FaultDetector, WithoutTheIsolationTestAnAmbiguousPairIsNeverDecided) {
