@@ -64,6 +64,11 @@ struct FaultDetectorParams {
   double identified_match_chi2{16.27};  // chi-square(3) at 0.999
   double identified_margin_chi2{25.0};
   int identified_windows{2};
+  // (F17) Pod sweep: when a fitted identifier window puts the fault torque identified_zero_chi2
+  // from zero but (F14) matches no jet, each pod's valve is closed in turn for probe_windows
+  // windows (pods ordered by their best-matching jet) and the step of the unexplained angular
+  // acceleration at the closure and at the reopening names the stuck jet.
+  bool identified_sweep{false};
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -121,6 +126,8 @@ struct FaultDetectorStatus {
   int identified_best{-1};
   int identified_streak{0};
   std::uint32_t identified_confirmations{0};  // faults confirmed through (F14)
+  std::uint32_t sweeps{0};                    // (F17) pod sweeps started
+  std::uint32_t sweep_confirmations{0};       // faults confirmed through (F17)
 };
 
 // Raised by update(); the caller turns them into events.
@@ -161,6 +168,9 @@ class FaultDetector {
   // A hypothesis is suspected (its score above half the confirmation level): the model it is
   // tested against is held (F7), and the identifier should not absorb the fault either.
   bool suspecting() const { return suspecting_; }
+  // (F17) A pod sweep is under way: the identifier's windows are not fitted meanwhile (its fault
+  // torque d is constant only while every valve stays as it is).
+  bool sweeping() const { return sweep_next_ >= 0; }
   // (F9) The pod whose latch valve the detector asks to be closed for an isolation test (-1 none).
   int probe_pod() const { return st_.probe_pod; }
 
@@ -298,6 +308,39 @@ class FaultDetector {
     probe_llr_.fill(0.0);
     probe_llr_pod_ = -1;
   }
+  // (F17) Pod sweep on the identifier's fault torque: the pods in test order, the next one
+  // (-1: no sweep), the tested pod's closed windows still to fly (0: reading or idle), and the
+  // step test's sums: the reference window's unexplained acceleration and each jet's mean excess
+  // thrust, the closed windows' sum, and their variances (rad/s^2)^2.
+  static constexpr int kSweepRepeats = 8;
+  std::array<int, kPods> sweep_order_{};
+  int sweep_next_{-1};
+  int sweep_pod_{-1};
+  int sweep_left_{0};
+  bool sweep_reading_{false};
+  int sweep_closed_{0};
+  Vec3 sweep_ref_{Vec3::Zero()};
+  Vec3 sweep_closed_sum_{Vec3::Zero()};
+  std::array<double, kThrusters> sweep_ref_excess_{};
+  double sweep_ref_var_{0.0};
+  double sweep_closed_var_{0.0};
+  std::array<double, kThrusters> sweep_ref_force_{};     // delivered mean thrust, reference
+  std::array<double, kThrusters> sweep_closed_force_{};  // ... summed over the closed windows
+  std::array<double, kThrusters> sweep_llr_{};  // each jet's L summed over the sweeps' tests
+  // The evaluated window's unexplained acceleration, its gyro variance, each jet's mean excess
+  // thrust (u_max - f over the open time, per second of window, N) and each pod's open fraction.
+  Vec3 eval_accel_{Vec3::Zero()};
+  double eval_accel_var_{0.0};
+  std::array<double, kThrusters> eval_excess_{};
+  std::array<double, kPods> eval_open_{};
+  void end_sweep() {
+    sweep_next_ = -1;
+    sweep_pod_ = -1;
+    sweep_left_ = 0;
+    sweep_reading_ = false;
+  }
+  // (F17) One step of the sweep at a window's decision; true when it confirmed a jet.
+  bool sweep_step();
   FaultDetectorStatus st_{};
   FaultEvents pending_{};
   int identified_confirm_{-1};  // (F14) thruster to confirm stuck on at the next update
