@@ -103,6 +103,7 @@ void FaultDetector::reset() {
   reset_probe_llr();
   end_sweep();
   sweep_llr_.fill(0.0);
+  sweep_llr_off_.fill(0.0);
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   st_ = FaultDetectorStatus{};
@@ -161,6 +162,7 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   reset_probe_llr();
   end_sweep();
   sweep_llr_.fill(0.0);
+  sweep_llr_off_.fill(0.0);
   st_.probe_pod = -1;
 }
 
@@ -185,6 +187,7 @@ void FaultDetector::clear(int thruster) {
   reset_probe_llr();
   end_sweep();
   sweep_llr_.fill(0.0);
+  sweep_llr_off_.fill(0.0);
   st_.probe_pod = -1;
 }
 
@@ -711,7 +714,8 @@ bool FaultDetector::sweep_step() {
   //   L_i = D' C^-1 s_i - s_i' C^-1 s_i / 2
   // to its pod's jets' sums (a jet whose pod showed no step loses s' C^-1 s / 2). The leader of
   // the sixteen sums is confirmed stuck on when the test just read is of its pod, its sum exceeds
-  // confirm_llr and every other by margin_llr, and it fits the step,
+  // confirm_llr and every other by margin_llr (and every stuck-off alternative's sum, scored on
+  // s = -b_j dg_j, the jet's delivered thrust step), and it fits the step,
   // (D - s_i)' C^-1 (D - s_i) < identified_match_chi2. Otherwise the next pod is tested from this
   // window. After the fourth, the pod whose jet leads every other pod's jets by margin_llr is
   // tested again (at most kSweepRepeats times) until its jets are told apart; otherwise the sweep
@@ -811,11 +815,13 @@ bool FaultDetector::sweep_step() {
   Vec3 net_force = Vec3::Zero();
   Vec3 torque_step = Vec3::Zero();
   double strength_var = 0.0;
+  std::array<double, kThrusters> step{};  // each jet's delivered thrust step, as D's
   for (int i = 0; i < kThrusters; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const auto pk = static_cast<std::size_t>(pod_[k]);
     const double g_re = u_max_ * eval_open_[pk] - eval_excess_[k];
     const double dg = 0.5 * (sweep_ref_force_[k] + g_re) - sweep_closed_force_[k] / m;
+    step[k] = dg;
     net_force += dg * dir_[k];
     torque_step += dg * b_[k];
     const double sk = m_.k_sigma * b_[k].norm() * dg;
@@ -823,6 +829,31 @@ bool FaultDetector::sweep_step() {
   }
   const double sd_cmd = r_sigma_ * j_inv_norm_ * net_force.norm() + rho * torque_step.norm() +
                         std::sqrt(strength_var);
+  // Stuck-off alternatives: jet j producing nothing leaves D = -b_j dg_j (its delivered thrust
+  // step: all of it for a jet of the tested pod, the reallocation's share for the others), scored
+  // the same way for every jet whose step is at least 1 N; their sums only block (a stuck-off jet
+  // is the bank's to confirm, where it is commanded).
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    if (std::fabs(step[k]) < 1.0) continue;
+    const Vec3 si = -b_[k] * step[k];
+    const double sd = sd_cmd + (rho + m_.k_sigma) * si.norm();
+    Mat3 ex;
+    ex << 0.0, -dir_[k].z(), dir_[k].y(), dir_[k].z(), 0.0, -dir_[k].x(), -dir_[k].y(),
+        dir_[k].x(), 0.0;
+    const Mat3 jm = j_inv_ * ex * (m_.k(i) * step[k]);
+    const Mat3 cov = jm * m_.r_cov * jm.transpose() +
+                     Mat3::Identity() * (var_gyro + sd * sd + 1e-30);
+    const Eigen::LDLT<Mat3> ldlt(cov);
+    const Vec3 ci_s = ldlt.solve(si);
+    sweep_llr_off_[k] += d.dot(ci_s) - 0.5 * si.dot(ci_s);
+  }
+  double off_best = -1e300;
+  for (int i = 0; i < kThrusters; ++i) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    off_best = std::fmax(off_best, sweep_llr_off_[static_cast<std::size_t>(i)]);
+  }
   int best_fit_jet = -1;
   double fit_of_best = 1e300;
   for (int i = 0; i < kThrusters; ++i) {
@@ -868,7 +899,8 @@ bool FaultDetector::sweep_step() {
     }
   }
   if (best < 0 || best != best_fit_jet || best_l <= p_.confirm_llr ||
-      fit_of_best >= p_.identified_match_chi2 || best_l - second <= p_.margin_llr) {
+      fit_of_best >= p_.identified_match_chi2 || best_l - second <= p_.margin_llr ||
+      best_l - off_best <= p_.margin_llr) {
     return false;  // the next pod is tested from this window
   }
   end_sweep();

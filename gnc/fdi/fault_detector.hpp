@@ -147,10 +147,11 @@ class FaultDetector {
   bool evaluating() const { return eval_phase_ != 0; }
   // The next update runs one of the evaluation's heavy steps: the two scoring steps, and the
   // decision when a hypothesis is past the confirmation level (the bias-bounded margins (F8)
-  // against every alternative). The executive keeps other periodic work off those ticks.
+  // against every alternative) or a pod sweep reads its step (F17). The executive keeps other
+  // periodic work off those ticks.
   bool heavy_step_next() const {
     return eval_phase_ == 1 || eval_phase_ == 2 ||
-           (eval_phase_ == 4 && st_.best_llr > p_.confirm_llr);
+           (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping()));
   }
   static constexpr int kEvaluationSteps = 4;
   FaultEvents update(const FaultDetectorInput& in);
@@ -327,6 +328,7 @@ class FaultDetector {
   std::array<double, kThrusters> sweep_ref_force_{};     // delivered mean thrust, reference
   std::array<double, kThrusters> sweep_closed_force_{};  // ... summed over the closed windows
   std::array<double, kThrusters> sweep_llr_{};  // each jet's L summed over the sweeps' tests
+  std::array<double, kThrusters> sweep_llr_off_{};  // ... of each jet stuck off
   // The evaluated window's unexplained acceleration, its gyro variance, each jet's mean excess
   // thrust (u_max - f over the open time, per second of window, N) and each pod's open fraction.
   Vec3 eval_accel_{Vec3::Zero()};

@@ -464,7 +464,7 @@ struct SweepRun {
   int ticks_closed{0};
 };
 
-SweepRun fly_sweep(bool sweep, int stuck, std::uint64_t seed) {
+SweepRun fly_sweep(bool sweep, int stuck, std::uint64_t seed, int stuck_off = -1) {
   Truth t;
   t.rng.seed(seed);
   FaultDetectorParams p;
@@ -490,7 +490,10 @@ SweepRun fly_sweep(bool sweep, int stuck, std::uint64_t seed) {
   std::array<bool, 4> prev_valve = t.valve;
   SweepRun out;
   for (int k = 0; k < 6000; ++k) {
-    if (k == 50) t.stuck_on = stuck;
+    if (k == 50) {
+      t.stuck_on = stuck;
+      t.stuck_off = stuck_off;
+    }
     if (k > 0 && k % 200 == 0) {  // an identifier window: the fault torque off zero, unmatched
       StuckOnEvidence e;
       e.fitted = true;
@@ -518,7 +521,12 @@ SweepRun fly_sweep(bool sweep, int stuck, std::uint64_t seed) {
       t.valve[static_cast<std::size_t>(d.probe_pod())] = false;
       ++out.ticks_closed;
     }
-    const Vec16 cmd = 0.1 * random_firing(rng);  // a despin's few percent of u_max
+    Vec16 cmd = 0.1 * random_firing(rng);  // a despin's few percent of u_max
+    if (stuck_off >= 0 && k >= 50) {
+      // The controller, short of that jet's torque, commands it hard (and not its opposite).
+      cmd(stuck_off) = 150.0;
+      cmd(stuck_off ^ 1) = 0.0;
+    }
     t.advance(cmd);
     prev = cmd;
     prev_valve = t.valve;
@@ -540,6 +548,22 @@ TEST(FaultDetector, APodSweepIsolatesAStuckOnJetBeforeTheModelIsIdentified) {
     EXPECT_EQ(with.r.kind, FaultKind::kStuckOn);
     EXPECT_EQ(with.sweep_confirmations, 1u);
     EXPECT_GE(with.sweeps, 1u);
+  }
+}
+
+// A jet stuck off and commanded hard leaves a step when its pod closes (the prediction drops the
+// thrust the truth never had): the sweep scores it as a stuck-off alternative and confirms no
+// stuck-on jet in its place.
+TEST(FaultDetector, APodSweepDoesNotTakeAStuckOffJetForAStuckOnOne) {
+  for (const int jet : {4, 12}) {
+    SCOPED_TRACE(jet);
+    const SweepRun run = fly_sweep(true, -1, 3, jet);
+    EXPECT_GE(run.sweeps, 1u);
+    EXPECT_EQ(run.sweep_confirmations, 0u) << "confirmed thruster " << run.r.thruster;
+    if (run.r.confirmed_at >= 0) {
+      EXPECT_EQ(run.r.thruster, jet);
+      EXPECT_EQ(run.r.kind, FaultKind::kStuckOff);
+    }
   }
 }
 
