@@ -248,6 +248,7 @@ GncConfig load_gnc(const std::string& path) {
       fd.identified_margin_chi2 = r.non_negative("identified_margin_chi2");
     }
     if (r.has("identified_windows")) fd.identified_windows = r.integer("identified_windows");
+    if (r.has("identified_sweep")) fd.identified_sweep = r.boolean("identified_sweep");  // (F17)
     p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
     r.finish();
   }

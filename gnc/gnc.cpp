@@ -457,7 +457,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // identifier's fault torque d (I22) absorbs, so its windows are kept: they are the evidence.
     const bool stuck_on_suspected = fdi_.status().best >= 0 && fdi_.status().best < kThrusters;
     in.force_valid = !(params_.fdi.enabled && fdi_.suspecting() &&
-                       !(params_.fdi.identified_isolation && stuck_on_suspected));
+                       !(params_.fdi.identified_isolation && stuck_on_suspected)) &&
+                     !(params_.fdi.enabled && fdi_.sweeping());  // (F17) valves moving
     // The identifier's step blocks stay off the fault detector's heavy evaluation steps
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
@@ -99,6 +100,10 @@ void FaultDetector::reset() {
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
+  reset_probe_llr();
+  end_sweep();
+  sweep_llr_.fill(0.0);
+  sweep_llr_off_.fill(0.0);
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   st_ = FaultDetectorStatus{};
@@ -154,6 +159,10 @@ void FaultDetector::declare(int thruster, FaultKind kind) {
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
+  reset_probe_llr();
+  end_sweep();
+  sweep_llr_.fill(0.0);
+  sweep_llr_off_.fill(0.0);
   st_.probe_pod = -1;
 }
 
@@ -175,6 +184,10 @@ void FaultDetector::clear(int thruster) {
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
+  reset_probe_llr();
+  end_sweep();
+  sweep_llr_.fill(0.0);
+  sweep_llr_off_.fill(0.0);
   st_.probe_pod = -1;
 }
 
@@ -203,6 +216,33 @@ void FaultDetector::identified_evidence(const StuckOnEvidence& e) {
   if (!pass) {
     st_.identified_best = -1;
     st_.identified_streak = 0;
+    // (F17) The fault torque stands out from zero, but no jet matches it yet (the model has not
+    // converged around it): sweep the pods, the one of the best-matching jet first.
+    if (p_.identified_sweep && e.chi2_zero > p_.identified_zero_chi2 && !sweeping() &&
+        probe_left_ == 0 && !verdict_pending_ && st_.confirmed_on == 0) {
+      std::array<double, kPods> pod_best{};
+      pod_best.fill(1e300);
+      for (int i = 0; i < kThrusters; ++i) {
+        const double c = e.chi2_jet[static_cast<std::size_t>(i)];
+        const auto q = static_cast<std::size_t>(pod_[static_cast<std::size_t>(i)]);
+        if (c >= 0.0 && c < pod_best[q]) pod_best[q] = c;
+      }
+      for (int q = 0; q < kPods; ++q) sweep_order_[static_cast<std::size_t>(q)] = q;
+      for (int a = 1; a < kPods; ++a) {  // insertion sort of four
+        for (int b = a; b > 0; --b) {
+          const auto x = static_cast<std::size_t>(sweep_order_[static_cast<std::size_t>(b)]);
+          const auto y = static_cast<std::size_t>(sweep_order_[static_cast<std::size_t>(b - 1)]);
+          if (pod_best[x] >= pod_best[y]) break;
+          std::swap(sweep_order_[static_cast<std::size_t>(b)],
+                    sweep_order_[static_cast<std::size_t>(b - 1)]);
+        }
+      }
+      sweep_next_ = 0;
+      sweep_pod_ = -1;
+      sweep_left_ = 0;
+      sweep_reading_ = false;
+      ++st_.sweeps;
+    }
     return;
   }
   st_.identified_streak = best == st_.identified_best ? st_.identified_streak + 1 : 1;
@@ -438,6 +478,21 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   ++st_.windows;
   eval_open_fraction_ =
       probe_tested_pod_ >= 0 ? w.tp[static_cast<std::size_t>(probe_tested_pod_)] / (n * dt_) : 1.0;
+  if (sweeping()) {
+    // (F17) The window's unexplained angular acceleration (the residual's slope), the gyro's share
+    // of its variance, each jet's mean excess thrust and each pod's open fraction.
+    const double t_win = n * dt_;
+    eval_accel_ = slope / dt_;
+    eval_accel_var_ = stt > 0.0 ? p_.gyro_sigma * p_.gyro_sigma / (stt * dt_ * dt_) : 1e300;
+    for (int i = 0; i < kThrusters; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      eval_excess_[k] = w.c[k] / t_win;
+    }
+    for (int q = 0; q < kPods; ++q) {
+      const auto pq = static_cast<std::size_t>(q);
+      eval_open_[pq] = w.tp[pq] / t_win;
+    }
+  }
 }
 
 void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
@@ -558,16 +613,15 @@ void FaultDetector::decide() {
   // pod fires whatever is commanded and its signature returns, whereas a stuck-off alternative
   // shows only where its jet is commanded. So no new test starts before probe_after_windows
   // windows have been seen with the valve open.
+  if (sweeping() && sweep_step()) return;
   bool probe_ended = false;
+  if (probe_left_ > 0 || (verdict_pending_ && eval_open_fraction_ >= 0.5)) {
+    // (F16) Every window of the test, and the reopened one that reads it, adds its LLRs.
+    for (std::size_t h = 0; h < probe_llr_.size(); ++h) probe_llr_[h] += window_llr_[h];
+  }
   if (probe_left_ > 0) {
-    // (F15) A window flown with the tested pod closed throughout: quiet or not.
-    if (eval_open_fraction_ <= 0.0) {
-      if (st_.chi2 > p_.suspect_chi2) {
-        probe_loud_ = true;
-      } else {
-        ++probe_quiet_;
-      }
-    }
+    // (F15) A window flown with the tested pod closed throughout.
+    if (eval_open_fraction_ <= 0.0) ++probe_closed_;
     if (--probe_left_ == 0) {
       st_.probe_pod = -1;
       ambiguous_windows_ = 0;
@@ -622,11 +676,19 @@ void FaultDetector::decide() {
     } else if (blocking < kThrusters) {
       pod = pod_g;
     }
+  } else if (best < kThrusters && pod_b == probe_llr_pod_) {
+    // (F16) The tests of this pod are under way: their sum (T) decides between the pod's jets
+    // from the reopened windows, one more each test.
+    pod = pod_b;
   }
-  if (pod < 0 || p_.probe_windows == 0 || probe_left_ > 0 || probe_ended) return;
+  if (pod < 0 || p_.probe_windows == 0 || probe_left_ > 0 || probe_ended || sweeping()) return;
   ++ambiguous_windows_;
   if (probe_left_ == 0 && ambiguous_windows_ >= p_.probe_after_windows) {
     st_.probe_pod = pod;
+    if (pod != probe_llr_pod_) {  // (F16) a test of another pod starts its own sum
+      probe_llr_.fill(0.0);
+      probe_llr_pod_ = pod;
+    }
     probe_left_ = p_.probe_windows;
     ++st_.probes;
     ambiguous_windows_ = 0;
@@ -635,18 +697,242 @@ void FaultDetector::decide() {
   }
 }
 
+bool FaultDetector::sweep_step() {
+  // (F17) Pod sweep. Before the model is identified the bank's residual carries the model's error
+  // (the gyroscopic term with J off by 10 %: 1e-3 rad/s^2, twenty times an axial jet), but that
+  // error changes slowly, whereas closing the pod of a stuck-on jet removes its torque at once.
+  // So the test reads the step of the unexplained acceleration a (the residual's slope, commanded
+  // thrust predicted on the open pods only): with a_ref the window before the closure, a_c the
+  // mean of the m windows flown with the pod closed throughout and a_re the reopened window,
+  //   D = (a_ref + a_re) / 2 - a_c        (a drift of the model error linear in time cancels),
+  // and jet i of the pod predicts s_i = b_i x_i, x_i = (x_ref,i + x_re,i) / 2 its mean excess thrust
+  // u_max - f_i. var D = (var_ref + var_re) / 4 + sum var_c / m^2 (the gyro's share of each
+  // window's slope) + sd_i^2 + C_r,i: sd_i = sd_cmd (the commanded thrust's model error, below: it
+  // changes only with the delivered thrust g_j, whose step is taken as D's) + (rho + k_sigma)|s_i|
+  // (rho the relative 1 sigma of J), and C_r,i = x_i^2 J^-1 [e_i]x P_r [e_i]x^T J^-T the centre of
+  // mass's share of the jet's torque (a 3x3 covariance C). Each test adds
+  //   L_i = D' C^-1 s_i - s_i' C^-1 s_i / 2
+  // to its pod's jets' sums (a jet whose pod showed no step loses s' C^-1 s / 2). The leader of
+  // the sixteen sums is confirmed stuck on when the test just read is of its pod, its sum exceeds
+  // confirm_llr and every other by margin_llr (and every stuck-off alternative's sum, scored on
+  // s = -b_j dg_j, the jet's delivered thrust step), and it fits the step,
+  // (D - s_i)' C^-1 (D - s_i) < identified_match_chi2. Otherwise the next pod is tested from this
+  // window. After the fourth, the pod whose jet leads every other pod's jets by margin_llr is
+  // tested again (at most kSweepRepeats times) until its jets are told apart; otherwise the sweep
+  // ends (a later identifier window may start another).
+  const int q = sweep_pod_;
+  if (q < 0) {
+    // The window just evaluated is the reference (its valves as they were): start the next test.
+    if (sweep_next_ < kPods) {
+      sweep_pod_ = sweep_order_[static_cast<std::size_t>(sweep_next_)];
+    } else {
+      // Every pod tested once: the pod of the leading sum is tested again while that sum is
+      // ahead of every other jet's by margin_llr (its step seen, the jet not yet decided), at
+      // most kSweepRepeats times; otherwise the sweep ends.
+      int lead = -1;
+      double l1 = -1e300;
+      double l2 = -1e300;
+      for (int i = 0; i < kThrusters; ++i) {
+        if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+        const double l = sweep_llr_[static_cast<std::size_t>(i)];
+        if (l > l1) {
+          l2 = l1;
+          l1 = l;
+          lead = i;
+        } else if (l > l2) {
+          l2 = l;
+        }
+      }
+      const bool pod_ahead = lead >= 0 && l1 > 0.0 && sweep_next_ < kPods + kSweepRepeats &&
+                             [&] {
+                               // ahead of every jet of the other pods by margin_llr
+                               const int ql = pod_[static_cast<std::size_t>(lead)];
+                               for (int i = 0; i < kThrusters; ++i) {
+                                 const auto k = static_cast<std::size_t>(i);
+                                 if (pod_[k] == ql) continue;
+                                 if (l1 - sweep_llr_[k] <= p_.margin_llr) return false;
+                               }
+                               return true;
+                             }();
+      if (!pod_ahead) {
+        end_sweep();
+        return false;
+      }
+      sweep_pod_ = pod_[static_cast<std::size_t>(lead)];
+    }
+    ++sweep_next_;
+    sweep_ref_ = eval_accel_;
+    sweep_ref_excess_ = eval_excess_;
+    for (int i = 0; i < kThrusters; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      sweep_ref_force_[k] =
+          u_max_ * eval_open_[static_cast<std::size_t>(pod_[k])] - eval_excess_[k];
+      sweep_closed_force_[k] = 0.0;
+    }
+    sweep_ref_var_ = eval_accel_var_;
+    sweep_closed_var_ = 0.0;
+    sweep_closed_sum_.setZero();
+    sweep_closed_ = 0;
+    sweep_left_ = p_.probe_windows > 0 ? p_.probe_windows : 1;
+    sweep_reading_ = false;
+    st_.probe_pod = sweep_pod_;
+    ++st_.probes;
+    return false;
+  }
+  const auto pq = static_cast<std::size_t>(q);
+  if (sweep_left_ > 0) {
+    if (eval_open_[pq] <= 0.0) {  // flown with the pod closed throughout
+      sweep_closed_sum_ += eval_accel_;
+      sweep_closed_var_ += eval_accel_var_;
+      for (int i = 0; i < kThrusters; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        sweep_closed_force_[k] +=
+            u_max_ * eval_open_[static_cast<std::size_t>(pod_[k])] - eval_excess_[k];
+      }
+      ++sweep_closed_;
+    }
+    if (--sweep_left_ == 0) {
+      st_.probe_pod = -1;
+      sweep_reading_ = true;
+    }
+    return false;
+  }
+  if (!sweep_reading_ || eval_open_[pq] < 0.5) return false;  // wait for the reopened window
+  sweep_reading_ = false;
+  sweep_pod_ = -1;  // the reopened window is the next test's reference
+  if (sweep_closed_ == 0) return false;
+  const double m = static_cast<double>(sweep_closed_);
+  const Vec3 d = 0.5 * (sweep_ref_ + eval_accel_) - sweep_closed_sum_ / m;
+  // var_g: (1/4)(var ref + var re) + (1/m^2) sum var closed.
+  const double var_gyro =
+      0.25 * (sweep_ref_var_ + eval_accel_var_) + sweep_closed_var_ / (m * m);
+  // The commanded thrust's model error changes between the windows only with the delivered thrust
+  // (the closure moves the pod's share to the other pods): per jet the delivered mean thrust
+  // g = (u_max t_open - c) / T, its step dg taken as D's. An error dr of the centre of mass adds
+  // J^-1 (dr x F) with F = sum dg_j e_j the net force step, an error of J^-1 rho |sum b_j dg_j|,
+  // the strengths k_sigma |b_j| dg_j each (independent).
+  const double rho = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
+  Vec3 net_force = Vec3::Zero();
+  Vec3 torque_step = Vec3::Zero();
+  double strength_var = 0.0;
+  std::array<double, kThrusters> step{};  // each jet's delivered thrust step, as D's
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto pk = static_cast<std::size_t>(pod_[k]);
+    const double g_re = u_max_ * eval_open_[pk] - eval_excess_[k];
+    const double dg = 0.5 * (sweep_ref_force_[k] + g_re) - sweep_closed_force_[k] / m;
+    step[k] = dg;
+    net_force += dg * dir_[k];
+    torque_step += dg * b_[k];
+    const double sk = m_.k_sigma * b_[k].norm() * dg;
+    strength_var += sk * sk;
+  }
+  const double sd_cmd = r_sigma_ * j_inv_norm_ * net_force.norm() + rho * torque_step.norm() +
+                        std::sqrt(strength_var);
+  // Stuck-off alternatives: jet j producing nothing leaves D = -b_j dg_j (its delivered thrust
+  // step: all of it for a jet of the tested pod, the reallocation's share for the others), scored
+  // the same way for every jet whose step is at least 1 N; their sums only block (a stuck-off jet
+  // is the bank's to confirm, where it is commanded).
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    if (std::fabs(step[k]) < 1.0) continue;
+    const Vec3 si = -b_[k] * step[k];
+    const double sd = sd_cmd + (rho + m_.k_sigma) * si.norm();
+    Mat3 ex;
+    ex << 0.0, -dir_[k].z(), dir_[k].y(), dir_[k].z(), 0.0, -dir_[k].x(), -dir_[k].y(),
+        dir_[k].x(), 0.0;
+    const Mat3 jm = j_inv_ * ex * (m_.k(i) * step[k]);
+    const Mat3 cov = jm * m_.r_cov * jm.transpose() +
+                     Mat3::Identity() * (var_gyro + sd * sd + 1e-30);
+    const Eigen::LDLT<Mat3> ldlt(cov);
+    const Vec3 ci_s = ldlt.solve(si);
+    sweep_llr_off_[k] += d.dot(ci_s) - 0.5 * si.dot(ci_s);
+  }
+  double off_best = -1e300;
+  for (int i = 0; i < kThrusters; ++i) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    off_best = std::fmax(off_best, sweep_llr_off_[static_cast<std::size_t>(i)]);
+  }
+  int best_fit_jet = -1;
+  double fit_of_best = 1e300;
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (pod_[k] != q) continue;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    const double x = 0.5 * (sweep_ref_excess_[k] + eval_excess_[k]);
+    const Vec3 si = b_[k] * x;
+    // The jet's own torque as uncertain as the model: J and k relatively (isotropic), and the
+    // centre of mass through its covariance, J^-1 k x (dr x e_i): J^-1 [e_i]x P_r [e_i]x^T J^-T x^2
+    // (mostly about the axis of least inertia, as every jet's signature is).
+    const double sd = sd_cmd + (rho + m_.k_sigma) * si.norm();
+    Mat3 ex;
+    ex << 0.0, -dir_[k].z(), dir_[k].y(), dir_[k].z(), 0.0, -dir_[k].x(), -dir_[k].y(),
+        dir_[k].x(), 0.0;
+    const Mat3 jm = j_inv_ * ex * (m_.k(i) * x);
+    const Mat3 cov = jm * m_.r_cov * jm.transpose() +
+                     Mat3::Identity() * (var_gyro + sd * sd + 1e-30);
+    const Eigen::LDLT<Mat3> ldlt(cov);
+    const Vec3 ci_s = ldlt.solve(si);
+    const Vec3 ci_ds = ldlt.solve(Vec3(d - si));
+    const double l = d.dot(ci_s) - 0.5 * si.dot(ci_s);
+    sweep_llr_[k] += l;
+    const double fit = (d - si).dot(ci_ds);
+    if (best_fit_jet < 0 || sweep_llr_[k] > sweep_llr_[static_cast<std::size_t>(best_fit_jet)]) {
+      best_fit_jet = i;
+      fit_of_best = fit;
+    }
+  }
+  // The sweeps' sums (every test of every pod adds its jets' L): the leader over all sixteen.
+  int best = -1;
+  double best_l = -1e300;
+  double second = -1e300;
+  for (int i = 0; i < kThrusters; ++i) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    const double l = sweep_llr_[static_cast<std::size_t>(i)];
+    if (l > best_l) {
+      second = best_l;
+      best_l = l;
+      best = i;
+    } else if (l > second) {
+      second = l;
+    }
+  }
+  if (best < 0 || best != best_fit_jet || best_l <= p_.confirm_llr ||
+      fit_of_best >= p_.identified_match_chi2 || best_l - second <= p_.margin_llr ||
+      best_l - off_best <= p_.margin_llr) {
+    return false;  // the next pod is tested from this window
+  }
+  end_sweep();
+  declare(best, FaultKind::kStuckOn);
+  ++st_.sweep_confirmations;
+  pending_.confirmed = true;
+  pending_.thruster = best;
+  pending_.kind = FaultKind::kStuckOn;
+  return true;
+}
+
 int FaultDetector::probe_verdict() const {
   // (F15) The unexplained motion followed the tested pod's valve: gone in every window flown with
   // the valve closed (at least one), back in the first window with it open. A stuck-off jet shows
   // only where it is commanded, not where a valve is, so the motion is a stuck-on jet of that pod:
   // the one whose signature explains the reopened window best, ahead of every other hypothesis
   // (any pod, any kind) by margin_llr in that window alone.
-  if (probe_loud_ || probe_quiet_ == 0 || st_.chi2 <= p_.suspect_chi2) return -1;
+  // (F16) "Ahead" is read on the LLR summed over the tests' windows (closed and reopened), not on
+  // the reopened window alone: in that window an axial jet and its mirror on the opposite pod
+  // (2 r_xy x e_z apart) explain the motion equally, whereas in the closed windows the mirror,
+  // behind an open valve, would have fired and did not (LLR -E/2 each).
+  // The test's likelihood already says whether the closed windows were quiet and the reopened one
+  // not (a stuck-on jet of the tested pod gains only in open windows; every other hypothesis is
+  // scored on the closed ones too), so no per-window chi-square bound is asked: a weak jet (a few
+  // sigma per window in cases 6-7) is decided over several consecutive tests of its pod. At least
+  // one window must have been flown with the pod closed throughout.
+  if (probe_closed_ == 0) return -1;
   int best = -1;
   double best_llr = -1e300;
   double second = -1e300;
   for (int h = 0; h < kHypotheses; ++h) {
-    const double l = window_llr_[static_cast<std::size_t>(h)];
+    const double l = probe_llr_[static_cast<std::size_t>(h)];
     if (l > best_llr) {
       second = best_llr;
       best_llr = l;

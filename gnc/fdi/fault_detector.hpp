@@ -64,6 +64,11 @@ struct FaultDetectorParams {
   double identified_match_chi2{16.27};  // chi-square(3) at 0.999
   double identified_margin_chi2{25.0};
   int identified_windows{2};
+  // (F17) Pod sweep: when a fitted identifier window puts the fault torque identified_zero_chi2
+  // from zero but (F14) matches no jet, each pod's valve is closed in turn for probe_windows
+  // windows (pods ordered by their best-matching jet) and the step of the unexplained angular
+  // acceleration at the closure and at the reopening names the stuck jet.
+  bool identified_sweep{false};
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -121,6 +126,8 @@ struct FaultDetectorStatus {
   int identified_best{-1};
   int identified_streak{0};
   std::uint32_t identified_confirmations{0};  // faults confirmed through (F14)
+  std::uint32_t sweeps{0};                    // (F17) pod sweeps started
+  std::uint32_t sweep_confirmations{0};       // faults confirmed through (F17)
 };
 
 // Raised by update(); the caller turns them into events.
@@ -140,10 +147,11 @@ class FaultDetector {
   bool evaluating() const { return eval_phase_ != 0; }
   // The next update runs one of the evaluation's heavy steps: the two scoring steps, and the
   // decision when a hypothesis is past the confirmation level (the bias-bounded margins (F8)
-  // against every alternative). The executive keeps other periodic work off those ticks.
+  // against every alternative) or a pod sweep reads its step (F17). The executive keeps other
+  // periodic work off those ticks.
   bool heavy_step_next() const {
     return eval_phase_ == 1 || eval_phase_ == 2 ||
-           (eval_phase_ == 4 && st_.best_llr > p_.confirm_llr);
+           (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping()));
   }
   static constexpr int kEvaluationSteps = 4;
   FaultEvents update(const FaultDetectorInput& in);
@@ -161,6 +169,9 @@ class FaultDetector {
   // A hypothesis is suspected (its score above half the confirmation level): the model it is
   // tested against is held (F7), and the identifier should not absorb the fault either.
   bool suspecting() const { return suspecting_; }
+  // (F17) A pod sweep is under way: the identifier's windows are not fitted meanwhile (its fault
+  // torque d is constant only while every valve stays as it is).
+  bool sweeping() const { return sweep_next_ >= 0; }
   // (F9) The pod whose latch valve the detector asks to be closed for an isolation test (-1 none).
   int probe_pod() const { return st_.probe_pod; }
 
@@ -274,22 +285,64 @@ class FaultDetector {
   std::array<double, kBasisPairs> cross_xx_{};  // per episode: sum_w (sum x~_a x~_b) / var
   int ambiguous_windows_{0};
   int probe_left_{0};
-  // (F15) The isolation test's outcome: the tested pod, whether every window flown with it closed
-  // throughout was quiet, and the verdict awaited from the first window after it reopens.
+  // (F15) The isolation test's outcome: the tested pod, how many windows were flown with it closed
+  // throughout, and the verdict awaited from the first window after it reopens.
   int probe_tested_pod_{-1};
-  int probe_quiet_{0};
-  bool probe_loud_{false};
+  int probe_closed_{0};
   bool verdict_pending_{false};
   double eval_open_fraction_{1.0};           // the evaluated window's open time of the tested pod
   std::array<double, kHypotheses> window_llr_{};  // the evaluated window's LLR per hypothesis
   void end_probe_verdict() {
     probe_tested_pod_ = -1;
-    probe_quiet_ = 0;
-    probe_loud_ = false;
+    probe_closed_ = 0;
     verdict_pending_ = false;
   }
   // (F15) The stuck-on hypothesis confirmed by a test's outcome, or -1.
   int probe_verdict() const;
+  // (F16) The tests' likelihood: each hypothesis's LLR summed over every window flown during the
+  // isolation tests of one pod (closed windows and reopened ones, consecutive tests of that pod
+  // adding up), and the pod (-1 none). A stuck-on jet of another pod loses ½E in each quiet closed
+  // window; one of the tested pod loses nothing there.
+  std::array<double, kHypotheses> probe_llr_{};
+  int probe_llr_pod_{-1};
+  void reset_probe_llr() {
+    probe_llr_.fill(0.0);
+    probe_llr_pod_ = -1;
+  }
+  // (F17) Pod sweep on the identifier's fault torque: the pods in test order, the next one
+  // (-1: no sweep), the tested pod's closed windows still to fly (0: reading or idle), and the
+  // step test's sums: the reference window's unexplained acceleration and each jet's mean excess
+  // thrust, the closed windows' sum, and their variances (rad/s^2)^2.
+  static constexpr int kSweepRepeats = 8;
+  std::array<int, kPods> sweep_order_{};
+  int sweep_next_{-1};
+  int sweep_pod_{-1};
+  int sweep_left_{0};
+  bool sweep_reading_{false};
+  int sweep_closed_{0};
+  Vec3 sweep_ref_{Vec3::Zero()};
+  Vec3 sweep_closed_sum_{Vec3::Zero()};
+  std::array<double, kThrusters> sweep_ref_excess_{};
+  double sweep_ref_var_{0.0};
+  double sweep_closed_var_{0.0};
+  std::array<double, kThrusters> sweep_ref_force_{};     // delivered mean thrust, reference
+  std::array<double, kThrusters> sweep_closed_force_{};  // ... summed over the closed windows
+  std::array<double, kThrusters> sweep_llr_{};  // each jet's L summed over the sweeps' tests
+  std::array<double, kThrusters> sweep_llr_off_{};  // ... of each jet stuck off
+  // The evaluated window's unexplained acceleration, its gyro variance, each jet's mean excess
+  // thrust (u_max - f over the open time, per second of window, N) and each pod's open fraction.
+  Vec3 eval_accel_{Vec3::Zero()};
+  double eval_accel_var_{0.0};
+  std::array<double, kThrusters> eval_excess_{};
+  std::array<double, kPods> eval_open_{};
+  void end_sweep() {
+    sweep_next_ = -1;
+    sweep_pod_ = -1;
+    sweep_left_ = 0;
+    sweep_reading_ = false;
+  }
+  // (F17) One step of the sweep at a window's decision; true when it confirmed a jet.
+  bool sweep_step();
   FaultDetectorStatus st_{};
   FaultEvents pending_{};
   int identified_confirm_{-1};  // (F14) thruster to confirm stuck on at the next update

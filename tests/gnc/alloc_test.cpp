@@ -8,7 +8,10 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "gnc/fdi/fault_detector.hpp"
 #include "gnc/gnc.hpp"
+#include "gnc/model/mass_properties.hpp"
+#include "gnc/model/rcs.hpp"
 #include "gnc_harness.hpp"
 
 
@@ -248,6 +251,71 @@ TEST(ZeroAllocation, NoHeapWhenATrajectoryIsStagedAndSwitchedAtATickBoundary) {
 // gnc/fdi/README.md (F14), estimation README (I22)-(I23): the identifier's fault torque state,
 // its per-window scoring of the 16 stuck-on columns and the detector's confirmation from it, with
 // channel 1's "+" jet stuck on from the first tick: no heap in any tick.
+// (F17) The pod sweep: the identifier's fault torque off zero and unmatched starts it, each pod
+// closed in turn, the step read and the stuck jet confirmed, all under the counter. A rigid body
+// with the study's inertia and thruster 6 stuck on, a J 10 % off in the model (the bank is blind).
+TEST(ZeroAllocation, NoHeapInAPodSweep) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(0.3, -0.2, 0.1);
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = 1e-7;
+  p.identified_isolation = true;
+  p.identified_sweep = true;
+  FaultDetector d;
+  d.configure(p, rcs, kUmax, kDt);
+  FaultModel m;
+  m.j = j;
+  m.j(0, 0) *= 1.1;
+  m.r = r;
+  m.j_rel_sigma = 0.1;
+  m.r_cov = Mat3::Identity() * 0.01;
+  m.k_sigma = 0.01;
+  d.set_model(m);
+  constexpr int kStuck = 6;
+  Vec3 w(0.01, 0.02, 0.03);
+  std::array<bool, kPods> valves{{true, true, true, true}};
+  long counted = -1;
+  {
+    Armed armed;
+    for (int k = 0; k < 3000; ++k) {
+      if (k > 0 && k % 200 == 0) {
+        StuckOnEvidence e;
+        e.fitted = true;
+        e.chi2_zero = 400.0;
+        e.chi2_jet.fill(50.0);
+        e.chi2_column.fill(400.0);
+        d.identified_evidence(e);
+      }
+      FaultDetectorInput in;
+      in.omega = w;
+      in.omega_valid = true;
+      in.valve_open = valves;
+      d.update(in);
+      for (int q = 0; q < kPods; ++q) valves[static_cast<std::size_t>(q)] = true;
+      if (d.probe_pod() >= 0) valves[static_cast<std::size_t>(d.probe_pod())] = false;
+      if ((d.confirmed_on() >> kStuck) & 1u) valves[static_cast<std::size_t>(kStuck / 4)] = false;
+      // The stuck jet (channel 3's "+": pod 1 axial) while its pod is open; nothing commanded.
+      Vec3 tau = Vec3::Zero();
+      if (valves[static_cast<std::size_t>(kStuck / 4)]) {
+        const int c = kStuck / 2;
+        tau = (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r)
+                  .cross(kUmax * rcs.channel_direction[static_cast<std::size_t>(c)]);
+      }
+      w += kDt * j.inverse() * (tau - w.cross(j * w));
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(d.status().sweeps, 1u);
+  EXPECT_EQ(d.status().sweep_confirmations, 1u);
+  EXPECT_EQ(d.confirmed_on(), 1u << kStuck);
+}
+
 TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {
   GncParams truth = test::small_vehicle_params();
   auto* loop = new test::SmallLoop(truth);
