@@ -13,9 +13,13 @@
 //                 identification with automatic model adoption, fault detection, the L1 allocator
 //   excite=on     with modules=all: the identification excitation too (an option, off in gnc.yaml;
 //                 gnc/estimation/README.md §I.6), with gnc.yaml's settings
+//   stuck=N       thruster N (0-15: channel N/2, + for even N) stuck on at u_max from onset=T s
+//                 (default 1000) until the flight closes its pod's latch valve: the fault detector,
+//                 its isolation test, the valve and the reallocation run on the counted ticks
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -49,6 +53,8 @@ struct Options {
   bool start_hold{false};
   bool all_modules{false};
   bool excite{false};
+  int stuck{-1};                // thruster stuck on (-1: none)
+  std::uint32_t onset_s{1000};  // ... from this simulated time
 };
 
 // Parses "key=value" tokens of the semihosting command line (unknown tokens are ignored).
@@ -76,6 +82,11 @@ Options parse_options() {
     if (const char* v = value_of("start=")) o.start_hold = std::strncmp(v, "hold", 4) == 0;
     if (const char* v = value_of("modules=")) o.all_modules = std::strncmp(v, "all", 3) == 0;
     if (const char* v = value_of("excite=")) o.excite = std::strncmp(v, "on", 2) == 0;
+    if (const char* v = value_of("stuck=")) {
+      const std::uint32_t n = to_u32(v);
+      o.stuck = n < 16U ? static_cast<int>(n) : -1;
+    }
+    if (const char* v = value_of("onset=")) o.onset_s = to_u32(v);
   }
   return o;
 }
@@ -214,7 +225,8 @@ int firmware_main() {
       .str(" B, sizeof(GncParams)=").u32(sizeof(gnc::GncParams))
       .str(" B, dt=").fix(g_params.dt, 2).str(" s, run ").u32(opt.seconds).str(" s")
       .str(opt.all_modules ? ", modules: MEKF + identification + FDI + L1" : ", modules: study")
-      .str(opt.all_modules && opt.excite ? " + excitation" : "");
+      .str(opt.all_modules && opt.excite ? " + excitation" : "")
+      .str(opt.stuck >= 0 ? ", a thruster stuck on" : "");
   line.flush();
 
   const double dt = g_params.dt;
@@ -281,7 +293,19 @@ int firmware_main() {
       if (c > counts_max[m]) counts_max[m] = c;
       if (c > budget_counts) ++over_budget;
     }
-    const gnc::Vec3 torque = b_true * g_out.command.force;
+    gnc::Vec8 applied = g_out.command.force;
+    if (opt.stuck >= 0 && t >= static_cast<double>(opt.onset_s)) {
+      // Thruster `stuck` fires u_max whatever is commanded; its partner still answers the command.
+      const int c = opt.stuck / 2;
+      const double u_max = g_params.rcs.u_max;
+      const double asked = applied(c);
+      applied(c) = (opt.stuck % 2 == 0) ? u_max - std::fmax(-asked, 0.0) : -u_max + std::fmax(asked, 0.0);
+    }
+    for (int c = 0; c < gnc::kChannels; ++c) {  // a closed latch valve: the pod produces nothing
+      const auto pod = static_cast<std::size_t>(g_params.rcs.channel_pod[static_cast<std::size_t>(c)]);
+      if (!g_out.command.valve_open[pod]) applied(c) = 0.0;
+    }
+    const gnc::Vec3 torque = b_true * applied;
     body.step(dt, torque);
     t += dt;
     if (g_gnc.mode() == gnc::Mode::kHold) {

@@ -131,6 +131,22 @@ Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
   return a;
 }
 
+const Mat83& Allocator::pinv_for(std::uint8_t free, const Mat38& b_f, int& rank) const {
+  for (const PinvMemo& m : pinv_memo_) {
+    if (m.valid && m.free == free) {
+      rank = m.rank;
+      return m.pinv;
+    }
+  }
+  PinvMemo& m = pinv_memo_[static_cast<std::size_t>(pinv_memo_next_)];
+  pinv_memo_next_ = (pinv_memo_next_ + 1) % kPinvMemos;
+  m.pinv = pinv_of(b_f, m.rank);
+  m.free = free;
+  m.valid = true;
+  rank = m.rank;
+  return m.pinv;
+}
+
 const char* to_string(AllocatorKind k) {
   switch (k) {
     case AllocatorKind::kPseudoInverse: return "pinv";
@@ -146,6 +162,9 @@ bool Allocator::configure(const Mat38& b_hat, double u_max, AllocatorKind kind) 
   }
   kind_ = kind;
   b_hat_ = b_hat;
+  authority_memo_ = AuthorityMemo{};  // B_hat changed: nothing kept is valid
+  pinv_memo_ = {};
+  pinv_memo_next_ = 0;
   u_max_ = u_max;
   const Mat3 bbt = b_hat * b_hat.transpose();
   // Eq. (53): B' (B B')^-1. The 3x3 inverse is closed-form (fixed size, no solver workspace that
@@ -200,7 +219,17 @@ void Allocator::allocate(const Vec3& u_c, const AllocatorLimits& limits, Vec8& u
     status.shortfall = u_c - status.torque_achieved;
     return;
   }
-  const Authority auth = authority(b_hat_, lo, hi);
+  std::uint16_t pattern = 0;
+  for (int i = 0; i < kChannels; ++i) {
+    if (hi(i) > 0.0) pattern = static_cast<std::uint16_t>(pattern | (1U << (2 * i)));
+    if (lo(i) < 0.0) pattern = static_cast<std::uint16_t>(pattern | (1U << (2 * i + 1)));
+  }
+  if (!authority_memo_.valid || authority_memo_.pattern != pattern) {
+    authority_memo_.value = authority(b_hat_, lo, hi);
+    authority_memo_.pattern = pattern;
+    authority_memo_.valid = true;
+  }
+  const Authority auth = authority_memo_.value;
   status.active_channels = static_cast<std::uint8_t>(auth.active_channels);
   status.rank = static_cast<std::uint8_t>(auth.rank);
   status.reduced_authority = !auth.spans;
@@ -215,10 +244,14 @@ void Allocator::allocate(const Vec3& u_c, const AllocatorLimits& limits, Vec8& u
   int rank = 0;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     Mat38 b_f = Mat38::Zero();
+    std::uint8_t free_bits = 0;
     for (int i = 0; i < kChannels; ++i) {
-      if (free[static_cast<std::size_t>(i)]) b_f.col(i) = b_hat_.col(i);
+      if (free[static_cast<std::size_t>(i)]) {
+        b_f.col(i) = b_hat_.col(i);
+        free_bits = static_cast<std::uint8_t>(free_bits | (1U << i));
+      }
     }
-    u = pinv_of(b_f, rank) * tau;  // Eq. (53) for the free channels
+    u = pinv_for(free_bits, b_f, rank) * tau;  // Eq. (53) for the free channels
     // A channel pushed the way its interval forbids (e.g. the "+" half of a failed thruster) stays
     // at zero; the others take over.
     bool changed = false;

@@ -3,6 +3,7 @@
 // Eq. (54).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 
@@ -55,6 +56,15 @@ struct AllocatorStatus {
   Vec3 shortfall{Vec3::Zero()};        // u_c - torque_achieved
 };
 
+// The authority the limits leave (independent of the torque asked): how many channels are active,
+// the rank of their columns, and whether the cone of their one-way thrust torques spans R^3.
+struct Authority {
+  int active_channels{0};
+  int rank{0};
+  bool spans{false};  // every torque direction can be produced (full authority, in direction)
+};
+Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi);
+
 class Allocator {
  public:
   // Precomputes B_hat' (B_hat B_hat')^-1. Returns false if B_hat B_hat' is singular (rank < 3) or
@@ -83,19 +93,32 @@ class Allocator {
   double u_max_{0.0};
   AllocatorKind kind_{AllocatorKind::kPseudoInverse};
   L1Allocation l1_{};
+  // Under limits, the authority and the re-derived Eq. (53) depend only on B_hat (fixed between
+  // configure() calls) and on which channels may push which way, so they are kept for the last
+  // patterns seen instead of being recomputed every tick (the Cortex-M7 tick budget: an eigen-
+  // decomposition and the cone test per tick while a pod is isolated). Like the L1 warm-start
+  // hint, a cache: results are bit-identical with or without it.
+  struct AuthorityMemo {
+    bool valid{false};
+    std::uint16_t pattern{0};  // bit 2i: channel i may push +, bit 2i+1: may push -
+    Authority value{};
+  };
+  static constexpr int kPinvMemos = 4;
+  struct PinvMemo {
+    bool valid{false};
+    std::uint8_t free{0};  // bit i: channel i free
+    int rank{0};
+    Mat83 pinv{Mat83::Zero()};
+  };
+  mutable AuthorityMemo authority_memo_{};
+  mutable std::array<PinvMemo, kPinvMemos> pinv_memo_{};
+  mutable int pinv_memo_next_{0};
+  const Mat83& pinv_for(std::uint8_t free, const Mat38& b_f, int& rank) const;
 };
 
 // Reciprocal condition number of B B' (0 when rank-deficient); used by parameter validation.
 double torque_matrix_rcond(const Mat38& b);
 
-// The authority the limits leave (independent of the torque asked): how many channels are active,
-// the rank of their columns, and whether the cone of their one-way thrust torques spans R^3.
-struct Authority {
-  int active_channels{0};
-  int rank{0};
-  bool spans{false};  // every torque direction can be produced (full authority, in direction)
-};
-Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi);
 
 // Eq. (54): fuel mass flow, kg/s, for channel forces u.
 inline double fuel_rate(const Vec8& u, double isp_s, double g0) {
