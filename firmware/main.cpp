@@ -245,6 +245,7 @@ int firmware_main() {
   std::uint32_t counts_max[gnc::kModeCount] = {};
   std::uint32_t counted[gnc::kModeCount] = {};
   TickNote worst[kWorst] = {};
+  double confirmed_at_s = -1.0;  // stuck=N: when the flight confirmed that thruster stuck on
   std::uint32_t over_budget = 0;
   // The 20000-instruction budget in counts (instructions per count from the calibration loop).
   const std::uint32_t budget_counts =
@@ -306,6 +307,10 @@ int firmware_main() {
       if (!g_out.command.valve_open[pod]) applied(c) = 0.0;
     }
     const gnc::Vec3 torque = b_true * applied;
+    if (opt.stuck >= 0 && confirmed_at_s < 0.0 &&
+        ((g_gnc.fault_detector().confirmed_on() >> opt.stuck) & 1U) != 0) {
+      confirmed_at_s = t;
+    }
     body.step(dt, torque);
     t += dt;
     if (g_gnc.mode() == gnc::Mode::kHold) {
@@ -374,5 +379,18 @@ int firmware_main() {
       .str(monotone ? "yes" : "no").str(", hold reached=").str(reached_hold ? "yes" : "no")
       .str(ok ? "  PASS" : "  FAIL");
   line.flush();
+  if (opt.stuck >= 0) {  // what the fault detector made of the injected fault (reported only)
+    const gnc::FaultDetectorStatus& st = g_gnc.fault_detector().status();
+    line.str("fault: thruster ").u32(static_cast<std::uint32_t>(opt.stuck)).str(" stuck on at ")
+        .u32(opt.onset_s).str(" s: ");
+    if (confirmed_at_s >= 0.0) {
+      line.str("confirmed at ").fix(confirmed_at_s, 1).str(" s");
+    } else {
+      line.str("NOT confirmed");
+    }
+    line.str(", isolation tests ").u32(st.probes).str(", confirmed on/off masks ")
+        .u32(st.confirmed_on).str("/").u32(st.confirmed_off);
+    line.flush();
+  }
   return ok ? 0 : 1;
 }

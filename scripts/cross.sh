@@ -115,7 +115,7 @@ if [[ -z "$only" || "$only" == "baremetal" ]]; then
     timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
         -icount shift=0 \
         -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=3000,arg=goal=despin,arg=modules=all,arg=stuck=5,arg=onset=2000 \
-        -kernel "$elf" | grep -E 'DETUMBLE:|HOLD:|over the|^  [0-9]' || true
+        -kernel "$elf" | grep -E 'DETUMBLE:|HOLD:|over the|^  [0-9]|^fault:' || true
     stage "bare metal: instructions per Gnc::step (qemu-system-arm -singlestep -d exec)"
     trace=$(mktemp)
     for modules in study all; do
