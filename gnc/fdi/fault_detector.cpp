@@ -729,20 +729,9 @@ bool FaultDetector::sweep_step() {
       // Every pod tested once: the pod of the leading sum is tested again while that sum is
       // ahead of every other jet's by margin_llr (its step seen, the jet not yet decided), at
       // most kSweepRepeats times; otherwise the sweep ends.
-      int lead = -1;
-      double l1 = -1e300;
-      double l2 = -1e300;
-      for (int i = 0; i < kThrusters; ++i) {
-        if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
-        const double l = sweep_llr_[static_cast<std::size_t>(i)];
-        if (l > l1) {
-          l2 = l1;
-          l1 = l;
-          lead = i;
-        } else if (l > l2) {
-          l2 = l;
-        }
-      }
+      const SweepLeader leader = sweep_leader();
+      const int lead = leader.jet;
+      const double l1 = leader.first;
       const bool pod_ahead = lead >= 0 && l1 > 0.0 && sweep_next_ < kPods + kSweepRepeats &&
                              [&] {
                                // ahead of every jet of the other pods by margin_llr
@@ -884,20 +873,10 @@ bool FaultDetector::sweep_step() {
     }
   }
   // The sweeps' sums (every test of every pod adds its jets' L): the leader over all sixteen.
-  int best = -1;
-  double best_l = -1e300;
-  double second = -1e300;
-  for (int i = 0; i < kThrusters; ++i) {
-    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
-    const double l = sweep_llr_[static_cast<std::size_t>(i)];
-    if (l > best_l) {
-      second = best_l;
-      best_l = l;
-      best = i;
-    } else if (l > second) {
-      second = l;
-    }
-  }
+  const SweepLeader leader = sweep_leader();
+  const int best = leader.jet;
+  const double best_l = leader.first;
+  const double second = leader.second;
   if (best < 0 || best != best_fit_jet || best_l <= p_.confirm_llr ||
       fit_of_best >= p_.identified_match_chi2 || best_l - second <= p_.margin_llr ||
       best_l - off_best <= p_.margin_llr) {
@@ -910,6 +889,23 @@ bool FaultDetector::sweep_step() {
   pending_.thruster = best;
   pending_.kind = FaultKind::kStuckOn;
   return true;
+}
+
+FaultDetector::SweepLeader FaultDetector::sweep_leader() const {
+  // (F17) The leading and second sums over the jets not yet latched.
+  SweepLeader r;
+  for (int i = 0; i < kThrusters; ++i) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    const double l = sweep_llr_[static_cast<std::size_t>(i)];
+    if (l > r.first) {
+      r.second = r.first;
+      r.first = l;
+      r.jet = i;
+    } else if (l > r.second) {
+      r.second = l;
+    }
+  }
+  return r;
 }
 
 int FaultDetector::probe_verdict() const {

@@ -343,6 +343,12 @@ class FaultDetector {
   }
   // (F17) One step of the sweep at a window's decision; true when it confirmed a jet.
   bool sweep_step();
+  struct SweepLeader {
+    int jet{-1};  // -1: every jet latched
+    double first{-1e300};
+    double second{-1e300};
+  };
+  SweepLeader sweep_leader() const;
   FaultDetectorStatus st_{};
   FaultEvents pending_{};
   int identified_confirm_{-1};  // (F14) thruster to confirm stuck on at the next update

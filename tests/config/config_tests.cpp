@@ -1,9 +1,12 @@
 // Configuration files: the shipped ones load into the SPEC's values; each class of bad file gives a
 // ConfigError naming the file, the key and the reason.
+#include <stdlib.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include <Eigen/Eigenvalues>
@@ -32,10 +35,11 @@ std::string read(const std::string& path) {
 class TempFile {
  public:
   TempFile(const std::string& name, const std::string& text) {
-    dir_ = fs::temp_directory_path() /
-           ("rocksteady_config_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + std::to_string(counter_++));
-    fs::create_directories(dir_);
+    // mkdtemp: unique across the test processes ctest runs in parallel (a name from the gtest
+    // seed, which follows the clock, collided when two started in the same millisecond).
+    std::string tmpl = (fs::temp_directory_path() / "rocksteady_config_XXXXXX").string();
+    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("mkdtemp failed: " + tmpl);
+    dir_ = tmpl;
     path_ = (dir_ / name).string();
     std::ofstream(path_) << text;
   }
@@ -43,7 +47,6 @@ class TempFile {
   const std::string& path() const { return path_; }
 
  private:
-  static inline int counter_ = 0;
   fs::path dir_;
   std::string path_;
 };
