@@ -15,7 +15,8 @@
 //                 gnc/estimation/README.md §I.6), with gnc.yaml's settings
 //   stuck=N       thruster N (0-15: channel N/2, + for even N) stuck on at u_max from onset=T s
 //                 (default 1000) until the flight closes its pod's latch valve: the fault detector,
-//                 its isolation test, the valve and the reallocation run on the counted ticks
+//                 its isolation test, the valve and the reallocation run on the counted ticks;
+//                 success then also needs that thruster, and only it, confirmed stuck on
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -373,14 +374,19 @@ int firmware_main() {
   // went SAFE, and (goal=hold) DETUMBLE handed over to HOLD. With start=hold: HOLD on every tick.
   const bool fell = w_end < 0.5 * w0;
   const bool safe = g_gnc.mode() == gnc::Mode::kSafe;
-  const bool ok = opt.start_hold ? always_hold
-                                 : monotone && fell && !safe && (!opt.require_hold || reached_hold);
+  // With stuck=N: the flight also confirmed that thruster stuck on, and nothing else.
+  const gnc::FaultDetectorStatus& fdi = g_gnc.fault_detector().status();
+  const bool isolated = opt.stuck < 0 || (confirmed_at_s >= 0.0 && fdi.confirmed_off == 0 &&
+                                          fdi.confirmed_on == (1U << opt.stuck));
+  const bool ok = isolated && (opt.start_hold ? always_hold
+                                              : monotone && fell && !safe &&
+                                                    (!opt.require_hold || reached_hold));
   line.str("result: |w| ").sci(w0, 4).str(" -> ").sci(w_end, 4).str(" rad/s, monotone=")
       .str(monotone ? "yes" : "no").str(", hold reached=").str(reached_hold ? "yes" : "no")
       .str(ok ? "  PASS" : "  FAIL");
   line.flush();
-  if (opt.stuck >= 0) {  // what the fault detector made of the injected fault (reported only)
-    const gnc::FaultDetectorStatus& st = g_gnc.fault_detector().status();
+  if (opt.stuck >= 0) {  // what the fault detector made of the injected fault
+    const gnc::FaultDetectorStatus& st = fdi;
     line.str("fault: thruster ").u32(static_cast<std::uint32_t>(opt.stuck)).str(" stuck on at ")
         .u32(opt.onset_s).str(" s: ");
     if (confirmed_at_s >= 0.0) {

@@ -107,6 +107,20 @@ if [[ -z "$only" || "$only" == "baremetal" ]]; then
     echo "cross: FAIL: the firmware image (modules=all) exited with $rc" >&2
     exit 1
   fi
+  # A thruster stuck on in HOLD, every module on: the flight must confirm it (and only it) and
+  # keep HOLD; the image's exit code says so.
+  stage "bare metal: every module on, HOLD, thruster 5 stuck on at 1000 s"
+  out=$(mktemp)
+  timeout 300 qemu-system-arm -machine mps2-an500 -nographic -monitor none -serial none \
+      -icount shift=0 \
+      -semihosting-config enable=on,target=native,arg=rocksteady_fw,arg=seconds=1200,arg=start=hold,arg=modules=all,arg=stuck=5,arg=onset=1000 \
+      -kernel "$elf" >"$out" || rc=$?
+  grep -E 'HOLD:|over the|^  [0-9]|^fault:|^result:' "$out" || true
+  rm -f "$out"
+  if ((rc != 0)); then
+    echo "cross: FAIL: the firmware image (HOLD, a thruster stuck on) exited with $rc" >&2
+    exit 1
+  fi
   if ((bench)); then
     # The budget while the fault detector works: thruster 5 stuck on at 2000 s (isolated about 2 s
     # later: isolation test, valve, reallocation on three pods). The image's own SysTick counts

@@ -681,7 +681,13 @@ void FaultDetector::decide() {
     // from the reopened windows, one more each test.
     pod = pod_b;
   }
-  if (pod < 0 || p_.probe_windows == 0 || probe_left_ > 0 || probe_ended || sweeping()) return;
+  // No test starts while the last one's verdict waits for its window flown mostly with the valve
+  // open: with short windows (5 ticks) the first window after the reopening was flown mostly
+  // closed, a new test started on it, and the verdict was never read (200 tests in 400 s, HOLD).
+  if (pod < 0 || p_.probe_windows == 0 || probe_left_ > 0 || probe_ended || verdict_pending_ ||
+      sweeping()) {
+    return;
+  }
   ++ambiguous_windows_;
   if (probe_left_ == 0 && ambiguous_windows_ >= p_.probe_after_windows) {
     st_.probe_pod = pod;
