@@ -302,15 +302,105 @@ void Identifier::reinflate_thruster(int i) {
 }
 
 void Identifier::reinflate_all() {
-  reinflate_inertia();
-  reinflate_offset();
-  for (int i = 0; i < kThrusters; ++i) reinflate_thruster(i);
-  // (I22) d too, unless it was settled at zero (I24): a fault the detector isolated while d was
-  // out of the state was never in d, and is gone with its valve.
+  // The same covariance as reinflate_inertia, reinflate_offset, reinflate_thruster(0..15) and
+  // (unless d was settled at zero, I24) reinflate_fault_torque in turn, bit for bit, on one tick
+  // of the Cortex-M7 budget. Those finish every pending block of rows first (the joint step's
+  // covariance rows, the anchor's, the settling's: up to 40 k instructions when a confirmation
+  // lands while a step is under way), and then clear every row but the rate bias b's (and d's
+  // when settled). Each of those row updates reads only its own row and the step's factors, so
+  // only the kept rows are computed here; the others are about to be the prior.
   const bool d_live = !d_held_zero_;
-  if (d_live) reinflate_fault_torque();
-  counters_.reinflations -= (d_live ? 3 : 2) + kThrusters;
+  std::array<bool, kIdParams> kept{};
+  for (int a = 0; a < 3; ++a) {
+    kept[static_cast<std::size_t>(kIdB + a)] = true;
+    kept[static_cast<std::size_t>(kIdD + a)] = !d_live;
+  }
+  finish_kept_rows(kept);
+  joint_.pending = false;  // a gain from the old covariance is dropped
+  joint_.started = false;
+  const Mat3 p_bb = p_all_.block<3, 3>(kIdB, kIdB);
+  const Mat3 p_bd = p_all_.block<3, 3>(kIdB, kIdD);
+  const Mat3 p_dd = p_all_.block<3, 3>(kIdD, kIdD);
+  p_all_.setZero();
+  const double vj = c_.j_prior_sigma * c_.j_prior_sigma;
+  const double vr = c_.r_prior_sigma * c_.r_prior_sigma;
+  const double vk = c_.k_prior_sigma * c_.k_prior_sigma;
+  for (int i = 0; i < 6; ++i) p_all_(i, i) = vj;
+  for (int i = 0; i < 3; ++i) p_all_(kIdR + i, kIdR + i) = vr;
+  for (int i = 0; i < kThrusters; ++i) p_all_(kIdK + i, kIdK + i) = vk;
+  p_all_.block<3, 3>(kIdB, kIdB) = p_bb;
+  if (d_live) {
+    // (I22) d too: a fault the detector isolated changes the constant torque; its estimate is
+    // kept as the starting point. A d settled at zero was never in the fault and stays out.
+    const double vd = c_.fault_torque_sigma * c_.fault_torque_sigma;
+    for (int i = 0; i < 3; ++i) p_all_(kIdD + i, kIdD + i) = vd;
+    d_held_zero_ = false;
+    settle_streak_ = 0;
+  } else {
+    p_all_.block<3, 3>(kIdB, kIdD) = p_bd;
+    p_all_.block<3, 3>(kIdD, kIdB) = p_bd.transpose();
+    p_all_.block<3, 3>(kIdD, kIdD) = p_dd;
+  }
+  p_j_ = vj * Mat6::Identity();
+  p_r_ = vr * Mat3::Identity();
+  p_k_ = vk * Mat16::Identity();
+  reference_.fill(false);  // no thruster defines the thrust scale any more
   ++counters_.reinflations;
+}
+
+void Identifier::finish_kept_rows(const std::array<bool, kIdParams>& kept) {
+  // What joint_finish_covariance, finish_anchor and finish_settle would leave in the kept rows
+  // and columns (the others are not computed and hold stale values).
+  if (joint_.rows_pending) {
+    joint_.rows_pending = false;
+    for (int i = joint_.cov_rows; i < kIdParams; ++i) {
+      if (kept[static_cast<std::size_t>(i)]) joint_covariance_rows(i, 1);
+    }
+    joint_.cov_rows = kIdParams;
+    for (int i = joint_.sym_rows; i < kIdParams; ++i) {
+      if (kept[static_cast<std::size_t>(i)]) symmetrise_rows(i, 1);
+    }
+    joint_.sym_rows = kIdParams;
+    // The cap of joint_finish_covariance, on the kept rows (scaling another row's column only
+    // changes entries that are about to be cleared).
+    for (int i = 0; i < kIdParams; ++i) {
+      if (!kept[static_cast<std::size_t>(i)]) continue;
+      const double cap = i < kIdD ? c_.gyro_bias_sigma * c_.gyro_bias_sigma
+                                  : c_.fault_torque_sigma * c_.fault_torque_sigma;
+      if (p_all_(i, i) > cap) {
+        const double f = std::sqrt(cap / p_all_(i, i));
+        p_all_.row(i) *= f;
+        p_all_.col(i) *= f;
+      }
+    }
+  }
+  if (anchor_.pending) {
+    anchor_.pending = false;
+    for (int i = anchor_.rows; i < kIdParams; ++i) {
+      if (!kept[static_cast<std::size_t>(i)]) continue;
+      for (int j = 0; j < kIdParams; ++j) {
+        const int lo = i < j ? i : j;
+        const int hi = i < j ? j : i;
+        p_all_(i, j) -= anchor_.g(lo) * anchor_.pc(hi);
+      }
+    }
+    anchor_.rows = kIdParams;
+  }
+  if (settle_.pending) {
+    settle_.pending = false;
+    for (int i = settle_.rows; i < kIdParams; ++i) {
+      if (!kept[static_cast<std::size_t>(i)]) continue;
+      for (int j = 0; j < kIdParams; ++j) {
+        const int lo = i < j ? i : j;
+        const int hi = i < j ? j : i;
+        p_all_(i, j) -= settle_.g.row(lo).dot(settle_.pd.row(hi));
+      }
+    }
+    settle_.rows = kIdParams;
+    p_all_.middleRows<3>(kIdD).setZero();
+    p_all_.middleCols<3>(kIdD).setZero();
+    p_b_ = p_all_.block<3, 3>(kIdB, kIdB);  // sync_blocks (the other blocks are re-inflated)
+  }
 }
 
 void Identifier::reinflate_fault_torque() {

@@ -265,7 +265,12 @@ class Identifier {
   const Mat3& offset_covariance() const { return p_r_; }
   const Mat16& strength_covariance() const { return p_k_; }
   const Mat3& bias_covariance() const { return p_b_; }
+  // kJoint: the whole covariance of [a; r; k; b; d] as it stands (rows of a step may be pending).
+  const MatId& joint_covariance() const { return p_all_; }
   const IdentifierFaultTorque& fault_torque() const { return ft_; }
+  // (I24) d is held at zero now (from the tick the settling starts; fault_torque().held_zero
+  // follows at the next score).
+  bool fault_torque_held_zero() const { return d_held_zero_; }
 
  private:
   // The data of one window, latched at its end.
@@ -334,6 +339,9 @@ class Identifier {
   void anchor_scale();             // (I15) the state, and the covariance's rank-one term
   bool anchor_rows();              // ... a block of rows of the covariance (true when done)
   void finish_anchor();            // ... every remaining row
+  // reinflate_all: every pending block of rows (joint step, anchor, settling) on the kept rows
+  // only.
+  void finish_kept_rows(const std::array<bool, kIdParams>& kept);
   void update_inertia();
   void update_offset();
   void update_strengths();

@@ -533,6 +533,85 @@ TEST(Identifier, AHealthyFaultTorqueIsSettledAtZeroAndGivesItsInformationBack) {
   EXPECT_LT(with.r_err, 3.0 * with.r_sigma + without.r_err);
 }
 
+// reinflate_all computes only the rows it keeps of the step under way (the rate bias b's, and
+// d's when settled at zero, I24): the Cortex-M7 tick of a confirmed fault. It must leave exactly
+// what re-inflating the groups one by one leaves (each of which finishes every pending row block
+// first): checked on every tick of a flight that goes through joint steps, anchors and the
+// settling of d, with d live and with d settled.
+TEST(Identifier, ReinflatingEverythingAtOnceEqualsGroupByGroupOnEveryTickOfAStep) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  s.disturbance_sigma = 1.0 / std::sqrt(3.0);
+  s.gyro_sigma = std::sqrt(1e-12 / kDt);
+  IdentifierConfig c = config_with_priors(s.j, s.r + Vec3(0.3, -0.2, 0.2));
+  c.gyro_sigma = s.gyro_sigma;
+  c.k_prior_sigma = 0.01;
+  c.second_order_noise = true;
+  c.gate_chi2 = 16.27;
+  c.fault_torque_sigma = 3000.0;
+  c.gyro_bias_sigma = 1e-5;
+  c.gyro_bias_estimated = true;  // b in the state: the joint step updates its rows too
+  Identifier id;
+  id.configure(c);
+  TruthRun truth(s);
+  RandomFiring fire(5);
+  int compared = 0, with_d_settled = 0, differing = 0;
+  int tick = 0;
+  truth.run(static_cast<int>(1500.0 / kDt), fire,
+            [&](double, const test::V3& w, const test::V8& f) {
+              id.update(id_input(w, f));
+              ++tick;
+              if (tick % 3 != 0) return;  // every third tick: every row-block phase is hit
+              Identifier at_once = id;
+              Identifier by_group = id;
+              const bool settled = id.fault_torque_held_zero();
+              at_once.reinflate_all();
+              by_group.reinflate_inertia();
+              by_group.reinflate_offset();
+              for (int i = 0; i < kThrusters; ++i) by_group.reinflate_thruster(i);
+              if (!settled) by_group.reinflate_fault_torque();
+              ++compared;
+              with_d_settled += settled ? 1 : 0;
+              const bool same =
+                  (at_once.joint_covariance().array() == by_group.joint_covariance().array())
+                      .all() &&
+                  (at_once.inertia_covariance().array() ==
+                   by_group.inertia_covariance().array()).all() &&
+                  (at_once.offset_covariance().array() == by_group.offset_covariance().array())
+                      .all() &&
+                  (at_once.strength_covariance().array() ==
+                   by_group.strength_covariance().array()).all() &&
+                  (at_once.bias_covariance().array() == by_group.bias_covariance().array())
+                      .all() &&
+                  at_once.fault_torque_held_zero() == by_group.fault_torque_held_zero();
+              if (!same && differing++ == 0) {
+                const MatId diff = at_once.joint_covariance() - by_group.joint_covariance();
+                Eigen::Index row = 0, col = 0;
+                const double largest = diff.cwiseAbs().maxCoeff(&row, &col);
+                ADD_FAILURE() << "first difference at tick " << tick << (settled ? " (d settled)" : "")
+                              << ": " << largest << " at (" << row << ", " << col << ")";
+              }
+              // And both fly on identically (the pending phase, the dropped gain).
+              if (tick % 999 == 0) {
+                for (int k = 0; k < 400; ++k) {
+                  const test::V3 wk = w + 1e-6 * k * test::V3(1.0, -0.5, 0.25);
+                  at_once.update(id_input(wk, f));
+                  by_group.update(id_input(wk, f));
+                }
+                EXPECT_TRUE((at_once.joint_covariance().array() ==
+                             by_group.joint_covariance().array()).all())
+                    << "tick " << tick;
+                EXPECT_TRUE((at_once.estimate().j.array() == by_group.estimate().j.array()).all())
+                    << "tick " << tick;
+              }
+            });
+  EXPECT_EQ(differing, 0) << "of " << compared << " ticks";
+  EXPECT_GT(with_d_settled, 100) << "the flight must settle d to test both branches";
+  EXPECT_LT(with_d_settled, compared - 100);
+  EXPECT_EQ(id.counters().fault_torque_settles, 1U);
+}
+
 TEST(Identifier, AConsideredRateBiasTakesTheGivenSigmaAfterTheStep) {
   TruthSetup s;
   s.j = study_j();
