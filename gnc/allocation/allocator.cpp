@@ -131,12 +131,17 @@ Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
   return a;
 }
 
-const Mat83& Allocator::pinv_for(std::uint8_t free, const Mat38& b_f, int& rank) const {
+const Mat83& Allocator::pinv_for(std::uint8_t free, int& rank) const {
   for (const PinvMemo& m : pinv_memo_) {
     if (m.valid && m.free == free) {
       rank = m.rank;
       return m.pinv;
     }
+  }
+  // Not kept: B_hat with the columns of the channels that are not free zeroed.
+  Mat38 b_f = Mat38::Zero();
+  for (int i = 0; i < kChannels; ++i) {
+    if ((free >> i) & 1U) b_f.col(i) = b_hat_.col(i);
   }
   PinvMemo& m = pinv_memo_[static_cast<std::size_t>(pinv_memo_next_)];
   pinv_memo_next_ = (pinv_memo_next_ + 1) % kPinvMemos;
@@ -243,15 +248,13 @@ void Allocator::allocate(const Vec3& u_c, const AllocatorLimits& limits, Vec8& u
   const double sign_tol = kSignTol * u_max_;
   int rank = 0;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
-    Mat38 b_f = Mat38::Zero();
     std::uint8_t free_bits = 0;
     for (int i = 0; i < kChannels; ++i) {
       if (free[static_cast<std::size_t>(i)]) {
-        b_f.col(i) = b_hat_.col(i);
         free_bits = static_cast<std::uint8_t>(free_bits | (1U << i));
       }
     }
-    u = pinv_for(free_bits, b_f, rank) * tau;  // Eq. (53) for the free channels
+    u = pinv_for(free_bits, rank) * tau;  // Eq. (53) for the free channels
     // A channel pushed the way its interval forbids (e.g. the "+" half of a failed thruster) stays
     // at zero; the others take over.
     bool changed = false;

@@ -113,7 +113,8 @@ class Allocator {
   mutable AuthorityMemo authority_memo_{};
   mutable std::array<PinvMemo, kPinvMemos> pinv_memo_{};
   mutable int pinv_memo_next_{0};
-  const Mat83& pinv_for(std::uint8_t free, const Mat38& b_f, int& rank) const;
+  // Eq. (53) for the channels whose bit is set in `free` (the others' columns zeroed), kept.
+  const Mat83& pinv_for(std::uint8_t free, int& rank) const;
 };
 
 // Reciprocal condition number of B B' (0 when rank-deficient); used by parameter validation.

@@ -303,12 +303,12 @@ void Identifier::reinflate_thruster(int i) {
 
 void Identifier::reinflate_all() {
   // The same covariance as reinflate_inertia, reinflate_offset, reinflate_thruster(0..15) and
-  // (unless d was settled at zero, I24) reinflate_fault_torque in turn, bit for bit, on one tick
-  // of the Cortex-M7 budget. Those finish every pending block of rows first (the joint step's
-  // covariance rows, the anchor's, the settling's: up to 40 k instructions when a confirmation
-  // lands while a step is under way), and then clear every row but the rate bias b's (and d's
-  // when settled). Each of those row updates reads only its own row and the step's factors, so
-  // only the kept rows are computed here; the others are about to be the prior.
+  // (unless d was settled at zero, I24) reinflate_fault_torque in turn (to rounding), on one
+  // tick of the Cortex-M7 budget. Those finish every pending block of rows first (the joint
+  // step's covariance rows, the anchor's, the settling's: up to 40 k instructions when a
+  // confirmation lands while a step is under way), and then clear every row but the rate bias
+  // b's (and d's when settled). Each entry's update reads only that entry and the step's
+  // factors, so only the kept block is computed here; the rest is about to be the prior.
   const bool d_live = !d_held_zero_;
   std::array<bool, kIdParams> kept{};
   for (int a = 0; a < 3; ++a) {
@@ -349,36 +349,65 @@ void Identifier::reinflate_all() {
 }
 
 void Identifier::finish_kept_rows(const std::array<bool, kIdParams>& kept) {
-  // What joint_finish_covariance, finish_anchor and finish_settle would leave in the kept rows
-  // and columns (the others are not computed and hold stale values).
+  // What joint_finish_covariance, finish_anchor and finish_settle would leave in the block of the
+  // kept rows and columns; every other entry is about to be cleared and is not computed. Each
+  // update of entry (i, j) reads only entry (i, j) and the step's factors.
+  std::array<int, kIdParams> idx{};
+  int n = 0;
+  for (int i = 0; i < kIdParams; ++i) {
+    if (kept[static_cast<std::size_t>(i)]) idx[static_cast<std::size_t>(n++)] = i;
+  }
   if (joint_.rows_pending) {
     joint_.rows_pending = false;
-    for (int i = joint_.cov_rows; i < kIdParams; ++i) {
-      if (kept[static_cast<std::size_t>(i)]) joint_covariance_rows(i, 1);
+    // joint_covariance_rows, entry by entry (equal to its row form up to rounding).
+    const VecId& d = joint_.d;
+    const bool full_form = !exc_.offset || !c_.gyro_bias_estimated;
+    for (int a = 0; a < n; ++a) {
+      const int i = idx[static_cast<std::size_t>(a)];
+      if (i < joint_.cov_rows) continue;  // this row is done
+      const Vec3 ks = joint_.k.row(i) * joint_.s;
+      for (int b = 0; b < n; ++b) {
+        const int j = idx[static_cast<std::size_t>(b)];
+        double v = d(i) * (p_all_(i, j) * d(j));
+        v -= joint_.k.row(i).dot(joint_.p_ht.row(j));
+        if (full_form) {
+          v -= joint_.p_ht.row(i).dot(joint_.k.row(j));
+          v += ks.dot(joint_.k.row(j).transpose());
+        }
+        p_all_(i, j) = v;
+      }
     }
     joint_.cov_rows = kIdParams;
-    for (int i = joint_.sym_rows; i < kIdParams; ++i) {
-      if (kept[static_cast<std::size_t>(i)]) symmetrise_rows(i, 1);
+    for (int a = 0; a < n; ++a) {  // symmetrise_rows on the kept pairs
+      const int i = idx[static_cast<std::size_t>(a)];
+      if (i < joint_.sym_rows) continue;
+      for (int b = a + 1; b < n; ++b) {
+        const int j = idx[static_cast<std::size_t>(b)];
+        const double v = 0.5 * (p_all_(i, j) + p_all_(j, i));
+        p_all_(i, j) = v;
+        p_all_(j, i) = v;
+      }
     }
     joint_.sym_rows = kIdParams;
-    // The cap of joint_finish_covariance, on the kept rows (scaling another row's column only
-    // changes entries that are about to be cleared).
-    for (int i = 0; i < kIdParams; ++i) {
-      if (!kept[static_cast<std::size_t>(i)]) continue;
+    // The cap of joint_finish_covariance, on the kept block, in the same order.
+    for (int a = 0; a < n; ++a) {
+      const int i = idx[static_cast<std::size_t>(a)];
       const double cap = i < kIdD ? c_.gyro_bias_sigma * c_.gyro_bias_sigma
                                   : c_.fault_torque_sigma * c_.fault_torque_sigma;
       if (p_all_(i, i) > cap) {
         const double f = std::sqrt(cap / p_all_(i, i));
-        p_all_.row(i) *= f;
-        p_all_.col(i) *= f;
+        for (int b = 0; b < n; ++b) p_all_(i, idx[static_cast<std::size_t>(b)]) *= f;
+        for (int b = 0; b < n; ++b) p_all_(idx[static_cast<std::size_t>(b)], i) *= f;
       }
     }
   }
   if (anchor_.pending) {
     anchor_.pending = false;
-    for (int i = anchor_.rows; i < kIdParams; ++i) {
-      if (!kept[static_cast<std::size_t>(i)]) continue;
-      for (int j = 0; j < kIdParams; ++j) {
+    for (int a = 0; a < n; ++a) {
+      const int i = idx[static_cast<std::size_t>(a)];
+      if (i < anchor_.rows) continue;
+      for (int b = 0; b < n; ++b) {
+        const int j = idx[static_cast<std::size_t>(b)];
         const int lo = i < j ? i : j;
         const int hi = i < j ? j : i;
         p_all_(i, j) -= anchor_.g(lo) * anchor_.pc(hi);
@@ -388,9 +417,11 @@ void Identifier::finish_kept_rows(const std::array<bool, kIdParams>& kept) {
   }
   if (settle_.pending) {
     settle_.pending = false;
-    for (int i = settle_.rows; i < kIdParams; ++i) {
-      if (!kept[static_cast<std::size_t>(i)]) continue;
-      for (int j = 0; j < kIdParams; ++j) {
+    for (int a = 0; a < n; ++a) {
+      const int i = idx[static_cast<std::size_t>(a)];
+      if (i < settle_.rows) continue;
+      for (int b = 0; b < n; ++b) {
+        const int j = idx[static_cast<std::size_t>(b)];
         const int lo = i < j ? i : j;
         const int hi = i < j ? j : i;
         p_all_(i, j) -= settle_.g.row(lo).dot(settle_.pd.row(hi));

@@ -443,6 +443,16 @@ void FaultDetector::evaluate_step() {
       break;
     case 3:
       evaluate_cross(w);
+      // (F10) A leader past the confirmation level is checked against every alternative (F8)
+      // in the decision; the first half of that scan is done here (the Cortex-M7 tick budget:
+      // 6 k instructions for the 31 alternatives on one tick). Nothing it reads changes before
+      // the decision: a model that arrives is held, and a declaration cancels the evaluation.
+      block_scan_ = BlockingScan{};
+      if (st_.best >= 0 && st_.best_llr > p_.confirm_llr &&
+          st_.best_llr - st_.runner_up_llr > p_.margin_llr) {
+        block_scan_.h = st_.best;
+        blocking_scan(st_.best, 0, kHypotheses / 2, block_scan_);
+      }
       eval_phase_ = 4;
       break;
     default:
@@ -650,7 +660,15 @@ void FaultDetector::decide() {
     return;
   }
   // (F6) clearly ahead of the runner-up, and (F8) of every alternative beyond the model's error.
-  int blocking = best_s - second > p_.margin_llr ? blocking_alternative(best) : runner_up;
+  int blocking = runner_up;
+  if (best_s - second > p_.margin_llr) {
+    if (block_scan_.h == best) {  // the second half of the scan begun in step 3
+      blocking_scan(best, kHypotheses / 2, kHypotheses, block_scan_);
+      blocking = block_scan_.worst;
+    } else {
+      blocking = blocking_alternative(best);
+    }
+  }
   if (blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
   if (blocking < 0) {
     const int thruster = best % kThrusters;
@@ -990,7 +1008,7 @@ int FaultDetector::partial_loss_alternative(int h) const {
   return -1;
 }
 
-int FaultDetector::blocking_alternative(int h) const {
+void FaultDetector::blocking_scan(int h, int g_begin, int g_end, BlockingScan& scan) const {
   // (F8) Under h, the model's error d of h's signature b_i (constant over the episode) gives the
   // pairwise LLR Lambda_h - Lambda_g the bias V . d with V = b_h A_h - b_g C_hg. Its variance,
   // from the identifier's: strength (d = b dk / k), centre of mass (d = J^-1 k dr x e_i) and
@@ -1001,9 +1019,7 @@ int FaultDetector::blocking_alternative(int h) const {
   const double kk = m_.k(static_cast<int>(ih));
   const double rel_k = kk != 0.0 ? m_.k_sigma / std::fabs(kk) : 0.0;
   const double dj = m_.j_rel_sigma * m_.j.norm() * bh.norm();
-  int worst = -1;
-  double worst_lead = 0.0;
-  for (int g = 0; g < kHypotheses; ++g) {
+  for (int g = g_begin; g < g_end; ++g) {
     if (g == h) continue;
     const auto kg = static_cast<std::size_t>(g);
     const int tg = g % kThrusters;
@@ -1017,12 +1033,17 @@ int FaultDetector::blocking_alternative(int h) const {
     const double vj = dj * w.norm();
     const double sd = std::sqrt(vk * vk + wxe.dot(m_.r_cov * wxe) + vj * vj);
     const double lead = lambda_[kh] - lambda_[kg] - p_.model_sigmas * sd;
-    if (lead <= p_.margin_llr && (worst < 0 || lead < worst_lead)) {
-      worst = g;
-      worst_lead = lead;
+    if (lead <= p_.margin_llr && (scan.worst < 0 || lead < scan.worst_lead)) {
+      scan.worst = g;
+      scan.worst_lead = lead;
     }
   }
-  return worst;
+}
+
+int FaultDetector::blocking_alternative(int h) const {
+  BlockingScan scan;
+  blocking_scan(h, 0, kHypotheses, scan);
+  return scan.worst;
 }
 
 }  // namespace rocksteady::gnc

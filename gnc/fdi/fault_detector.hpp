@@ -146,11 +146,12 @@ class FaultDetector {
   // (F10) A closed window is being evaluated: the next update runs one step of it.
   bool evaluating() const { return eval_phase_ != 0; }
   // The next update runs one of the evaluation's heavy steps: the two scoring steps, and the
-  // decision when a hypothesis is past the confirmation level (the bias-bounded margins (F8)
-  // against every alternative) or a pod sweep reads its step (F17). The executive keeps other
-  // periodic work off those ticks.
+  // cross sums and the decision when a hypothesis is past the confirmation level (the
+  // bias-bounded margins (F8) against every alternative, half on each) or a pod sweep reads its
+  // step (F17). The executive keeps other periodic work off those ticks.
   bool heavy_step_next() const {
     return eval_phase_ == 1 || eval_phase_ == 2 ||
+           (eval_phase_ == 3 && st_.best_llr > p_.confirm_llr) ||
            (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping()));
   }
   static constexpr int kEvaluationSteps = 4;
@@ -188,6 +189,15 @@ class FaultDetector {
   // The alternative that the leader h cannot yet be told from under (F6)/(F8), or -1 (exposed to
   // close_window only).
   int blocking_alternative(int h) const;
+  // The scan behind it over alternatives [g_begin, g_end), continuing `scan` (split over two
+  // evaluation steps, F10).
+  struct BlockingScan {
+    int h{-1};  // the leader scanned for (-1: no scan under way)
+    int worst{-1};
+    double worst_lead{0.0};
+  };
+  void blocking_scan(int h, int g_begin, int g_end, BlockingScan& scan) const;
+  BlockingScan block_scan_{};
   // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
   // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.
   int partial_loss_alternative(int h) const;

@@ -533,11 +533,28 @@ TEST(Identifier, AHealthyFaultTorqueIsSettledAtZeroAndGivesItsInformationBack) {
   EXPECT_LT(with.r_err, 3.0 * with.r_sigma + without.r_err);
 }
 
-// reinflate_all computes only the rows it keeps of the step under way (the rate bias b's, and
-// d's when settled at zero, I24): the Cortex-M7 tick of a confirmed fault. It must leave exactly
-// what re-inflating the groups one by one leaves (each of which finishes every pending row block
-// first): checked on every tick of a flight that goes through joint steps, anchors and the
-// settling of d, with d live and with d settled.
+// reinflate_all computes only the block it keeps of the step under way (the rate bias b's, and
+// d's when settled at zero, I24): the Cortex-M7 tick of a confirmed fault. It must leave what
+// re-inflating the groups one by one leaves (each of which finishes every pending row block of
+// the whole matrix first), to rounding: checked on every third tick of a flight that goes
+// through joint steps, anchors and the settling of d, with d live and with d settled.
+namespace {
+// Largest |a_ij - b_ij| / sqrt(b_ii b_jj) (0 where both are 0): the difference in units of the
+// entries' own scale, so a cross term is not judged against a large prior elsewhere.
+double scaled_difference(const MatId& a, const MatId& b) {
+  double worst = 0.0;
+  for (int i = 0; i < kIdParams; ++i) {
+    for (int j = 0; j < kIdParams; ++j) {
+      const double diff = std::fabs(a(i, j) - b(i, j));
+      if (diff == 0.0) continue;
+      const double scale = std::sqrt(std::fabs(b(i, i) * b(j, j)));
+      worst = std::fmax(worst, scale > 0.0 ? diff / scale : 1.0);
+    }
+  }
+  return worst;
+}
+}  // namespace
+
 TEST(Identifier, ReinflatingEverythingAtOnceEqualsGroupByGroupOnEveryTickOfAStep) {
   TruthSetup s;
   s.j = study_j();
@@ -556,7 +573,10 @@ TEST(Identifier, ReinflatingEverythingAtOnceEqualsGroupByGroupOnEveryTickOfAStep
   id.configure(c);
   TruthRun truth(s);
   RandomFiring fire(5);
-  int compared = 0, with_d_settled = 0, differing = 0;
+  int compared = 0, with_d_settled = 0, flown_on = 0;
+  double worst = 0.0, worst_flown = 0.0;
+  int worst_tick = -1;
+  bool exact_elsewhere = true;
   int tick = 0;
   truth.run(static_cast<int>(1500.0 / kDt), fire,
             [&](double, const test::V3& w, const test::V8& f) {
@@ -573,40 +593,44 @@ TEST(Identifier, ReinflatingEverythingAtOnceEqualsGroupByGroupOnEveryTickOfAStep
               if (!settled) by_group.reinflate_fault_torque();
               ++compared;
               with_d_settled += settled ? 1 : 0;
-              const bool same =
-                  (at_once.joint_covariance().array() == by_group.joint_covariance().array())
+              const double diff =
+                  scaled_difference(at_once.joint_covariance(), by_group.joint_covariance());
+              if (diff > worst) {
+                worst = diff;
+                worst_tick = tick;
+              }
+              // The re-inflated groups are their priors, exactly.
+              exact_elsewhere =
+                  exact_elsewhere &&
+                  (at_once.inertia_covariance().array() == by_group.inertia_covariance().array())
                       .all() &&
-                  (at_once.inertia_covariance().array() ==
-                   by_group.inertia_covariance().array()).all() &&
                   (at_once.offset_covariance().array() == by_group.offset_covariance().array())
                       .all() &&
                   (at_once.strength_covariance().array() ==
                    by_group.strength_covariance().array()).all() &&
-                  (at_once.bias_covariance().array() == by_group.bias_covariance().array())
-                      .all() &&
                   at_once.fault_torque_held_zero() == by_group.fault_torque_held_zero();
-              if (!same && differing++ == 0) {
-                const MatId diff = at_once.joint_covariance() - by_group.joint_covariance();
-                Eigen::Index row = 0, col = 0;
-                const double largest = diff.cwiseAbs().maxCoeff(&row, &col);
-                ADD_FAILURE() << "first difference at tick " << tick << (settled ? " (d settled)" : "")
-                              << ": " << largest << " at (" << row << ", " << col << ")";
-              }
-              // And both fly on identically (the pending phase, the dropped gain).
+              // And both fly on alike (the pending phase, the dropped gain).
               if (tick % 999 == 0) {
+                ++flown_on;
                 for (int k = 0; k < 400; ++k) {
                   const test::V3 wk = w + 1e-6 * k * test::V3(1.0, -0.5, 0.25);
                   at_once.update(id_input(wk, f));
                   by_group.update(id_input(wk, f));
                 }
-                EXPECT_TRUE((at_once.joint_covariance().array() ==
-                             by_group.joint_covariance().array()).all())
-                    << "tick " << tick;
-                EXPECT_TRUE((at_once.estimate().j.array() == by_group.estimate().j.array()).all())
+                worst_flown = std::fmax(worst_flown, scaled_difference(at_once.joint_covariance(),
+                                                                       by_group.joint_covariance()));
+                EXPECT_LT((at_once.estimate().j - by_group.estimate().j).norm(),
+                          1e-9 * by_group.estimate().j.norm())
                     << "tick " << tick;
               }
             });
-  EXPECT_EQ(differing, 0) << "of " << compared << " ticks";
+  std::printf("%d ticks compared (%d with d settled): largest scaled difference %.3g (tick %d), "
+              "%.3g after 400 more ticks\n",
+              compared, with_d_settled, worst, worst_tick, worst_flown);
+  EXPECT_LT(worst, 1e-14) << "tick " << worst_tick;  // rounding: 2e-16 measured
+  EXPECT_LT(worst_flown, 1e-9);
+  EXPECT_TRUE(exact_elsewhere);
+  EXPECT_GT(flown_on, 10);
   EXPECT_GT(with_d_settled, 100) << "the flight must settle d to test both branches";
   EXPECT_LT(with_d_settled, compared - 100);
   EXPECT_EQ(id.counters().fault_torque_settles, 1U);
