@@ -68,7 +68,10 @@ nlohmann::json fdi_json(const FdiReport& f) {
           {"confirmed_on", f.confirmed_on},
           {"confirmed_off", f.confirmed_off},
           {"valve_closed_s", opt(f.valve_closed_s)},
-          {"suspicions", f.suspicions}};
+          {"suspicions", f.suspicions},
+          {"fault_first_commanded_s", opt(f.fault_first_commanded_s)},
+          {"fault_commanded_s", f.fault_commanded_s},
+          {"fault_commanded_impulse_ns", f.fault_commanded_impulse_ns}};
 }
 
 FdiReport fdi_from_json(const nlohmann::json& j) {
@@ -83,6 +86,12 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
   f.confirmed_off = j.at("confirmed_off").get<std::uint16_t>();
   f.valve_closed_s = to_opt(j.at("valve_closed_s"));
   f.suspicions = j.at("suspicions").get<std::uint32_t>();
+  // Absent from draws written before these were measured.
+  if (j.contains("fault_first_commanded_s")) {
+    f.fault_first_commanded_s = to_opt(j.at("fault_first_commanded_s"));
+    f.fault_commanded_s = j.at("fault_commanded_s").get<double>();
+    f.fault_commanded_impulse_ns = j.at("fault_commanded_impulse_ns").get<double>();
+  }
   return f;
 }
 

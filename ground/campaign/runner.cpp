@@ -226,6 +226,21 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       d.confirmed_on = f.confirmed_on;
       d.confirmed_off = f.confirmed_off;
       d.suspicions = f.suspicions;
+      if (!setup.truth.faults.empty()) {
+        // The first injected fault's jet, commanded by the flight this tick (held over it).
+        const plant::ThrusterFault& inj = setup.truth.faults.front();
+        const int c = inj.thruster / 2;
+        const double asked = out.command.enabled ? out.command.force(c) : 0.0;
+        const double half = inj.thruster % 2 == 0 ? std::max(asked, 0.0) : std::max(-asked, 0.0);
+        const auto pod = static_cast<std::size_t>(fs.params.rcs.channel_pod[static_cast<std::size_t>(c)]);
+        if (t >= inj.onset_s && half > 0.0 && out.command.valve_open[pod]) {
+          if (!d.fault_first_commanded_s) d.fault_first_commanded_s = t;
+          if (!d.first_confirmation_s || *d.first_confirmation_s >= t) {
+            d.fault_commanded_s += fs.params.dt;
+            d.fault_commanded_impulse_ns += half * fs.params.dt;
+          }
+        }
+      }
     }
     if (log_every != 0 && k % log_every == 0) {
       // The row at time t_k: the state, the estimate and the command computed from it.

@@ -75,6 +75,14 @@ struct FdiReport {
   std::uint16_t confirmed_off{0};
   std::optional<double> valve_closed_s;
   std::uint32_t suspicions{0};
+  // The injected fault's jet as the flight commanded it after onset (from the truth's fault list
+  // and the flight's command; the flight never sees the former): the first tick it was commanded
+  // (its half of the channel asked a positive force with the pod's valve open), and the time and
+  // impulse it was commanded from onset to the first confirmation (or the end of the run). A
+  // stuck-off or degraded jet can only show while it is commanded.
+  std::optional<double> fault_first_commanded_s;
+  double fault_commanded_s{0.0};
+  double fault_commanded_impulse_ns{0.0};
 };
 
 // The re-planner's policy for the replan strategies (ground/planner/replanner.hpp, ReplanPolicy):

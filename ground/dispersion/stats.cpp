@@ -128,7 +128,7 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
           g.kind = plant::to_string(kind);
           g.onset_s = onset;
           g.case_number = c;
-          std::vector<double> lat, pen;
+          std::vector<double> lat, pen, cmd, imp;
           for (const DrawResult& d : draws) {
             if (!d.sampled.has_fault || d.sampled.fault.kind != kind ||
                 d.sampled.fault.onset_s != onset || (c != 0 && d.sampled.case_number != c) ||
@@ -139,12 +139,15 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
             ++g.runs;
             g.successes += o.success ? 1 : 0;
             const campaign::FdiReport& f = o.fdi;
+            if (!f.fault_first_commanded_s) ++g.not_commanded;
             if (f.confirmations == 0) {
               ++g.none;
             } else if (f.confirmations == 1 && f.thruster == d.sampled.fault.thruster &&
                        f.kind == declared_kind(kind) && f.first_confirmation_s) {
               ++g.isolated;
               lat.push_back(*f.first_confirmation_s - onset);
+              cmd.push_back(f.fault_commanded_s);
+              imp.push_back(f.fault_commanded_impulse_ns);
             } else {
               ++g.wrong;
             }
@@ -154,6 +157,9 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
           if (g.runs == 0) continue;
           g.latency_s = percentiles(lat);
           if (!lat.empty()) g.latency_max_s = *std::max_element(lat.begin(), lat.end());
+          g.commanded_to_isolation_s = percentiles(cmd);
+          g.commanded_impulse_to_isolation_ns = percentiles(imp);
+          if (!cmd.empty()) g.commanded_to_isolation_max_s = *std::max_element(cmd.begin(), cmd.end());
           g.penalty_kg = percentiles(pen);
           if (!pen.empty()) g.penalty_max_kg = *std::max_element(pen.begin(), pen.end());
           s.faults.push_back(g);
@@ -481,7 +487,12 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                       {"latency_s", pct_json(g.latency_s)},
                       {"latency_max_s", opt_json(g.latency_max_s)},
                       {"fuel_penalty_kg", pct_json(g.penalty_kg)},
-                      {"fuel_penalty_max_kg", opt_json(g.penalty_max_kg)}});
+                      {"fuel_penalty_max_kg", opt_json(g.penalty_max_kg)},
+                      {"not_commanded", g.not_commanded},
+                      {"commanded_to_isolation_s", pct_json(g.commanded_to_isolation_s)},
+                      {"commanded_to_isolation_max_s", opt_json(g.commanded_to_isolation_max_s)},
+                      {"commanded_impulse_to_isolation_ns",
+                       pct_json(g.commanded_impulse_to_isolation_ns)}});
   }
   json refs = json::array();
   for (const ReferenceRow& r : s.references) {
@@ -682,6 +693,27 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
          << " / " << nc(g.latency_max_s, "%.1f") << " | " << nc(g.penalty_kg.p50, "%.2f")
          << " / " << nc(g.penalty_kg.p95, "%.2f") << " / " << nc(g.penalty_max_kg, "%.2f")
          << " |\n";
+    }
+    bool unforced = false;
+    for (const FaultGroupStats& g : s.faults) unforced = unforced || g.kind != "stuck_on";
+    if (unforced) {
+      md << "\nStuck-off and degraded jets show only while they are commanded: the runs in which the "
+            "flight never commanded the jet after onset (its half of the channel, its pod's valve "
+            "open), and over the isolated runs the time it was commanded from onset to the "
+            "confirmation (and the impulse asked of it meanwhile; u_max for one second is 200 N s in the "
+            "study's cases).\n\n| strategy | fault | onset (s) | runs | never commanded | isolated | "
+            "commanded before isolation p50 / p95 / max (s) | impulse p50 / p95 (N s) |\n"
+            "|---|---|---:|---:|---:|---:|---|---|\n";
+      for (const FaultGroupStats& g : s.faults) {
+        if (g.case_number != 0 || g.kind == "stuck_on") continue;
+        md << "| `" << g.strategy << "` | " << g.kind << " | " << fmt("%.0f", g.onset_s) << " | "
+           << g.runs << " | " << g.not_commanded << " | " << g.isolated << " | "
+           << nc(g.commanded_to_isolation_s.p50, "%.1f") << " / "
+           << nc(g.commanded_to_isolation_s.p95, "%.1f") << " / "
+           << nc(g.commanded_to_isolation_max_s, "%.1f") << " | "
+           << nc(g.commanded_impulse_to_isolation_ns.p50, "%.0f") << " / "
+           << nc(g.commanded_impulse_to_isolation_ns.p95, "%.0f") << " |\n";
+      }
     }
     if (!spec.faults.case_numbers.empty()) {
       md << "\nPer case: isolated / runs (latency p50 s), and successes.\n\n| strategy | fault | "

@@ -100,6 +100,14 @@ struct FaultGroupStats {
   std::optional<double> latency_max_s;
   Percentiles penalty_kg;  // total fuel minus the reference's (draws and reference both flew)
   std::optional<double> penalty_max_kg;
+  // The faulty jet as the flight commanded it after onset (campaign FdiReport): runs in which it
+  // was never commanded (a stuck-off or degraded jet then has nothing to show), and over the
+  // isolated runs the time it was commanded from onset to the confirmation (the issue's "seconds
+  // of commanded firing").
+  int not_commanded{0};
+  Percentiles commanded_to_isolation_s;
+  std::optional<double> commanded_to_isolation_max_s;
+  Percentiles commanded_impulse_to_isolation_ns;  // the same, as commanded impulse (N s)
 };
 
 struct ReferenceRow {

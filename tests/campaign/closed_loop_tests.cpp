@@ -1,10 +1,14 @@
 // The in-process closed loop: plant + flight core in lockstep over the study's cases.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "ground/campaign/estimation_report.hpp"
 #include "ground/campaign/fsw_flight_side.hpp"
 #include "ground/campaign/runner.hpp"
 #include "ground/config/config.hpp"
@@ -292,6 +296,51 @@ TEST(ClosedLoop, AThrusterStuckOnInHoldIsConfirmedByTheIsolationTest) {
   EXPECT_EQ(r.fdi.confirmations, 1);
   EXPECT_LE(*r.fdi.first_confirmation_s - f.onset_s, 20.0);
   EXPECT_LT(r.total_fuel_kg - healthy.total_fuel_kg, 2.0);
+}
+
+// The campaign's measure of how much a stuck-off jet was asked to fire after onset (the issue's
+// latency "of commanded firing"): recomputed here from the run's per-tick time series (the
+// commanded channel forces) for thruster 4 ("+" of channel 2, a jet the despin commands), stuck
+// off at 3000 s in case 1.
+TEST(ClosedLoop, TheFaultyJetsCommandedFiringIsMeasuredFromOnsetToTheConfirmation) {
+  config::RunSetup s = load(1);
+  plant::ThrusterFault f;
+  f.thruster = 4;
+  f.kind = plant::FaultKind::kStuckOff;
+  f.onset_s = 3000.0;
+  s.truth.faults.push_back(f);
+  const double dt = s.flight.dt;
+  const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", dt, 3600.0);
+  ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
+  ASSERT_FALSE(r.fdi.valve_closed_s.has_value()) << "a valve closed: the recount below assumes open";
+  const double end =
+      r.fdi.first_confirmation_s ? *r.fdi.first_confirmation_s : r.series.back().t + 1.0;
+  std::optional<double> first;
+  double seconds = 0.0, impulse = 0.0;
+  for (const TimeRow& row : r.series) {
+    const double half = std::max(row.force(2), 0.0);
+    if (row.t < f.onset_s - 1e-9 || !(half > 0.0)) continue;
+    if (!first) first = row.t;
+    if (row.t <= end + 1e-9) {
+      seconds += dt;
+      impulse += half * dt;
+    }
+  }
+  ASSERT_TRUE(first.has_value()) << "the despin never asked for thruster 4 after onset";
+  std::printf("thruster 4 stuck off at 3000 s: first commanded at %.1f s, commanded %.1f s "
+              "(%.1f N s) until %s %.1f s\n",
+              *first, seconds, impulse, r.fdi.first_confirmation_s ? "confirmation at" : "the end,",
+              end);
+  ASSERT_TRUE(r.fdi.fault_first_commanded_s.has_value());
+  EXPECT_NEAR(*r.fdi.fault_first_commanded_s, *first, 1e-6);
+  EXPECT_NEAR(r.fdi.fault_commanded_s, seconds, 1e-6);
+  EXPECT_NEAR(r.fdi.fault_commanded_impulse_ns, impulse, 1e-6 * impulse + 1e-9);
+  EXPECT_GT(r.fdi.fault_commanded_impulse_ns, 0.0);
+  // The JSON of a draw carries them (a restarted dispersion reads them back).
+  const FdiReport back = fdi_from_json(fdi_json(r.fdi));
+  EXPECT_EQ(back.fault_first_commanded_s, r.fdi.fault_first_commanded_s);
+  EXPECT_EQ(back.fault_commanded_s, r.fdi.fault_commanded_s);
+  EXPECT_EQ(back.fault_commanded_impulse_ns, r.fdi.fault_commanded_impulse_ns);
 }
 
 }  // namespace
