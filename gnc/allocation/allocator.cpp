@@ -111,17 +111,26 @@ Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
   // The cone of the generators is R^3 unless some y != 0 has y'g >= 0 for every generator g; the
   // extreme rays of that dual cone are orthogonal to two independent generators, so it is enough to
   // try y = +-(g_a x g_b) over the pairs.
+  // The norms are computed once (the same values as computed in place: the Cortex-M7 budget of
+  // the tick a new pattern first appears).
+  std::array<double, 2 * kChannels> norm{};
+  for (int j = 0; j < n; ++j) {
+    norm[static_cast<std::size_t>(j)] = gen[static_cast<std::size_t>(j)].norm();
+  }
   for (int p = 0; p < n; ++p) {
     for (int q = p + 1; q < n; ++q) {
       const Vec3& ga = gen[static_cast<std::size_t>(p)];
       const Vec3& gb = gen[static_cast<std::size_t>(q)];
       const Vec3 y = ga.cross(gb);
-      if (!(y.norm() > kSpanTol * ga.norm() * gb.norm())) continue;
+      const double ny = y.norm();
+      if (!(ny > kSpanTol * norm[static_cast<std::size_t>(p)] * norm[static_cast<std::size_t>(q)])) {
+        continue;
+      }
       for (const double sign : {1.0, -1.0}) {
         bool separates = true;
         for (int j = 0; j < n && separates; ++j) {
           const Vec3& g = gen[static_cast<std::size_t>(j)];
-          separates = sign * y.dot(g) >= -kSpanTol * y.norm() * g.norm();
+          separates = sign * y.dot(g) >= -kSpanTol * ny * norm[static_cast<std::size_t>(j)];
         }
         if (separates) return a;  // a half-space holds every generator: spans is false
       }
