@@ -68,6 +68,7 @@ ParamCheck Gnc::init(const GncParams& params) {
                                                      : ModelCandidate::kDisabled;
   candidate_windows_ = 0;
   fault_model_stale_ = false;
+  reinflate_pending_ = false;
   last_adoption_t_ = 0.0;
   adopted_once_ = false;
   adoptions_ = 0;
@@ -120,6 +121,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
     candidate_status_ = ModelCandidate::kNotConfident;
     candidate_windows_ = 0;
     fault_model_stale_ = false;
+    reinflate_pending_ = false;
   } else if (model_changed && declared_change) {
     candidate_status_ = ModelCandidate::kNotConfident;  // re-evaluated against this table
     ident_.reinflate_all();
@@ -259,11 +261,9 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
     // Until the confirmation the fault was unmodelled: every group the identifier fitted since
     // onset absorbed it. Its covariance goes back to the prior (estimates kept), which also makes
     // the detector insensitive until the model is re-identified (no cascade of confirmations).
-    if (params_.identification.enabled) {
-      ident_.reinflate_all();
-      release_fault_model();
-      refresh_fault_model();
-    }
+    // That is done at the start of the next tick (step 1b): this one closes the valve and
+    // reallocates, and the detector, which has just dropped its windows, scores none before then.
+    if (params_.identification.enabled) reinflate_pending_ = true;
     const int pod = params_.rcs.channel_pod[fe.thruster / 2];
     const auto p = static_cast<std::size_t>(pod);
     if (fe.kind == FaultKind::kStuckOn && params_.fdi.auto_isolate && !isolation_inhibited_ &&
@@ -462,7 +462,14 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // The identifier's step blocks stay off the fault detector's heavy evaluation steps
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
-    ident_.update(in, !fdi_busy);
+    const bool reinflating = reinflate_pending_;
+    if (reinflating) {  // a fault confirmed on the last tick (step 1c)
+      reinflate_pending_ = false;
+      ident_.reinflate_all();
+      release_fault_model();
+      fault_model_stale_ = true;  // the detector takes the re-inflated model on a later tick
+    }
+    ident_.update(in, !fdi_busy && !reinflating);
     // (F14) The identifier's stuck-on evidence (I23), once per scored window.
     const IdentifierFaultTorque& ft = ident_.fault_torque();
     if (ft.scored != fault_torque_scored_) {
@@ -498,8 +505,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // (a 3x3 inverse and eigenvalues, 16 columns) waits for a tick that neither latches the
     // identifier's window nor carries a heavy step of the detector.
     // The excitation's basis stages (after a model change) take the same quiet ticks.
-    excite_quiet_ = !fdi_busy && !window_latched;
-    if (fault_model_stale_ && !fdi_busy && !window_latched) {
+    excite_quiet_ = !fdi_busy && !window_latched && !reinflating;
+    if (fault_model_stale_ && !fdi_busy && !window_latched && !reinflating) {
       refresh_fault_model();
       fault_model_stale_ = false;
     }

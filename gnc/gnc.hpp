@@ -116,6 +116,9 @@ class Gnc {
   ModelCandidate candidate_status_{ModelCandidate::kDisabled};
   std::uint32_t candidate_windows_{0};
   bool fault_model_stale_{false};  // a window closed: refresh the detector's model
+  // A fault was confirmed: the identifier is re-inflated on the next tick, before its update
+  // (the confirmation tick carries the valve and the reallocation; the Cortex-M7 budget).
+  bool reinflate_pending_{false};
   // (gnc/fdi/README.md (F12)) The model last given to the detector, and the one it keeps while
   // the identifier re-converges after its innovation gate re-inflated J, r and k (I18).
   FaultModel fault_model_given_{};

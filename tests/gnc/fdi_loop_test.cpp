@@ -298,6 +298,11 @@ struct AllModulesHoldRun {
   int thruster{-1};
   std::uint32_t probes{0};
   double max_rate{0.0};  // |w| of the truth after the onset, rad/s
+  // The identifier's re-inflation by the confirmation: none on the confirmation tick (which
+  // carries the valve and the reallocation), one on the next, back to the inertia prior.
+  int reinflated_on_confirmation_tick{-1};
+  int reinflated_on_next_tick{-1};
+  bool inertia_at_prior_next_tick{false};
 };
 
 AllModulesHoldRun fly_all_modules_stuck_on_in_hold(int jet) {
@@ -323,10 +328,24 @@ AllModulesHoldRun fly_all_modules_stuck_on_in_hold(int jet) {
   AllModulesHoldRun run;
   constexpr int kOnset = 10000;  // 1000 s
   double t = 0.0;
+  int confirmed_k = -1;
+  std::uint32_t reinflations_before = 0;
   for (int k = 0; k < kOnset + 1200; ++k) {
     if (k == kOnset) truth.stuck_on = jet;
+    const std::uint32_t reinflations = gnc.identifier().counters().reinflations;
     gnc.step(truth.sample(t), k == 0 ? c : GncCommands{}, out);
+    if (confirmed_k >= 0 && k == confirmed_k + 1) {
+      run.reinflated_on_next_tick =
+          static_cast<int>(gnc.identifier().counters().reinflations - reinflations);
+      const double v = p.identification.config.j_prior_sigma * p.identification.config.j_prior_sigma;
+      run.inertia_at_prior_next_tick =
+          (gnc.identifier().inertia_covariance().diagonal().array() == v).all();
+    }
     if (k >= kOnset && run.confirmed_after_s < 0.0 && count(out, EventId::kFaultConfirmed) > 0) {
+      confirmed_k = k;
+      reinflations_before = reinflations;
+      run.reinflated_on_confirmation_tick =
+          static_cast<int>(gnc.identifier().counters().reinflations - reinflations_before);
       run.confirmed_after_s = (k - kOnset) * p.dt;
       for (int i = 0; i < 16; ++i) {
         if ((gnc.fault_detector().confirmed_on() >> i) & 1u) run.thruster = i;
@@ -352,6 +371,9 @@ TEST(GncFdi, EveryJetStuckOnInHoldWithEveryModuleOnIsConfirmedByItsFirstTest) {
     // HOLD's rate stays at its own scale (it starts at 2.7e-4 rad/s); unconfirmed, the jet
     // spins the vehicle up past 3e-3 rad/s within the 120 s.
     EXPECT_LT(run.max_rate, 1e-3) << "jet " << jet;
+    EXPECT_EQ(run.reinflated_on_confirmation_tick, 0) << "jet " << jet;
+    EXPECT_EQ(run.reinflated_on_next_tick, 1) << "jet " << jet;
+    EXPECT_TRUE(run.inertia_at_prior_next_tick) << "jet " << jet;
   }
 }
 
