@@ -346,6 +346,27 @@ TEST(FaultAuthority, RankAndSpanOfEveryMaskAgreeWithMonteCarlo) {
   EXPECT_FALSE(all_directions_attainable(b, lo, hi, 3000));
 }
 
+// With every active channel two-way the generators are +-B_i, so the cone spans R^3 exactly when
+// the rank is 3 (authority() takes that without the pair test): every subset of two-way
+// channels, against the Monte Carlo truth.
+TEST(FaultAuthority, TwoWayChannelsSpanExactlyWhenTheyHaveRankThree) {
+  const Mat38 b = study_b();
+  int spanning = 0, not_spanning = 0;
+  for (unsigned mask = 1; mask < 256; ++mask) {
+    Vec8 lo = Vec8::Zero(), hi = Vec8::Zero();
+    for (int c = 0; c < 8; ++c) {
+      if ((mask >> c) & 1U) lo(c) = -kUMax, hi(c) = kUMax;
+    }
+    const Authority a = authority(b, lo, hi);
+    const bool truth = all_directions_attainable(b, lo, hi, 400);
+    EXPECT_EQ(a.spans, truth) << "channels " << mask;
+    EXPECT_EQ(a.spans, a.rank == 3) << "channels " << mask;
+    (truth ? spanning : not_spanning) += 1;
+  }
+  EXPECT_GT(spanning, 0);
+  EXPECT_GT(not_spanning, 0);
+}
+
 // Largest t with t d attainable within the bounds (bisection on the L1 program's feasibility).
 double max_along(const Mat38& b, const Vec8& lo, const Vec8& hi, const Vec3& d) {
   L1Allocation lp;
