@@ -401,32 +401,28 @@ void Identifier::finish_kept_rows(const std::array<bool, kIdParams>& kept) {
       }
     }
   }
-  if (anchor_.pending) {
-    anchor_.pending = false;
+  // The anchor's and the settling's rank-deficient terms: entry (i, j) of a row not yet done loses
+  // term(min(i, j), max(i, j)) (anchor_rows, settle_rows).
+  const auto subtract_kept = [&](int rows_done, auto term) {
     for (int a = 0; a < n; ++a) {
       const int i = idx[static_cast<std::size_t>(a)];
-      if (i < anchor_.rows) continue;
+      if (i < rows_done) continue;
       for (int b = 0; b < n; ++b) {
         const int j = idx[static_cast<std::size_t>(b)];
-        const int lo = i < j ? i : j;
-        const int hi = i < j ? j : i;
-        p_all_(i, j) -= anchor_.g(lo) * anchor_.pc(hi);
+        p_all_(i, j) -= i < j ? term(i, j) : term(j, i);
       }
     }
+  };
+  if (anchor_.pending) {
+    anchor_.pending = false;
+    subtract_kept(anchor_.rows, [this](int lo, int hi) { return anchor_.g(lo) * anchor_.pc(hi); });
     anchor_.rows = kIdParams;
   }
   if (settle_.pending) {
     settle_.pending = false;
-    for (int a = 0; a < n; ++a) {
-      const int i = idx[static_cast<std::size_t>(a)];
-      if (i < settle_.rows) continue;
-      for (int b = 0; b < n; ++b) {
-        const int j = idx[static_cast<std::size_t>(b)];
-        const int lo = i < j ? i : j;
-        const int hi = i < j ? j : i;
-        p_all_(i, j) -= settle_.g.row(lo).dot(settle_.pd.row(hi));
-      }
-    }
+    subtract_kept(settle_.rows, [this](int lo, int hi) {
+      return settle_.g.row(lo).dot(settle_.pd.row(hi));
+    });
     settle_.rows = kIdParams;
     p_all_.middleRows<3>(kIdD).setZero();
     p_all_.middleCols<3>(kIdD).setZero();

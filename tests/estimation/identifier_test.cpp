@@ -482,6 +482,28 @@ TEST(Identifier, AJetStuckOnFromTheStartIsFittedAsTheFaultTorqueAndMatchesOnlyIt
   }
 }
 
+// The study vehicle under rich firing with a quiet gyro, from r 0.4 m off, with the flight's
+// strength prior, second-order term and innovation gate: the fault torque's settling (I24).
+struct SettlingSetup {
+  TruthSetup truth;
+  IdentifierConfig config;
+};
+SettlingSetup settling_setup() {
+  SettlingSetup out;
+  TruthSetup& s = out.truth;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  s.disturbance_sigma = 1.0 / std::sqrt(3.0);
+  s.gyro_sigma = std::sqrt(1e-12 / kDt);
+  IdentifierConfig& c = out.config;
+  c = config_with_priors(s.j, s.r + Vec3(0.3, -0.2, 0.2));
+  c.gyro_sigma = s.gyro_sigma;
+  c.k_prior_sigma = 0.01;
+  c.second_order_noise = true;
+  c.gate_chi2 = 16.27;
+  return out;
+}
+
 // (I24): without a fault, d-hat stays consistent with zero and is settled there (the
 // pseudo-measurement d = 0); the information it held returns to J and r, whose 1 sigma end
 // within 25 % of an identifier that never had d (the detector's noise (F5) is built from them),
@@ -489,16 +511,9 @@ TEST(Identifier, AJetStuckOnFromTheStartIsFittedAsTheFaultTorqueAndMatchesOnlyIt
 // r's 1 sigma is 3 % larger. Under the despin's firing the difference cost the detector its
 // axial isolations at 3000 s in cases 6-7: gnc/fdi/README.md (F14).)
 TEST(Identifier, AHealthyFaultTorqueIsSettledAtZeroAndGivesItsInformationBack) {
-  TruthSetup s;
-  s.j = study_j();
-  s.r = study_true_mass_properties().r_so_bcm;
-  s.disturbance_sigma = 1.0 / std::sqrt(3.0);
-  s.gyro_sigma = std::sqrt(1e-12 / kDt);
-  IdentifierConfig c = config_with_priors(s.j, s.r + Vec3(0.3, -0.2, 0.2));
-  c.gyro_sigma = s.gyro_sigma;
-  c.k_prior_sigma = 0.01;
-  c.second_order_noise = true;
-  c.gate_chi2 = 16.27;
+  const SettlingSetup setup = settling_setup();
+  const TruthSetup& s = setup.truth;
+  IdentifierConfig c = setup.config;
   struct Result {
     double r_sigma, j_sigma, r_err;
     bool held;
@@ -556,16 +571,9 @@ double scaled_difference(const MatId& a, const MatId& b) {
 }  // namespace
 
 TEST(Identifier, ReinflatingEverythingAtOnceEqualsGroupByGroupOnEveryTickOfAStep) {
-  TruthSetup s;
-  s.j = study_j();
-  s.r = study_true_mass_properties().r_so_bcm;
-  s.disturbance_sigma = 1.0 / std::sqrt(3.0);
-  s.gyro_sigma = std::sqrt(1e-12 / kDt);
-  IdentifierConfig c = config_with_priors(s.j, s.r + Vec3(0.3, -0.2, 0.2));
-  c.gyro_sigma = s.gyro_sigma;
-  c.k_prior_sigma = 0.01;
-  c.second_order_noise = true;
-  c.gate_chi2 = 16.27;
+  const SettlingSetup setup = settling_setup();
+  const TruthSetup& s = setup.truth;
+  IdentifierConfig c = setup.config;
   c.fault_torque_sigma = 3000.0;
   c.gyro_bias_sigma = 1e-5;
   c.gyro_bias_estimated = true;  // b in the state: the joint step updates its rows too
