@@ -16,6 +16,16 @@ nlohmann::json estimation_json(const EstimationReport& e) {
                      {"offset_confident", m.offset_confident},
                      {"offset_unobservable", m.offset_unobservable}});
   }
+  nlohmann::json strengths = nlohmann::json::array();
+  for (const StrengthMark& m : e.strengths) {
+    strengths.push_back({{"first_fired_s", m.first_fired_s ? nlohmann::json(*m.first_fired_s)
+                                                            : nlohmann::json(nullptr)},
+                         {"reached", m.reached},
+                         {"err", m.err},
+                         {"sigma", m.sigma},
+                         {"confident", m.confident},
+                         {"impulse_ns", m.impulse_ns}});
+  }
   return {{"estimator", e.estimator},
           {"attitude_rms_rad", e.attitude_rms_rad},
           {"attitude_max_rad", e.attitude_max_rad},
@@ -23,7 +33,8 @@ nlohmann::json estimation_json(const EstimationReport& e) {
           {"rate_max_rad_s", e.rate_max_rad_s},
           {"identifying", e.identifying},
           {"model_adoptions", e.model_adoptions},
-          {"identification", marks}};
+          {"identification", marks},
+          {"strengths_after_firing", strengths}};
 }
 
 namespace {
@@ -117,6 +128,19 @@ EstimationReport estimation_from_json(const nlohmann::json& j) {
     x.offset_confident = m.at("offset_confident").get<bool>();
     x.offset_unobservable = m.at("offset_unobservable").get<int>();
     e.marks.push_back(x);
+  }
+  // Absent from draws written before it was measured.
+  if (j.contains("strengths_after_firing")) {
+    for (const nlohmann::json& m : j.at("strengths_after_firing")) {
+      StrengthMark x;
+      x.first_fired_s = to_opt(m.at("first_fired_s"));
+      x.reached = m.at("reached").get<bool>();
+      x.err = m.at("err").get<double>();
+      x.sigma = m.at("sigma").get<double>();
+      x.confident = m.at("confident").get<bool>();
+      x.impulse_ns = m.at("impulse_ns").get<double>();
+      e.strengths.push_back(x);
+    }
   }
   return e;
 }

@@ -18,5 +18,6 @@ EstimationReport estimation_from_json(const nlohmann::json& j);
 // Chi-square 95 % upper bounds for the normalised errors of IdentificationMark (6 and 3 dof).
 inline constexpr double kChi2Dof6P95 = 12.592;
 inline constexpr double kChi2Dof3P95 = 7.815;
+inline constexpr double kChi2Dof1P95 = 3.841;
 
 }  // namespace rocksteady::campaign

@@ -144,6 +144,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   std::size_t next_mark = 0;
   if (est.identifying) {
     for (double m : marks) est.marks.push_back(IdentificationMark{m});
+    est.strengths.resize(16);
   }
   const Eigen::Matrix3d j_true = plant.inertia();
   const Eigen::Vector3d r_true = setup.truth.mass.r_so_bcm;
@@ -179,6 +180,31 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       m.inertia_confident = e.inertia_confident;
       m.offset_confident = e.offset_confident;
       m.offset_unobservable = e.offset_unobservable;
+    }
+    // Each thruster's strength 600 s after the flight first asked it for thrust: thruster 2c is
+    // the "+" half of channel c, 2c+1 the "-" half; a closed pod fires neither.
+    for (int i = 0; i < static_cast<int>(est.strengths.size()); ++i) {
+      StrengthMark& sm = est.strengths[static_cast<std::size_t>(i)];
+      if (sm.reached) continue;
+      const int c = i / 2;
+      const double asked = o.command.enabled ? o.command.force(c) : 0.0;
+      const double half = i % 2 == 0 ? std::max(asked, 0.0) : std::max(-asked, 0.0);
+      const auto pod =
+          static_cast<std::size_t>(fs.params.rcs.channel_pod[static_cast<std::size_t>(c)]);
+      const bool fired = half > 0.0 && o.command.valve_open[pod];
+      if (!sm.first_fired_s) {
+        if (!fired) continue;
+        sm.first_fired_s = t;
+      }
+      if (t >= *sm.first_fired_s + kStrengthMarkAfterFiringS - 1e-9) {
+        const gnc::EstimationTelemetry& e = o.telemetry.est;
+        sm.reached = true;
+        sm.err = std::abs(e.k(i) - k_true(i));
+        sm.sigma = e.k_sigma(i);
+        sm.confident = ((e.thruster_confident >> i) & 1u) != 0;
+      } else if (fired) {
+        sm.impulse_ns += half * fs.params.dt;
+      }
     }
   };
 

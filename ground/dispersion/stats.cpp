@@ -276,6 +276,39 @@ Summary summarize(const DispersionSpec& spec, const std::vector<DrawResult>& dra
       is.j_nees_in95 = is.n > 0 ? static_cast<double>(j_in) / is.n : 0.0;
       is.r_nees_in95 = is.n > 0 ? static_cast<double>(r_in) / is.n : 0.0;
     }
+    {
+      StrengthStats& ks = st.strengths;
+      std::vector<double> worst, all, worst_conf;
+      int within = 0, nees_in = 0;
+      for (const DrawResult& d : draws) {
+        if (k >= d.runs.size() || d.runs[k].status != "ok") continue;
+        double w = -1.0, wc = -1.0;
+        for (const campaign::StrengthMark& m : d.runs[k].estimation.strengths) {
+          if (!m.first_fired_s) ++ks.never_fired;
+          if (!m.reached) continue;
+          ++ks.pairs;
+          all.push_back(m.err);
+          w = std::max(w, m.err);
+          within += m.err <= 0.02 ? 1 : 0;
+          const double z = m.sigma > 0.0 ? m.err / m.sigma : std::numeric_limits<double>::infinity();
+          nees_in += z * z <= campaign::kChi2Dof1P95 ? 1 : 0;
+          if (m.confident) {
+            ++ks.confident;
+            wc = std::max(wc, m.err);
+          }
+        }
+        if (w >= 0.0) {
+          ++ks.draws;
+          worst.push_back(w);
+        }
+        if (wc >= 0.0) worst_conf.push_back(wc);
+      }
+      ks.worst = percentiles(worst);
+      ks.all = percentiles(all);
+      ks.worst_confident = percentiles(worst_conf);
+      ks.within_2pct = ks.pairs > 0 ? static_cast<double>(within) / ks.pairs : 0.0;
+      ks.nees_in95 = ks.pairs > 0 ? static_cast<double>(nees_in) / ks.pairs : 0.0;
+    }
     std::stable_sort(ranks.begin(), ranks.end(), [](const Rank& x, const Rank& y) {
       if (x.severity != y.severity) return x.severity > y.severity;
       if (x.fuel != y.fuel) return x.fuel > y.fuel;
@@ -432,9 +465,21 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                     {"inertia_confident", is.inertia_confident},
                     {"offset_confident", is.offset_confident}});
     }
+    const StrengthStats& ks = st.strengths;
+    const json strengths = {{"after_first_firing_s", campaign::kStrengthMarkAfterFiringS},
+                            {"draws", ks.draws},
+                            {"pairs", ks.pairs},
+                            {"never_fired", ks.never_fired},
+                            {"worst_per_draw", pct_json(ks.worst)},
+                            {"all", pct_json(ks.all)},
+                            {"within_2pct", ks.within_2pct},
+                            {"nees_in_chi2_95", ks.nees_in95},
+                            {"confident", ks.confident},
+                            {"worst_confident_per_draw", pct_json(ks.worst_confident)}};
     const json estimation = {{"attitude_rms_rad", pct_json(st.attitude_rms_rad)},
                              {"rate_rms_rad_s", pct_json(st.rate_rms_rad_s)},
-                             {"identification", id}};
+                             {"identification", id},
+                             {"strengths_after_firing", strengths}};
     strategies.push_back({{"strategy", st.strategy},
                           {"draws", st.draws},
                           {"flown", st.flown},
@@ -648,6 +693,24 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
            << nc(is.k_max_err.p50, "%.3f") << " / " << nc(is.k_max_err.p95, "%.3f") << " | "
            << fmt("%.2f", is.j_nees_in95) << " | " << fmt("%.2f", is.r_nees_in95) << " |\n";
       }
+    }
+    md << "\nThruster strengths 600 s after each thruster's first commanded firing (the pairs "
+          "(draw, thruster) whose run lasted that long): |k̂−k| worst thruster per draw and over "
+          "every pair, p50 / p95 / p99; the fraction within 2 %; NEES in 95 %: (|k̂−k|/1σ)² inside "
+          "the chi-square (1 dof) 95 % bound; the worst confident thruster per draw.\n\n"
+          "| strategy | draws | pairs | never fired | worst per draw | every pair | within 2 % | "
+          "NEES in 95 % | confident | worst confident per draw |\n"
+          "|---|---:|---:|---:|---|---|---:|---:|---:|---|\n";
+    for (const StrategyStats& st : s.strategies) {
+      if (st.identification.empty()) continue;
+      const StrengthStats& ks = st.strengths;
+      auto three = [&](const Percentiles& q) {
+        return nc(q.p50, "%.4f") + " / " + nc(q.p95, "%.4f") + " / " + nc(q.p99, "%.4f");
+      };
+      md << "| `" << st.strategy << "` | " << ks.draws << " | " << ks.pairs << " | "
+         << ks.never_fired << " | " << three(ks.worst) << " | " << three(ks.all) << " | "
+         << fmt("%.3f", ks.within_2pct) << " | " << fmt("%.2f", ks.nees_in95) << " | "
+         << ks.confident << " | " << three(ks.worst_confident) << " |\n";
     }
   }
   bool any_fdi = false;

@@ -49,6 +49,20 @@ struct IdentificationStats {
   int offset_confident{0};
 };
 
+// Thruster strengths kStrengthMarkAfterFiringS (600 s) after each thruster's first commanded firing
+// (issue 18's target), over the (draw, thruster) pairs whose mark the run reached.
+struct StrengthStats {
+  int draws{0};                 // draws with at least one thruster's mark reached
+  int pairs{0};                 // (draw, thruster) pairs with the mark reached
+  int never_fired{0};           // pairs the flight never commanded
+  Percentiles worst;            // per draw, the largest |k_hat - k| over its reached thrusters
+  Percentiles all;              // every reached pair
+  double within_2pct{0.0};      // fraction of the reached pairs with |k_hat - k| <= 0.02
+  double nees_in95{0.0};        // fraction with (err / sigma)^2 inside the chi-square (1 dof) 95 %
+  int confident{0};             // reached pairs the identifier called confident
+  Percentiles worst_confident;  // per draw, the largest error over its confident thrusters
+};
+
 struct StrategyStats {
   std::string strategy;
   int draws{0};
@@ -64,6 +78,7 @@ struct StrategyStats {
   // and the identification marks when the strategy identifies.
   Percentiles attitude_rms_rad, rate_rms_rad_s;
   std::vector<IdentificationStats> identification;
+  StrengthStats strengths;
 };
 
 struct PairedStats {

@@ -197,6 +197,58 @@ TEST(ClosedLoop, RunnerDrivesAnyFlightSideInLockstep) {
   EXPECT_NEAR(w1.dot(j * w1), w0.dot(j * w0), 1e-9 * w0.dot(j * w0));
 }
 
+// Issue 18's strength target is counted from each thruster's first firing: the campaign's first
+// firing, reached flag and impulse to the mark are recounted here from the per-tick series (the
+// commanded channel forces; no fault, every valve open) in case 1 with a 2 % strength spread.
+TEST(ClosedLoop, EachThrustersStrengthIsScored600sAfterItsFirstCommandedFiring) {
+  config::RunSetup s = load(1);
+  for (int i = 0; i < 16; ++i) s.truth.thruster_strength(i) = 1.0 + 0.02 * ((i % 3) - 1);
+  const double dt = s.flight.dt;
+  const RunResult r = run(s, "ntcl+dpd_ref:id", dt, 1200.0);
+  ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
+  ASSERT_EQ(r.estimation.strengths.size(), 16u);
+  const double t_last = r.series.back().t;
+  int reached = 0;
+  for (int i = 0; i < 16; ++i) {
+    const int c = i / 2;
+    std::optional<double> first;
+    double impulse = 0.0;
+    for (const TimeRow& row : r.series) {
+      const double half = i % 2 == 0 ? std::max(row.force(c), 0.0) : std::max(-row.force(c), 0.0);
+      if (!first && half > 0.0) first = row.t;
+      if (first && row.t < *first + kStrengthMarkAfterFiringS - 1e-9) impulse += half * dt;
+    }
+    const StrengthMark& m = r.estimation.strengths[static_cast<std::size_t>(i)];
+    ASSERT_EQ(m.first_fired_s.has_value(), first.has_value()) << "thruster " << i;
+    if (!first) {
+      EXPECT_FALSE(m.reached);
+      continue;
+    }
+    EXPECT_NEAR(*m.first_fired_s, *first, 1e-6) << "thruster " << i;
+    EXPECT_EQ(m.reached, *first + kStrengthMarkAfterFiringS <= t_last + 1e-6) << "thruster " << i;
+    if (!m.reached) continue;
+    ++reached;
+    EXPECT_NEAR(m.impulse_ns, impulse, 1e-6 * impulse + 1e-9) << "thruster " << i;
+    EXPECT_GT(m.sigma, 0.0);
+    EXPECT_TRUE(std::isfinite(m.err));
+    std::printf("thruster %2d: first fired %6.1f s, %8.0f N s to its mark, |k^-k| %.4f (1 sigma "
+                "%.4f)%s\n",
+                i, *first, m.impulse_ns, m.err, m.sigma, m.confident ? ", confident" : "");
+  }
+  EXPECT_GT(reached, 0) << "no thruster reached its mark in 1200 s";
+  // A restarted dispersion reads them back from the draw's JSON.
+  const EstimationReport back = estimation_from_json(estimation_json(r.estimation));
+  ASSERT_EQ(back.strengths.size(), 16u);
+  for (std::size_t i = 0; i < 16; ++i) {
+    EXPECT_EQ(back.strengths[i].first_fired_s, r.estimation.strengths[i].first_fired_s);
+    EXPECT_EQ(back.strengths[i].reached, r.estimation.strengths[i].reached);
+    EXPECT_EQ(back.strengths[i].err, r.estimation.strengths[i].err);
+    EXPECT_EQ(back.strengths[i].sigma, r.estimation.strengths[i].sigma);
+    EXPECT_EQ(back.strengths[i].confident, r.estimation.strengths[i].confident);
+    EXPECT_EQ(back.strengths[i].impulse_ns, r.estimation.strengths[i].impulse_ns);
+  }
+}
+
 }  // namespace
 }  // namespace rocksteady::campaign
 

@@ -95,6 +95,56 @@ TEST(Summary, SuccessWorstAndPairedDifferencesOnSyntheticDraws) {
   EXPECT_LT(*s.crossovers[0].crossover_kg_m2, 1e6);
 }
 
+// The strengths 600 s after each thruster's first firing, summarised over synthetic draws: worst
+// per draw, every pair, within 2 %, chi-square (1 dof) consistency and the confident ones, all
+// recounted by hand below.
+TEST(Summary, ThrusterStrengthsAfterFirstFiringPerDrawAndPerPair) {
+  DispersionSpec spec;
+  spec.name = "strengths";
+  spec.strategies = {*campaign::parse_strategy("ntcl+dpd_ref:id")};
+  auto mark = [](double err, double sigma, bool confident) {
+    campaign::StrengthMark m;
+    m.first_fired_s = 10.0;
+    m.reached = true;
+    m.err = err;
+    m.sigma = sigma;
+    m.confident = confident;
+    return m;
+  };
+  std::vector<DrawResult> draws(3);
+  for (int i = 0; i < 3; ++i) {
+    draws[static_cast<std::size_t>(i)].index = i;
+    StrategyOutcome o = ok("ntcl+dpd_ref:id", 90.0, true);
+    o.estimation.identifying = true;
+    o.estimation.marks.push_back(campaign::IdentificationMark{60.0, true});
+    o.estimation.strengths.resize(16);  // never fired unless set below
+    draws[static_cast<std::size_t>(i)].runs = {o};
+  }
+  auto& s0 = draws[0].runs[0].estimation.strengths;
+  s0[0] = mark(0.010, 0.01, true);   // z 1.0: in band, within 2 %
+  s0[1] = mark(0.030, 0.01, false);  // z 3.0: out of band, not within
+  s0[2].first_fired_s = 3500.0;      // fired, run ended before its mark
+  auto& s1 = draws[1].runs[0].estimation.strengths;
+  s1[5] = mark(0.005, 0.002, true);  // z 2.5: out (6.25 > 3.841), within
+  s1[6] = mark(0.019, 0.01, true);   // z 1.9: in (3.61), within
+  // Draw 2: no thruster fired, so it has no worst thruster.
+  const Summary s = summarize(spec, draws);
+  ASSERT_EQ(s.strategies.size(), 1u);
+  const StrengthStats& k = s.strategies[0].strengths;
+  EXPECT_EQ(k.draws, 2);
+  EXPECT_EQ(k.pairs, 4);
+  EXPECT_EQ(k.never_fired, 13 + 14 + 16);
+  EXPECT_EQ(k.confident, 3);
+  EXPECT_NEAR(k.within_2pct, 3.0 / 4.0, 1e-12);
+  EXPECT_NEAR(k.nees_in95, 2.0 / 4.0, 1e-12);
+  ASSERT_EQ(k.worst.n, 2);  // 0.030 and 0.019
+  EXPECT_NEAR(*k.worst.p50, 0.0245, 1e-12);
+  ASSERT_EQ(k.all.n, 4);    // 0.005 0.010 0.019 0.030: p50 (0.010 + 0.019) / 2
+  EXPECT_NEAR(*k.all.p50, 0.0145, 1e-12);
+  ASSERT_EQ(k.worst_confident.n, 2);  // 0.010 and 0.019
+  EXPECT_NEAR(*k.worst_confident.p95, 0.010 + 0.95 * 0.009, 1e-12);
+}
+
 // A fault dispersion over two study cases: isolation counted per kind, onset and case against the
 // draw's injected fault, latency from onset, fuel penalty against the case's fault-free reference.
 TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheReference) {
