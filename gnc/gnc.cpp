@@ -463,6 +463,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
     const bool reinflating = reinflate_pending_;
+    // The tick after a re-inflation the identifier's block is the rewrite of its covariance
+    // (Identifier::reinflate_all); the detector's model refresh waits for the tick after that.
+    const bool rewriting = ident_.covariance_rewrite_pending() && !fdi_busy && !reinflating;
     if (reinflating) {  // a fault confirmed on the last tick (step 1c)
       reinflate_pending_ = false;
       ident_.reinflate_all();
@@ -506,7 +509,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // identifier's window nor carries a heavy step of the detector.
     // The excitation's basis stages (after a model change) take the same quiet ticks.
     excite_quiet_ = !fdi_busy && !window_latched && !reinflating;
-    if (fault_model_stale_ && !fdi_busy && !window_latched && !reinflating) {
+    if (fault_model_stale_ && !fdi_busy && !window_latched && !reinflating && !rewriting) {
       refresh_fault_model();
       fault_model_stale_ = false;
     }

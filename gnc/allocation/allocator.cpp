@@ -48,29 +48,57 @@ Sym3 eig3(const Mat3& m) {
   return Sym3{es.eigenvectors(), es.eigenvalues()};
 }
 
-// Rank of the columns of b (as the number of eigenvalues of b b' above kRankTol of the largest).
-int rank_of(const Mat38& b) {
-  const Sym3 e = eig3(b * b.transpose());
-  const double top = e.lambda.cwiseAbs().maxCoeff();
-  if (!(top > 0.0)) return 0;
+// The rank of m = b b' (symmetric positive semi-definite, eigenvalues l1 <= l2 <= l3): the number
+// of eigenvalues above kRankTol l3. Decided in closed form from the invariants t = tr m = l1+l2+l3,
+// e = l1 l2 + l1 l3 + l2 l3 and d = det m = l1 l2 l3 wherever they are conclusive, and by the
+// eigenvalues only in between:
+//   l3 <= t <= 3 l3;  l2 l3 <= e <= 3 l2 l3;  d / e <= l1 <= 3 d / e, so
+//   e > 3 kRankTol t^2  => l2 > kRankTol l3,   e <= kRankTol t^2 / 9 => l2 <= kRankTol l3,
+//   d > kRankTol t e    => l1 > kRankTol l3,   3 d <= kRankTol t e / 3 => l1 <= kRankTol l3.
+// The closed-form eigenvalues of a 3x3 are accurate only to about 1e-8 of the largest, which made
+// a single channel look like rank 2; the invariants are exact where it matters (a rank-deficient
+// set of columns gives e or d at rounding level; d is used only while its rounding is far below
+// the threshold). It also saves the eigen-decomposition on the tick
+// a latch valve first closes (the Cortex-M7 budget).
+int rank_of_gram(const Mat3& m, const Sym3* e3) {
+  const double t = m.trace();
+  if (!(t > 0.0)) return 0;
+  const double e = 0.5 * (t * t - (m * m).trace());
+  const double d = m.determinant();
+  int low2 = -1;  // l2 above the threshold: 1 yes, 0 no, -1 undecided
+  if (e > 3.0 * kRankTol * t * t) low2 = 1;
+  if (e <= kRankTol * t * t / 9.0) low2 = 0;
+  if (low2 == 0) return 1;
+  // d carries a rounding error of about 1e-16 t^3: compared with kRankTol t e only while e is
+  // large enough for that to be far below the threshold.
+  int low1 = -1;
+  if (e > 1e-4 * t * t) {
+    if (d > kRankTol * t * e) low1 = 1;
+    if (3.0 * d <= kRankTol * t * e / 3.0) low1 = 0;
+  }
+  if (low2 == 1 && low1 >= 0) return 2 + low1;
+  // In the band: the eigenvalues decide.
+  const Sym3 own = e3 != nullptr ? *e3 : eig3(m);
+  const double top = own.lambda.maxCoeff();
   int r = 0;
-  for (int i = 0; i < 3; ++i) r += e.lambda(i) > kRankTol * top ? 1 : 0;
-  return r;
+  for (int i = 0; i < 3; ++i) r += own.lambda(i) > kRankTol * top ? 1 : 0;
+  return std::max(r, 1);
 }
+
+// Rank of the columns of b.
+int rank_of(const Mat38& b) { return rank_of_gram(b * b.transpose(), nullptr); }
 
 // Eq. (53) re-derived for the columns of b_f (the others zero): B_F' (B_F B_F')^+, the
 // minimum-norm least-squares inverse (the right inverse when rank 3).
 Mat83 pinv_of(const Mat38& b_f, int& rank) {
-  const Sym3 e = eig3(b_f * b_f.transpose());
-  const double top = e.lambda.cwiseAbs().maxCoeff();
-  rank = 0;
+  const Mat3 m = b_f * b_f.transpose();
+  rank = rank_of_gram(m, nullptr);
+  if (rank == 3) return b_f.transpose() * m.inverse();  // as Eq. (53) in configure()
   Mat3 inv = Mat3::Zero();
-  if (top > 0.0) {
-    for (int i = 0; i < 3; ++i) {
-      if (e.lambda(i) > kRankTol * top) {
-        inv += e.v.col(i) * e.v.col(i).transpose() / e.lambda(i);
-        ++rank;
-      }
+  if (rank > 0) {
+    const Sym3 e = eig3(m);  // ascending: the rank largest eigenpairs span the columns
+    for (int i = 3 - rank; i < 3; ++i) {
+      inv += e.v.col(i) * e.v.col(i).transpose() / e.lambda(i);
     }
   }
   return b_f.transpose() * inv;

@@ -266,7 +266,10 @@ class Identifier {
   const Mat16& strength_covariance() const { return p_k_; }
   const Mat3& bias_covariance() const { return p_b_; }
   // kJoint: the whole covariance of [a; r; k; b; d] as it stands (rows of a step may be pending).
-  const MatId& joint_covariance() const { return p_all_; }
+  // reinflate_all's rewrite of the joint covariance waits for the next update with a free block.
+  bool covariance_rewrite_pending() const { return fill_pending_; }
+  // The joint covariance (completes a re-inflation's deferred rewrite first).
+  const MatId& joint_covariance();
   const IdentifierFaultTorque& fault_torque() const { return ft_; }
   // (I24) d is held at zero now (from the tick the settling starts; fault_torque().held_zero
   // follows at the next score).
@@ -285,7 +288,7 @@ class Identifier {
     Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
   };
   enum class Phase : std::uint8_t {
-    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kReport, kFaultScore,
+    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
     kSettleStart, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
@@ -342,6 +345,17 @@ class Identifier {
   // reinflate_all: every pending block of rows (joint step, anchor, settling) on the kept rows
   // only.
   void finish_kept_rows(const std::array<bool, kIdParams>& kept);
+  // reinflate_all's rewrite of p_all_, deferred to the identifier's next block (or to whatever
+  // reads p_all_ first).
+  void complete_reinflation();
+  struct Fill {
+    Mat3 p_bb{Mat3::Zero()};
+    Mat3 p_bd{Mat3::Zero()};
+    Mat3 p_dd{Mat3::Zero()};
+    bool d_live{false};
+  };
+  Fill fill_{};
+  bool fill_pending_{false};
   void update_inertia();
   void update_offset();
   void update_strengths();

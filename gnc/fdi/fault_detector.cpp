@@ -439,20 +439,22 @@ void FaultDetector::evaluate_step() {
     case 2:
       evaluate_scores(w, kThrusters, kHypotheses);
       rank_hypotheses();
-      eval_phase_ = 3;
-      break;
-    case 3:
       evaluate_cross(w);
       // (F10) A leader past the confirmation level is checked against every alternative (F8)
-      // in the decision; the first half of that scan is done here (the Cortex-M7 tick budget:
-      // 6 k instructions for the 31 alternatives on one tick). Nothing it reads changes before
+      // before the decision, the scan split over this step and the next (the Cortex-M7 tick
+      // budget: 6.6 k instructions for the 31 alternatives; the decision that starts an isolation
+      // test also re-solves the allocation with a pod closed). Nothing it reads changes before
       // the decision: a model that arrives is held, and a declaration cancels the evaluation.
       block_scan_ = BlockingScan{};
       if (st_.best >= 0 && st_.best_llr > p_.confirm_llr &&
           st_.best_llr - st_.runner_up_llr > p_.margin_llr) {
         block_scan_.h = st_.best;
-        blocking_scan(st_.best, 0, kHypotheses / 2, block_scan_);
+        blocking_scan(st_.best, 0, kScanSplit, block_scan_);
       }
+      eval_phase_ = 3;
+      break;
+    case 3:
+      if (block_scan_.h >= 0) blocking_scan(block_scan_.h, kScanSplit, kHypotheses, block_scan_);
       eval_phase_ = 4;
       break;
     default:
@@ -662,8 +664,7 @@ void FaultDetector::decide() {
   // (F6) clearly ahead of the runner-up, and (F8) of every alternative beyond the model's error.
   int blocking = runner_up;
   if (best_s - second > p_.margin_llr) {
-    if (block_scan_.h == best) {  // the second half of the scan begun in step 3
-      blocking_scan(best, kHypotheses / 2, kHypotheses, block_scan_);
+    if (block_scan_.h == best) {  // the scan of steps 2 and 3
       blocking = block_scan_.worst;
     } else {
       blocking = blocking_alternative(best);

@@ -145,10 +145,11 @@ class FaultDetector {
   void set_model(const FaultModel& m);
   // (F10) A closed window is being evaluated: the next update runs one step of it.
   bool evaluating() const { return eval_phase_ != 0; }
-  // The next update runs one of the evaluation's heavy steps: the two scoring steps, and the
-  // cross sums and the decision when a hypothesis is past the confirmation level (the
-  // bias-bounded margins (F8) against every alternative, half on each) or a pod sweep reads its
-  // step (F17). The executive keeps other periodic work off those ticks.
+  // The next update runs one of the evaluation's heavy steps: the two scoring steps (the second
+  // with the cross sums), and, when a hypothesis is past the confirmation level, step 3 (the
+  // rest of its bias-bounded margins (F8) against every alternative, begun in step 2) and the
+  // decision (it may start an isolation test), or the decision when a pod sweep reads its step
+  // (F17). The executive keeps other periodic work off those ticks.
   bool heavy_step_next() const {
     return eval_phase_ == 1 || eval_phase_ == 2 ||
            (eval_phase_ == 3 && st_.best_llr > p_.confirm_llr) ||
@@ -189,8 +190,10 @@ class FaultDetector {
   // The alternative that the leader h cannot yet be told from under (F6)/(F8), or -1 (exposed to
   // close_window only).
   int blocking_alternative(int h) const;
-  // The scan behind it over alternatives [g_begin, g_end), continuing `scan` (split over two
-  // evaluation steps, F10).
+  // The scan behind it over alternatives [g_begin, g_end), continuing `scan` (split over
+  // evaluation steps 2 and 3 at kScanSplit, F10: step 2 also scores and ranks, so it takes the
+  // smaller part).
+  static constexpr int kScanSplit = 12;
   struct BlockingScan {
     int h{-1};  // the leader scanned for (-1: no scan under way)
     int worst{-1};

@@ -285,6 +285,25 @@ TEST(FaultPinv, FewerThanThreeDirectionsGiveTheLeastSquaresTorqueAndNoChannelIsI
       EXPECT_LT(std::fabs(st.shortfall.dot(b.col(3))), 1e-8 * u_c.norm() * b.col(3).norm());
     }
   }
+  // One channel left (rank 1): the torque is the projection of the request on its column, and the
+  // pseudoinverse holds no spurious second direction (the closed-form eigenvalues of B_F B_F' put
+  // the zero ones near 1e-8 of the largest).
+  for (int c = 0; c < 8; ++c) {
+    AllocatorLimits one = nominal_limits(kUMax);
+    for (int k = 0; k < 8; ++k) {
+      if (k != c) one.lo(k) = one.hi(k) = 0.0;
+    }
+    for (int trial = 0; trial < 20; ++trial) {
+      const Vec3 u_c = Vec3(n(rng), n(rng), n(rng)) * 20.0;
+      Vec8 u;
+      AllocatorStatus st;
+      alloc.allocate(u_c, one, u, st);
+      EXPECT_EQ(st.rank, 1) << "channel " << c;
+      EXPECT_EQ(st.active_channels, 1);
+      const Vec8 ls = st.scale * min_norm_ls(b, {c}, u_c);
+      EXPECT_LT((u - ls).norm(), 1e-8 * (1.0 + ls.norm())) << "channel " << c;
+    }
+  }
   // Nothing left: impossible, nothing fired, the bias is all there is.
   AllocatorLimits none = nominal_limits(kUMax);
   none.lo.setZero();
@@ -365,6 +384,55 @@ TEST(FaultAuthority, TwoWayChannelsSpanExactlyWhenTheyHaveRankThree) {
   }
   EXPECT_GT(spanning, 0);
   EXPECT_GT(not_spanning, 0);
+}
+
+// The rank authority() reports (and the pseudoinverse's free set uses) counts the eigenvalues of
+// B_F B_F' above 1e-9 of the largest; a closed-form test takes rank 3 without the
+// eigen-decomposition when it is certain. Against the singular values of B_F (SVD, independent):
+// every subset of channels of the study's B, and of matrices whose columns lean out of a plane by
+// a tilt that puts the smallest eigenvalue at 1e-5 ... 1e-13 of the largest, either side of the
+// threshold and of the closed-form test's own bound.
+TEST(FaultAuthority, RankOfEveryChannelSubsetAgreesWithTheSingularValues) {
+  auto svd_rank = [](const Mat38& m) {
+    const Eigen::JacobiSVD<Mat38> svd(m);
+    const Vec3 s = svd.singularValues();  // descending
+    if (!(s(0) > 0.0)) return 0;
+    int r = 0;
+    for (int i = 0; i < 3; ++i) r += s(i) * s(i) > 1e-9 * s(0) * s(0) ? 1 : 0;
+    return r;
+  };
+  std::vector<Mat38> matrices{study_b()};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(0.0, 6.283185307179586);
+  for (const double ratio : {1e-5, 1e-7, 3e-9, 1.2e-9, 0.8e-9, 1e-11, 1e-13}) {
+    // Columns at random in-plane angles, tilted out of it by +-t: with unit in-plane parts and 8
+    // columns, B B' has about 4 in-plane and 8 t^2 out of plane, so t^2 = ratio / 2.
+    Mat38 m;
+    const double t = std::sqrt(ratio / 2.0);
+    for (int c = 0; c < 8; ++c) {
+      const double a = angle(rng);
+      m.col(c) = 150.0 * Vec3(std::cos(a), std::sin(a), (c % 2 == 0 ? t : -t));
+    }
+    matrices.push_back(m);
+  }
+  int full = 0, deficient = 0;
+  for (const Mat38& b : matrices) {
+    for (unsigned mask = 1; mask < 256; ++mask) {
+      Vec8 lo = Vec8::Zero(), hi = Vec8::Zero();
+      Mat38 b_f = Mat38::Zero();
+      for (int c = 0; c < 8; ++c) {
+        if ((mask >> c) & 1U) {
+          lo(c) = -kUMax, hi(c) = kUMax;
+          b_f.col(c) = b.col(c);
+        }
+      }
+      const int truth = svd_rank(b_f);
+      EXPECT_EQ(authority(b, lo, hi).rank, truth) << "channels " << mask;
+      (truth == 3 ? full : deficient) += 1;
+    }
+  }
+  EXPECT_GT(full, 0);
+  EXPECT_GT(deficient, 0);
 }
 
 // Largest t with t d attainable within the bounds (bisection on the L1 program's feasibility).
