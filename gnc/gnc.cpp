@@ -466,6 +466,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // The tick after a re-inflation the identifier's block is the rewrite of its covariance
     // (Identifier::reinflate_all); the detector's model refresh waits for the tick after that.
     const bool rewriting = ident_.covariance_rewrite_pending() && !fdi_busy && !reinflating;
+    // ... and the linearisation of a step (the detector's model refresh waits for another tick).
+    const bool linearising = ident_.heavy_block_next() && !fdi_busy && !reinflating;
     if (reinflating) {  // a fault confirmed on the last tick (step 1c)
       reinflate_pending_ = false;
       ident_.reinflate_all();
@@ -506,10 +508,12 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // The detector predicts with the latest identified model; one that arrives while a closed
     // window is evaluated is held by the detector until the evaluation ends (F10). The refresh
     // (a 3x3 inverse and eigenvalues, 16 columns) waits for a tick that neither latches the
-    // identifier's window nor carries a heavy step of the detector.
+    // identifier's window, nor carries a heavy step of the detector, nor the identifier's
+    // linearisation or covariance rewrite.
     // The excitation's basis stages (after a model change) take the same quiet ticks.
     excite_quiet_ = !fdi_busy && !window_latched && !reinflating;
-    if (fault_model_stale_ && !fdi_busy && !window_latched && !reinflating && !rewriting) {
+    if (fault_model_stale_ && !fdi_busy && !window_latched && !reinflating && !rewriting &&
+        !linearising) {
       refresh_fault_model();
       fault_model_stale_ = false;
     }

@@ -85,23 +85,39 @@ int rank_of_gram(const Mat3& m, const Sym3* e3) {
   return std::max(r, 1);
 }
 
-// Rank of the columns of b.
-int rank_of(const Mat38& b) { return rank_of_gram(b * b.transpose(), nullptr); }
+// B_F B_F' for the columns of b in the mask (bit i: column i), summed column by column without
+// forming B_F (the Cortex-M7 budget of the tick a latch valve first closes).
+Mat3 gram_of(const Mat38& b, std::uint8_t cols) {
+  Mat3 m = Mat3::Zero();
+  for (int i = 0; i < kChannels; ++i) {
+    if ((cols >> i) & 1U) m.noalias() += b.col(i) * b.col(i).transpose();
+  }
+  return m;
+}
 
-// Eq. (53) re-derived for the columns of b_f (the others zero): B_F' (B_F B_F')^+, the
+// Eq. (53) re-derived for the columns of b in the mask (the others zero): B_F' (B_F B_F')^+, the
 // minimum-norm least-squares inverse (the right inverse when rank 3).
-Mat83 pinv_of(const Mat38& b_f, int& rank) {
-  const Mat3 m = b_f * b_f.transpose();
+Mat83 pinv_of(const Mat38& b, std::uint8_t cols, int& rank) {
+  const Mat3 m = gram_of(b, cols);
   rank = rank_of_gram(m, nullptr);
-  if (rank == 3) return b_f.transpose() * m.inverse();  // as Eq. (53) in configure()
   Mat3 inv = Mat3::Zero();
-  if (rank > 0) {
+  if (rank == 3) {
+    inv = m.inverse();  // as Eq. (53) in configure()
+  } else if (rank > 0) {
     const Sym3 e = eig3(m);  // ascending: the rank largest eigenpairs span the columns
     for (int i = 3 - rank; i < 3; ++i) {
       inv += e.v.col(i) * e.v.col(i).transpose() / e.lambda(i);
     }
   }
-  return b_f.transpose() * inv;
+  Mat83 out;
+  for (int i = 0; i < kChannels; ++i) {
+    if ((cols >> i) & 1U) {
+      out.row(i) = (inv * b.col(i)).transpose();  // inv is symmetric: (b_i' inv)' = inv b_i
+    } else {
+      out.row(i).setZero();
+    }
+  }
+  return out;
 }
 
 // The limits as the allocator uses them: within [-u_max, u_max] and their sign; NaN -> out.
@@ -122,7 +138,7 @@ void clip_limits(const AllocatorLimits& in, double u_max, Vec8& lo, Vec8& hi, Ve
 
 Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
   Authority a;
-  Mat38 b_act = Mat38::Zero();
+  std::uint8_t act = 0;
   // The one-way thrust torques the limits allow: +B_i where hi_i > 0, -B_i where lo_i < 0.
   std::array<Vec3, 2 * kChannels> gen{};
   int n = 0;
@@ -130,11 +146,11 @@ Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
     const bool up = hi(i) > 0.0, down = lo(i) < 0.0;
     if (!(up || down) || !(b.col(i).norm() > 0.0)) continue;
     ++a.active_channels;
-    b_act.col(i) = b.col(i);
+    act = static_cast<std::uint8_t>(act | (1U << i));
     if (up) gen[static_cast<std::size_t>(n++)] = b.col(i);
     if (down) gen[static_cast<std::size_t>(n++)] = -b.col(i);
   }
-  a.rank = rank_of(b_act);
+  a.rank = rank_of_gram(gram_of(b, act), nullptr);
   if (a.rank < 3) return a;
   // Every active channel may push both ways (a closed pod, nominal limits): the generators come in
   // pairs +-B_i, so their cone is their span, R^3 at rank 3. The pair test below is only for
@@ -183,14 +199,10 @@ const Mat83& Allocator::pinv_for(std::uint8_t free, int& rank) const {
       return m.pinv;
     }
   }
-  // Not kept: B_hat with the columns of the channels that are not free zeroed.
-  Mat38 b_f = Mat38::Zero();
-  for (int i = 0; i < kChannels; ++i) {
-    if ((free >> i) & 1U) b_f.col(i) = b_hat_.col(i);
-  }
+  // Not kept: Eq. (53) for B_hat's free columns.
   PinvMemo& m = pinv_memo_[static_cast<std::size_t>(pinv_memo_next_)];
   pinv_memo_next_ = (pinv_memo_next_ + 1) % kPinvMemos;
-  m.pinv = pinv_of(b_f, m.rank);
+  m.pinv = pinv_of(b_hat_, free, m.rank);
   m.free = free;
   m.valid = true;
   rank = m.rank;

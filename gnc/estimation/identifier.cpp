@@ -314,6 +314,7 @@ void Identifier::reinflate_all() {
   // b's (and d's when settled). Each entry's update reads only that entry and the step's
   // factors, so only the kept block is computed here; the rest is about to be the prior.
   complete_reinflation();
+  anchor_scale_finish();  // a scale anchor begun on the last block ends as it would have
   const bool d_live = !d_held_zero_;
   std::array<bool, kIdParams> kept{};
   for (int a = 0; a < 3; ++a) {
@@ -755,12 +756,37 @@ void Identifier::anchor_scale() {
   c /= n;
   b /= n;
   if (c_.mode == IdentifierMode::kJoint) {
-    // c is sparse (1/n on the reference thrusters): P c sums those columns (the Cortex-M7 tick
-    // budget).
-    VecId pc = VecId::Zero();
-    for (int i = 0; i < kThrusters; ++i) {
-      if (reference_[i]) pc += p_all_.col(kIdK + i) * c(kIdK + i);
+    // c is sparse (1/n on the reference thrusters): P c sums those columns, the first eight
+    // thrusters' here and the rest on the next block (anchor_scale_finish; the Cortex-M7 tick
+    // budget: 16 columns and the update on one tick were 3.7 k instructions).
+    anchor_.c = c;
+    anchor_.b = b;
+    anchor_.pc.setZero();
+    for (int i = 0; i < kThrusters / 2; ++i) {
+      if (reference_[i]) anchor_.pc += p_all_.col(kIdK + i) * c(kIdK + i);
     }
+    anchor_.pc_pending = true;
+  } else {
+    const Vec16 ck = c.segment<kThrusters>(kIdK);
+    const Vec16 pc = p_k_ * ck;
+    const double cpc = ck.dot(pc);
+    if (!(cpc > 0.0)) return;
+    k_ -= pc * ((ck.dot(k_) - b) / cpc);
+    p_k_.noalias() -= pc * pc.transpose() / cpc;
+    p_k_ = 0.5 * (p_k_ + p_k_.transpose()).eval();
+  }
+}
+
+void Identifier::anchor_scale_finish() {
+  if (!anchor_.pc_pending) return;
+  anchor_.pc_pending = false;
+  const VecId& c = anchor_.c;
+  const double b = anchor_.b;
+  VecId pc = anchor_.pc;
+  for (int i = kThrusters / 2; i < kThrusters; ++i) {
+    if (reference_[i]) pc += p_all_.col(kIdK + i) * c(kIdK + i);
+  }
+  {
     const double cpc = c.dot(pc);
     if (!(cpc > 0.0)) return;
     VecId x;
@@ -776,14 +802,6 @@ void Identifier::anchor_scale() {
     k_ = x.segment<kThrusters>(kIdK);
     b_ = x.segment<3>(kIdB);
     d_ = x.segment<3>(kIdD);
-  } else {
-    const Vec16 ck = c.segment<kThrusters>(kIdK);
-    const Vec16 pc = p_k_ * ck;
-    const double cpc = ck.dot(pc);
-    if (!(cpc > 0.0)) return;
-    k_ -= pc * ((ck.dot(k_) - b) / cpc);
-    p_k_.noalias() -= pc * pc.transpose() / cpc;
-    p_k_ = 0.5 * (p_k_ + p_k_.transpose()).eval();
   }
 }
 
@@ -807,6 +825,7 @@ bool Identifier::anchor_rows() {
 }
 
 void Identifier::finish_anchor() {
+  anchor_scale_finish();
   while (!anchor_rows()) {
   }
 }
@@ -935,6 +954,10 @@ void Identifier::step_phase() {
       }
       break;
     case Phase::kAnchor:
+      if (anchor_.pc_pending) {
+        anchor_scale_finish();
+        break;
+      }
       if (anchor_rows()) phase_ = Phase::kSync;
       break;
     case Phase::kSync:

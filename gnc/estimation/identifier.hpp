@@ -266,8 +266,15 @@ class Identifier {
   const Mat16& strength_covariance() const { return p_k_; }
   const Mat3& bias_covariance() const { return p_b_; }
   // kJoint: the whole covariance of [a; r; k; b; d] as it stands (rows of a step may be pending).
+  // A latched window's step (or its fault-torque scoring) is still under way.
+  bool stepping() const { return phase_ != Phase::kIdle; }
   // reinflate_all's rewrite of the joint covariance waits for the next update with a free block.
   bool covariance_rewrite_pending() const { return fill_pending_; }
+  // The next block is the joint step's linearisation, the heaviest (about 3 k Cortex-M7
+  // instructions): the executive keeps its other periodic work off that tick.
+  bool heavy_block_next() const {
+    return !fill_pending_ && phase_ == Phase::kInertia && c_.mode == IdentifierMode::kJoint;
+  }
   // The joint covariance (completes a re-inflation's deferred rewrite first).
   const MatId& joint_covariance();
   const IdentifierFaultTorque& fault_torque() const { return ft_; }
@@ -345,6 +352,7 @@ class Identifier {
   // reinflate_all: every pending block of rows (joint step, anchor, settling) on the kept rows
   // only.
   void finish_kept_rows(const std::array<bool, kIdParams>& kept);
+  void anchor_scale_finish();
   // reinflate_all's rewrite of p_all_, deferred to the identifier's next block (or to whatever
   // reads p_all_ first).
   void complete_reinflation();
@@ -415,6 +423,9 @@ class Identifier {
   struct AnchorStep {  // the thrust-scale anchor's covariance term, a block of rows per tick
     bool pending{false};
     int rows{0};
+    bool pc_pending{false};   // P c begun (the first eight thrusters); its end and x on the next block
+    VecId c{VecId::Zero()};
+    double b{0.0};
     VecId pc{VecId::Zero()};  // P c
     VecId g{VecId::Zero()};   // P c / (c' P c)
   };
