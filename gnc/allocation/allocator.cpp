@@ -60,7 +60,7 @@ Sym3 eig3(const Mat3& m) {
 // set of columns gives e or d at rounding level; d is used only while its rounding is far below
 // the threshold). It also saves the eigen-decomposition on the tick
 // a latch valve first closes (the Cortex-M7 budget).
-int rank_of_gram(const Mat3& m, const Sym3* e3) {
+int rank_of_gram(const Mat3& m) {
   const double t = m.trace();
   if (!(t > 0.0)) return 0;
   const double e = 0.5 * (t * t - (m * m).trace());
@@ -78,10 +78,10 @@ int rank_of_gram(const Mat3& m, const Sym3* e3) {
   }
   if (low2 == 1 && low1 >= 0) return 2 + low1;
   // In the band: the eigenvalues decide.
-  const Sym3 own = e3 != nullptr ? *e3 : eig3(m);
-  const double top = own.lambda.maxCoeff();
+  const Sym3 e3 = eig3(m);
+  const double top = e3.lambda.maxCoeff();
   int r = 0;
-  for (int i = 0; i < 3; ++i) r += own.lambda(i) > kRankTol * top ? 1 : 0;
+  for (int i = 0; i < 3; ++i) r += e3.lambda(i) > kRankTol * top ? 1 : 0;
   return std::max(r, 1);
 }
 
@@ -99,7 +99,7 @@ Mat3 gram_of(const Mat38& b, std::uint8_t cols) {
 // minimum-norm least-squares inverse (the right inverse when rank 3).
 Mat83 pinv_of(const Mat38& b, std::uint8_t cols, int& rank) {
   const Mat3 m = gram_of(b, cols);
-  rank = rank_of_gram(m, nullptr);
+  rank = rank_of_gram(m);
   Mat3 inv = Mat3::Zero();
   if (rank == 3) {
     inv = m.inverse();  // as Eq. (53) in configure()
@@ -150,7 +150,7 @@ Authority authority(const Mat38& b, const Vec8& lo, const Vec8& hi) {
     if (up) gen[static_cast<std::size_t>(n++)] = b.col(i);
     if (down) gen[static_cast<std::size_t>(n++)] = -b.col(i);
   }
-  a.rank = rank_of_gram(gram_of(b, act), nullptr);
+  a.rank = rank_of_gram(gram_of(b, act));
   if (a.rank < 3) return a;
   // Every active channel may push both ways (a closed pod, nominal limits): the generators come in
   // pairs +-B_i, so their cone is their span, R^3 at rank 3. The pair test below is only for

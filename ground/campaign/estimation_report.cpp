@@ -2,6 +2,16 @@
 
 namespace rocksteady::campaign {
 
+namespace {
+nlohmann::json opt(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+std::optional<double> to_opt(const nlohmann::json& j) {
+  if (j.is_null()) return std::nullopt;
+  return j.get<double>();
+}
+}  // namespace
+
 nlohmann::json estimation_json(const EstimationReport& e) {
   nlohmann::json marks = nlohmann::json::array();
   for (const IdentificationMark& m : e.marks) {
@@ -18,8 +28,7 @@ nlohmann::json estimation_json(const EstimationReport& e) {
   }
   nlohmann::json strengths = nlohmann::json::array();
   for (const StrengthMark& m : e.strengths) {
-    strengths.push_back({{"first_fired_s", m.first_fired_s ? nlohmann::json(*m.first_fired_s)
-                                                            : nlohmann::json(nullptr)},
+    strengths.push_back({{"first_fired_s", opt(m.first_fired_s)},
                          {"reached", m.reached},
                          {"err", m.err},
                          {"sigma", m.sigma},
@@ -36,16 +45,6 @@ nlohmann::json estimation_json(const EstimationReport& e) {
           {"identification", marks},
           {"strengths_after_firing", strengths}};
 }
-
-namespace {
-nlohmann::json opt(const std::optional<double>& v) {
-  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-}
-std::optional<double> to_opt(const nlohmann::json& j) {
-  if (j.is_null()) return std::nullopt;
-  return j.get<double>();
-}
-}  // namespace
 
 nlohmann::json replan_json(const ReplanReport& r) {
   nlohmann::json plans = nlohmann::json::array();
