@@ -38,9 +38,9 @@ void report(const planner::PlanResult& r) {
   std::printf("open loop       max error %.3g rad/s, final rate %.3g rad/s\n", v.propagation_error,
               v.propagated_final_rate);
   if (v.refinement_checked) {
-    std::printf("refined grid    %.4f kg (change %.4f %%), %d iterations, %.3f s\n",
-                v.refined_fuel_kg, 100.0 * v.refinement_change, v.refined_iterations,
-                v.refined_seconds);
+    std::printf("grid check      %.4f kg on %d nodes (change %.4f %%), %d iterations, %.3f s\n",
+                v.refined_fuel_kg, v.refined_nodes, 100.0 * v.refinement_change,
+                v.refined_iterations, v.refined_seconds);
   }
 }
 
@@ -100,7 +100,17 @@ int main(int argc, char** argv) {
   app.add_flag("--free-final-time", settings.free_final_time, "let t_f float in [min, max]");
   app.add_option("--tolerance", settings.tolerance, "IPOPT convergence tolerance (scaled NLP)")
       ->check(CLI::PositiveNumber);
-  app.add_flag("--no-refinement", no_refinement, "skip the grid-refinement check");
+  app.add_flag("--no-refinement", no_refinement, "skip the grid-convergence check");
+  std::string refinement_check = "coarsen";
+  app.add_option("--refinement-check", refinement_check,
+                 "grid-convergence check: coarsen (re-solve on every other node) or bisect "
+                 "(every interval halved)")
+      ->check(CLI::IsMember({"coarsen", "bisect"}));
+  settings.jobs = 0;
+  app.add_option("--jobs", settings.jobs,
+                 "long horizons: candidate despins solved in this many worker processes at once "
+                 "(0 = one per hardware thread, 1 = in this process)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("-o,--output", output, "trajectory file to write");
   app.add_option("--cache-dir", cache_dir,
                  "plan-once cache directory (file named by problem hash)");
@@ -129,6 +139,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   settings.verify_refinement = !no_refinement;
+  settings.refinement_check = refinement_check == "bisect"
+                                  ? planner::PlanSettings::RefinementCheck::kBisect
+                                  : planner::PlanSettings::RefinementCheck::kCoarsen;
   settings.tumble_grid = tumble_grid;
   if (study_horizon) {
     if (settings.t_final_max > 0.0) {

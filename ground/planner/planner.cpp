@@ -8,10 +8,19 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
+#include <type_traits>
+
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "ground/planner/transcription.hpp"
 #include "gnc/model/mass_properties.hpp"
@@ -148,6 +157,9 @@ const char* status_text(Ipopt::SolverReturn s) {
   }
 }
 
+// Set in a candidate worker process (solve_candidates).
+bool g_candidate_worker = false;
+
 struct SolveOutcome {
   bool ok{false};
   std::string error;
@@ -260,8 +272,11 @@ SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
   // MPI stub and Fortran state are process-global (two campaign workers re-planning at once ended
   // in "double free or corruption"). The solves do not depend on each other, so results are
   // unchanged; only concurrent callers wait.
+  // A candidate worker (solve_candidates) is a single-threaded child with its own copy of MUMPS, and
+  // its copy of the mutex may have been taken by another thread of the parent at the fork.
   static std::mutex ipopt_mutex;
-  const std::lock_guard<std::mutex> ipopt_lock(ipopt_mutex);
+  std::unique_lock<std::mutex> ipopt_lock(ipopt_mutex, std::defer_lock);
+  if (!g_candidate_worker) ipopt_lock.lock();
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", settings.print_level);
   if (settings.print_level >= 5) app->Options()->SetStringValue("print_timing_statistics", "yes");
@@ -271,6 +286,9 @@ SolveOutcome solve_once(const PlanModel& model, const PlanSettings& settings,
   app->Options()->SetIntegerValue("max_iter", settings.max_iterations);
   app->Options()->SetNumericValue("bound_relax_factor", 0.0);  // bounds hold exactly
   app->Options()->SetStringValue("mu_strategy", "adaptive");
+  // No "acceptable" stop: a solve converges to `tolerance` or fails (case 3 at 2780 s stopped at
+  // an acceptable point after 75 iterations and converged at 79 without the stop).
+  app->Options()->SetIntegerValue("acceptable_iter", 0);
   if (warm != nullptr && spec.warm_mu > 0.0) {
     // Warm start [Rocksteady choice]: the guess is a converged plan of a nearby problem (another
     // grid, a shorter horizon, an earlier state), so the barrier starts small and the bounds are
@@ -380,6 +398,16 @@ std::vector<double> uniform_grid(int nodes) {
   std::vector<double> g(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) g[k] = static_cast<double>(k) / (n - 1);
   g[static_cast<std::size_t>(n - 1)] = 1.0;
+  return g;
+}
+
+// Every other node of a grid, the last one kept: (N+1)/2 nodes (N odd), N/2 + 1 (N even, the last
+// interval then spans one of the grid's).
+std::vector<double> coarsened(const std::vector<double>& grid) {
+  std::vector<double> g;
+  g.reserve(grid.size() / 2 + 2);
+  for (std::size_t k = 0; k < grid.size(); k += 2) g.push_back(grid[k]);
+  if (g.back() != grid.back()) g.push_back(grid.back());
   return g;
 }
 
@@ -616,21 +644,28 @@ namespace {
 
 PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end, SolveSpec* grid_out = nullptr);
 
-// The grid-refinement check of a plan solved on `spec`'s grid: re-solved on every interval halved
-// (2N-1 nodes), warm-started from the plan, the fuel must change by less than refinement_limit.
-// Fills r.verification's refinement fields; false (with r.error) when the check fails.
+// The grid-convergence check of a plan solved on `spec`'s grid (PlanSettings::refinement_check):
+// re-solved on every other node (kCoarsen) or on every interval halved (kBisect), warm-started from
+// the plan; the fuel must change by less than refinement_limit. Fills r.verification's refinement
+// fields; false (with r.error) when the check fails.
 bool check_refinement(const PlanModel& model, const PlanSettings& settings, const SolveSpec& spec,
                       PlanResult& r) {
   SolveSpec fine_spec = spec;
-  fine_spec.grid = bisected(spec.grid);  // every interval halved: 2N-1 nodes
+  const bool coarsen = settings.refinement_check == PlanSettings::RefinementCheck::kCoarsen &&
+                       spec.grid.size() >= 5;
+  // Coarsened: the coarse grid's points (its nodes and midpoints) are the plan's nodes on a uniform
+  // grid, so the warm start is the plan's own values there and the solve only re-balances them.
+  fine_spec.grid = coarsen ? coarsened(spec.grid) : bisected(spec.grid);
   fine_spec.nodes = static_cast<int>(fine_spec.grid.size());
+  r.verification.refined_nodes = fine_spec.nodes;
   fine_spec.warm = &r.samples;
   fine_spec.warm_mu = kWarmMu;
   const SolveOutcome fine = solve(model, settings, fine_spec);
   r.verification.refined_iterations = fine.iterations;
   r.verification.refined_seconds = fine.seconds;
   if (!fine.ok) {
-    r.error = "verification failed: refined grid: " + fine.error;
+    r.error = std::string("verification failed: ") + (coarsen ? "coarsened" : "refined") +
+              " grid: " + fine.error;
     return false;
   }
   r.verification.refinement_checked = true;
@@ -639,7 +674,8 @@ bool check_refinement(const PlanModel& model, const PlanSettings& settings, cons
       std::abs(r.verification.refined_fuel_kg - r.fuel_kg) / r.fuel_kg;
   if (!(r.verification.refinement_change < settings.refinement_limit)) {
     std::ostringstream msg;
-    msg << "grid refinement (" << r.nodes << " -> " << fine_spec.nodes
+    msg << (coarsen ? "grid coarsening (" : "grid refinement (") << r.nodes << " -> "
+        << fine_spec.nodes
         << " nodes) changes the fuel by " << 100.0 * r.verification.refinement_change
         << " % (limit " << 100.0 * settings.refinement_limit << " %)";
     r.verification.passed = false;
@@ -650,22 +686,260 @@ bool check_refinement(const PlanModel& model, const PlanSettings& settings, cons
   return true;
 }
 
+// One candidate despin of a long horizon: its plan (verified, not yet grid-checked) and its grid.
+struct Candidate {
+  PlanResult result;
+  SolveSpec spec;
+};
+
+Candidate solve_candidate(const PlanProblem& problem, double horizon) {
+  PlanProblem sub = problem;
+  sub.settings.t_final_max = horizon;
+  sub.settings.active_horizon_max = -1.0;  // this horizon in full
+  sub.settings.verify_refinement = false;
+  Candidate c;
+  c.result = plan_impl(sub, true, &c.spec);
+  c.result.t_final_max = horizon;
+  c.spec.warm = nullptr;
+  return c;
+}
+
+// A candidate as bytes, for the pipe from its worker process (same machine, same build).
+class Bytes {
+ public:
+  template <typename T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    buf_.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  void put_string(const std::string& v) {
+    put(v.size());
+    buf_.append(v);
+  }
+  const std::string& str() const { return buf_; }
+
+ private:
+  std::string buf_;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::string& buf) : buf_(buf) {}
+  template <typename T>
+  bool get(T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (buf_.size() - at_ < sizeof v) return false;
+    std::memcpy(&v, buf_.data() + at_, sizeof v);
+    at_ += sizeof v;
+    return true;
+  }
+  bool get_string(std::string& v) {
+    std::size_t n = 0;
+    if (!get(n) || buf_.size() - at_ < n) return false;
+    v.assign(buf_, at_, n);
+    at_ += n;
+    return true;
+  }
+  bool done() const { return at_ == buf_.size(); }
+
+ private:
+  const std::string& buf_;
+  std::size_t at_{0};
+};
+
+std::string encode(const Candidate& c) {
+  Bytes b;
+  const PlanResult& r = c.result;
+  b.put(r.ok);
+  b.put_string(r.error);
+  b.put(r.cost_ns);
+  b.put(r.fuel_kg);
+  b.put(r.t_final);
+  b.put(r.t_final_min);
+  b.put(r.t_final_max);
+  b.put(r.nodes);
+  b.put(r.t_active);
+  b.put(r.iterations);
+  b.put(r.solve_seconds);
+  b.put(r.samples.size());
+  for (const PlanSample& s : r.samples) {
+    b.put(s.t);
+    for (int k = 0; k < 3; ++k) b.put(s.omega_d[k]);
+    for (int k = 0; k < 3; ++k) b.put(s.omega_d_dot[k]);
+    for (int k = 0; k < 8; ++k) b.put(s.u_d[k]);
+  }
+  const Verification& v = r.verification;
+  b.put(v.passed);
+  b.put_string(v.failure);
+  b.put(v.max_defect);
+  b.put(v.max_rate_excess);
+  b.put(v.max_control_excess);
+  b.put(v.boundary_error);
+  b.put(v.propagation_error);
+  b.put(v.propagated_final_rate);
+  b.put(c.spec.nodes);
+  b.put(c.spec.grid.size());
+  for (const double g : c.spec.grid) b.put(g);
+  b.put(c.spec.t_min);
+  b.put(c.spec.t_max);
+  b.put(c.spec.rest_at_end);
+  return b.str();
+}
+
+bool decode(const std::string& bytes, Candidate& c) {
+  Reader in(bytes);
+  PlanResult& r = c.result;
+  std::size_t n = 0;
+  bool ok = in.get(r.ok) && in.get_string(r.error) && in.get(r.cost_ns) && in.get(r.fuel_kg) &&
+            in.get(r.t_final) && in.get(r.t_final_min) && in.get(r.t_final_max) &&
+            in.get(r.nodes) && in.get(r.t_active) && in.get(r.iterations) &&
+            in.get(r.solve_seconds) && in.get(n) && n <= static_cast<std::size_t>(1) << 20;
+  if (!ok) return false;
+  r.samples.resize(n);
+  for (PlanSample& s : r.samples) {
+    ok = ok && in.get(s.t);
+    for (int k = 0; k < 3; ++k) ok = ok && in.get(s.omega_d[k]);
+    for (int k = 0; k < 3; ++k) ok = ok && in.get(s.omega_d_dot[k]);
+    for (int k = 0; k < 8; ++k) ok = ok && in.get(s.u_d[k]);
+  }
+  Verification& v = r.verification;
+  ok = ok && in.get(v.passed) && in.get_string(v.failure) && in.get(v.max_defect) &&
+       in.get(v.max_rate_excess) && in.get(v.max_control_excess) && in.get(v.boundary_error) &&
+       in.get(v.propagation_error) && in.get(v.propagated_final_rate) && in.get(c.spec.nodes) &&
+       in.get(n) && n <= static_cast<std::size_t>(1) << 20;
+  if (!ok) return false;
+  c.spec.grid.resize(n);
+  for (double& g : c.spec.grid) ok = ok && in.get(g);
+  return ok && in.get(c.spec.t_min) && in.get(c.spec.t_max) && in.get(c.spec.rest_at_end) &&
+         in.done();
+}
+
+// The candidates of a long horizon, in the order of `horizons`. With PlanSettings::jobs != 1 each is
+// solved in a worker process of its own (fork; at most `jobs` at once, the longest horizons first,
+// since they take longest); the workers share nothing, so the result is the same as one after the
+// other. A worker that ends without a complete answer makes its candidate fail with the reason.
+std::vector<Candidate> solve_candidates(const PlanProblem& problem,
+                                        const std::vector<double>& horizons) {
+  const std::size_t n = horizons.size();
+  std::size_t jobs = problem.settings.jobs > 0
+                         ? static_cast<std::size_t>(problem.settings.jobs)
+                         : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+  jobs = std::min(jobs, n);
+  std::vector<Candidate> out(n);
+  if (jobs <= 1 || g_candidate_worker) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = solve_candidate(problem, horizons[i]);
+    return out;
+  }
+  const auto failed = [&](std::size_t i, const std::string& why) {
+    out[i] = Candidate{};
+    out[i].result.t_final_max = horizons[i];
+    out[i].result.error = why;
+  };
+  struct Worker {
+    pid_t pid{-1};
+    int fd{-1};
+    std::size_t index{0};
+    std::string bytes;
+  };
+  std::vector<Worker> running;
+  std::size_t next = 0;  // horizons are increasing: start from the last
+  std::fflush(nullptr);  // nothing buffered is written twice by a child
+  while (next < n || !running.empty()) {
+    while (running.size() < jobs && next < n) {
+      const std::size_t i = n - 1 - next++;
+      int fds[2];
+      if (::pipe(fds) != 0) {
+        failed(i, std::string("no pipe for a planner worker: ") + std::strerror(errno));
+        continue;
+      }
+      const pid_t pid = ::fork();
+      if (pid < 0) {
+        ::close(fds[0]);
+        ::close(fds[1]);
+        failed(i, std::string("no planner worker process: ") + std::strerror(errno));
+        continue;
+      }
+      if (pid == 0) {  // the worker: solve, write, leave without the parent's exit handlers
+        ::close(fds[0]);
+        g_candidate_worker = true;
+        std::string bytes;
+        try {
+          bytes = encode(solve_candidate(problem, horizons[i]));
+        } catch (...) {
+          ::_exit(2);
+        }
+        std::size_t at = 0;
+        while (at < bytes.size()) {
+          const ssize_t w = ::write(fds[1], bytes.data() + at, bytes.size() - at);
+          if (w < 0 && errno == EINTR) continue;
+          if (w <= 0) ::_exit(3);
+          at += static_cast<std::size_t>(w);
+        }
+        ::_exit(0);
+      }
+      ::close(fds[1]);
+      running.push_back(Worker{pid, fds[0], i, {}});
+    }
+    if (running.empty()) continue;
+    std::vector<pollfd> polls;
+    for (const Worker& w : running) polls.push_back(pollfd{w.fd, POLLIN, 0});
+    if (::poll(polls.data(), polls.size(), -1) < 0 && errno != EINTR) {
+      for (Worker& w : running) {  // cannot wait on them: stop them, their candidates fail
+        ::kill(w.pid, SIGKILL);
+        ::close(w.fd);
+        ::waitpid(w.pid, nullptr, 0);
+        failed(w.index, std::string("planner worker lost: poll: ") + std::strerror(errno));
+      }
+      running.clear();
+      continue;
+    }
+    for (std::size_t k = polls.size(); k-- > 0;) {
+      if (polls[k].revents == 0) continue;
+      Worker& w = running[k];
+      char chunk[65536];
+      const ssize_t got = ::read(w.fd, chunk, sizeof chunk);
+      if (got > 0) {
+        w.bytes.append(chunk, static_cast<std::size_t>(got));
+        continue;
+      }
+      if (got < 0 && errno == EINTR) continue;
+      ::close(w.fd);  // end of the worker's answer
+      int status = 0;
+      while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      if (!(WIFEXITED(status) && WEXITSTATUS(status) == 0 && decode(w.bytes, out[w.index]))) {
+        std::ostringstream why;
+        why << "the planner worker for the " << horizons[w.index] << " s horizon ended without a "
+            << "complete plan (";
+        if (WIFSIGNALED(status)) {
+          why << "signal " << WTERMSIG(status);
+        } else {
+          why << "exit status " << WEXITSTATUS(status) << ", " << w.bytes.size() << " bytes";
+        }
+        why << ")";
+        failed(w.index, why.str());
+      }
+      running.erase(running.begin() + static_cast<std::ptrdiff_t>(k));
+    }
+  }
+  return out;
+}
+
 // Long horizon [Rocksteady choice] (PlanSettings::active_horizon_max): the least-fuel verified plan
-// among the horizons t_auto, 2 t_auto, ... and `active` (each solved cold: a warm start from the
+// among the horizons t_auto, 2 t_auto, ... up to `active` (each solved cold: a warm start from the
 // shorter plan extended by rest stays in its local minimum, measured on cases 4 and 7), ending with
 // u_d = 0, then rest to t_final: two more samples, omega_d = 0 and u_d = 0 (Eq. 41 holds exactly
-// there). The whole plan is verified again, rest tail included.
+// there; none when the chosen despin already ends at t_final). The whole plan is verified again, rest
+// tail included.
 PlanResult plan_long(const PlanProblem& problem, double t_auto, double active, double t_final) {
-  std::vector<double> horizons;  // doubling from t_auto; none within 25 % below `active`
-  for (double h = t_auto; h < active / 1.25; h *= 2.0) horizons.push_back(h);
-  horizons.push_back(active);
+  // Doubling from t_auto up to `active`, and `active` itself when the last doubling is more than
+  // 25 % short of it.
+  std::vector<double> horizons;
+  for (double h = t_auto; h <= active; h *= 2.0) horizons.push_back(h);
+  if (horizons.empty() || horizons.back() < active / 1.25) horizons.push_back(active);
   // Every candidate is solved and verified (verify_samples) without the grid-refinement re-solve;
   // then the cheapest is refinement-checked, and, should that fail, the next cheapest, and so on:
   // the re-solves of the candidates that lose are saved.
-  struct Candidate {
-    PlanResult result;
-    SolveSpec spec;
-  };
   std::vector<Candidate> candidates;
   int iterations = 0;
   int refined_iterations = 0;
@@ -677,19 +951,13 @@ PlanResult plan_long(const PlanProblem& problem, double t_auto, double active, d
     msg << (failures.empty() ? "" : "; ") << h << " s: " << why;
     failures += msg.str();
   };
-  for (const double h : horizons) {
-    PlanProblem sub = problem;
-    sub.settings.t_final_max = h;
-    sub.settings.active_horizon_max = -1.0;  // this horizon in full
-    sub.settings.verify_refinement = false;
-    Candidate c;
-    c.result = plan_impl(sub, true, &c.spec);
+  for (Candidate& c : solve_candidates(problem, horizons)) {
     iterations += c.result.iterations;
     seconds += c.result.solve_seconds;
     if (c.result.ok) {
       candidates.push_back(std::move(c));
     } else {
-      note(h, c.result.error);
+      note(c.result.t_final_max, c.result.error);
     }
   }
   std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
@@ -727,17 +995,20 @@ PlanResult plan_long(const PlanProblem& problem, double t_auto, double active, d
     return r;
   }
   r.t_active = r.t_final;
-  PlanSample mid;
-  mid.t = 0.5 * (r.t_active + t_final);
-  PlanSample end;
-  end.t = t_final;
-  r.samples.push_back(mid);
-  r.samples.push_back(end);
-  r.t_final = t_final;
-  r.nodes += 1;
+  if (r.t_active < t_final) {
+    PlanSample mid;
+    mid.t = 0.5 * (r.t_active + t_final);
+    PlanSample end;
+    end.t = t_final;
+    r.samples.push_back(mid);
+    r.samples.push_back(end);
+    r.t_final = t_final;
+    r.nodes += 1;
+  }
   const Verification active_v = r.verification;
   r.verification = verify_samples(problem.model, r.samples, problem.settings.propagation_limit);
   r.verification.refinement_checked = active_v.refinement_checked;
+  r.verification.refined_nodes = active_v.refined_nodes;
   r.verification.refined_fuel_kg = active_v.refined_fuel_kg;
   r.verification.refinement_change = active_v.refinement_change;
   r.verification.refined_iterations = active_v.refined_iterations;
@@ -777,9 +1048,14 @@ PlanResult plan_impl(const PlanProblem& problem, bool rest_at_end, SolveSpec* gr
     double t_auto_min = 0.0;
     double t_auto = 0.0;
     resolve_final_time_bounds(model, automatic, t_auto_min, t_auto);
-    const double active = settings.active_horizon_max > 0.0 ? settings.active_horizon_max
-                                                            : std::max(kActiveHorizon, t_auto);
-    if (r.t_final_max > active) return plan_long(problem, t_auto, active, r.t_final_max);
+    const bool automatic_active = settings.active_horizon_max <= 0.0;
+    const double active =
+        automatic_active ? std::max(t_auto, std::min(kActiveHorizon, kActiveFactor * t_auto))
+                         : settings.active_horizon_max;
+    const double full_up_to = automatic_active ? std::min(active, kFullFactor * t_auto) : active;
+    if (r.t_final_max > full_up_to) {
+      return plan_long(problem, t_auto, std::min(active, r.t_final_max), r.t_final_max);
+    }
   }
   SolveSpec spec;
   spec.t_min = r.t_final_min;
@@ -970,7 +1246,7 @@ std::uint64_t problem_hash(const PlanProblem& problem) {
   std::uint64_t h = 14695981039346656037ULL;
   const PlanModel& m = problem.model;
   const PlanSettings& s = problem.settings;
-  const char tag[] = "rocksteady-plan-v2";
+  const char tag[] = "rocksteady-plan-v3";
   hash_bytes(h, tag, sizeof tag);
   for (int i = 0; i < 9; ++i) hash_double(h, m.j_hat(i / 3, i % 3));
   for (int i = 0; i < 24; ++i) hash_double(h, m.b_hat(i / 8, i % 8));
@@ -984,7 +1260,9 @@ std::uint64_t problem_hash(const PlanProblem& problem) {
   hash_double(h, s.tolerance);
   hash_double(h, s.refinement_limit);
   hash_double(h, s.propagation_limit);
+  const bool bisect = s.refinement_check == PlanSettings::RefinementCheck::kBisect;
   const std::int64_t flags = (s.verify_refinement ? 1 : 0) + (s.free_final_time ? 2 : 0) +
+                             (bisect ? 4 : 0) +
                              (s.tumble_grid ? 8 : 0) + 16 * std::int64_t{s.max_iterations};
   hash_double(h, s.intervals_per_turn);
   hash_double(h, s.active_horizon_max);

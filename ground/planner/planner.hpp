@@ -59,6 +59,13 @@ inline constexpr int kMaxRegrids = 3;
 // the fuel at 11 000 s is 0.7 % below the 5 560 s plan's, for 8x the planning time, and beyond
 // 12 775 s a 25 s grid no longer fits the on-board table.
 inline constexpr double kActiveHorizon = 5600.0;
+// ... and at most kActiveFactor automatic horizons (64 shortest despins): at u_max = 1000 N (case 4,
+// t_auto = 245 s) the candidates beyond 1 963 s needed 355-512 nodes and 20 s each to land in a
+// dearer local minimum (75.6 kg against 65.8 kg at 1 963 s). Case 1's 5 600 s is 4 t_auto.
+inline constexpr double kActiveFactor = 8.0;
+// A fixed horizon up to kFullFactor automatic horizons (and the active horizon) is planned in full;
+// a longer one as the cheapest of the doubling candidates, then rest (README.md, "Long horizons").
+inline constexpr double kFullFactor = 4.0;
 // Barrier parameter a warm-started solve starts from.
 inline constexpr double kWarmMu = 1e-7;
 // Iterations a warm-started solve gets before it is repeated cold (case 3 at 1390 s: a warm
@@ -86,17 +93,32 @@ struct PlanSettings {
   double t_final_min{0.0};
   double t_final_max{0.0};
   // Long horizons (fixed final time, automatic uniform grid): a horizon longer than the active
-  // horizon is planned as a despin over the active horizon followed by rest until t_final_max.
-  // The despin is the least-fuel verified plan among the horizons t_auto, 2 t_auto, 4 t_auto, ...
-  // up to the active horizon (t_auto = the automatic horizon, kHorizonFactor t_lower), each solved
-  // cold, so the fuel never exceeds the automatic-horizon plan's. 0 = automatic:
-  // max(kActiveHorizon, t_auto). A negative value plans every horizon in full (no rest tail).
+  // horizon, or than kFullFactor t_auto, is planned as a despin over at most min(horizon, active)
+  // followed by rest until t_final_max. The despin is the least-fuel verified plan among the
+  // horizons t_auto, 2 t_auto, 4 t_auto, ... up to that (and that itself when the last doubling is
+  // more than 25 % short of it) (t_auto = the automatic horizon, kHorizonFactor t_lower), each
+  // solved cold, so the fuel never exceeds the automatic-horizon plan's. 0 = automatic:
+  // max(t_auto, min(kActiveHorizon, kActiveFactor t_auto)). A positive value sets the active
+  // horizon and plans every horizon up to it in full; a negative one plans every horizon in full
+  // (no rest tail).
   double active_horizon_max{0.0};
   double tolerance{1e-9};    // IPOPT tol (scaled NLP)
   int max_iterations{1000};
   int print_level{0};  // IPOPT print_level (0 = quiet, 5 = per-iteration log)
-  bool verify_refinement{true};      // re-solve on a grid of 2N-1 nodes and compare the fuel
+  // The grid-convergence check of the chosen plan (README.md, "Grid-convergence check"):
+  // kCoarsen (default) re-solves on every other node, warm-started from the plan's own node values;
+  // for a transcription of order p >= 1 the coarse-fine fuel difference is (2^p - 1) times the
+  // plan's own discretisation error, so it bounds that error. kBisect re-solves on every interval
+  // halved (2N-1 nodes), which measures (1 - 2^-p) of it and costs 5-30x more.
+  enum class RefinementCheck { kCoarsen, kBisect };
+  bool verify_refinement{true};      // run the grid-convergence check and compare the fuel
+  RefinementCheck refinement_check{RefinementCheck::kCoarsen};
   double refinement_limit{0.01};     // allowed relative fuel change on refinement
+  // Long horizons: the candidate despins are solved in this many worker processes at once (each
+  // its own IPOPT and MUMPS: MUMPS is process-global, so not threads). 1: in this process, one
+  // after the other. 0: one per hardware thread. Results do not depend on it. A process that runs
+  // other threads (the campaign's workers) keeps 1: a forked child inherits only its caller.
+  int jobs{1};
   double propagation_limit{1e-3};    // allowed open-loop error, relative to |omega_init|
 };
 
@@ -129,7 +151,8 @@ struct Verification {
   double propagation_error{0.0};  // max |omega_open_loop - omega_d| at the samples, rad/s
   double propagated_final_rate{0.0};  // |omega_open_loop(t_f)|, rad/s
   bool refinement_checked{false};
-  double refined_fuel_kg{0.0};
+  int refined_nodes{0};           // nodes of the check's grid (fewer: coarsened; more: bisected)
+  double refined_fuel_kg{0.0};    // fuel of the plan re-solved on the check's grid
   double refinement_change{0.0};  // |fuel_refined - fuel| / fuel
   int refined_iterations{0};
   double refined_seconds{0.0};

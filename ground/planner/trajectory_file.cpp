@@ -171,6 +171,8 @@ std::string format_trajectory_file(const PlanProblem& problem, const PlanResult&
     << "  t_final_min: " << num(result.t_final_min) << "  # s (resolved)\n"
     << "  t_final_max: " << num(result.t_final_max) << "  # s (resolved)\n"
     << "  tolerance: " << num(s.tolerance) << "\n"
+    << "  refinement_check: "
+    << (s.refinement_check == PlanSettings::RefinementCheck::kBisect ? "bisect" : "coarsen") << "\n"
     << "  refinement_limit: " << num(s.refinement_limit) << "\n"
     << "  propagation_limit: " << num(s.propagation_limit) << "\n"
     << "  problem_hash: \"" << hex64(problem_hash(problem)) << "\"\n"
@@ -182,6 +184,7 @@ std::string format_trajectory_file(const PlanProblem& problem, const PlanResult&
     << "  iterations: " << result.iterations << "\n"
     << "  solve_seconds: " << num(result.solve_seconds) << "\n"
     << "  refined_fuel_kg: " << num(result.verification.refined_fuel_kg) << "\n"
+    << "  refined_nodes: " << result.verification.refined_nodes << "  # nodes of the grid check\n"
     << "  max_defect: " << num(result.verification.max_defect) << "  # rad/s\n"
     << "  propagation_error: " << num(result.verification.propagation_error) << "  # rad/s\n"
     << "  table_checksum: \"" << hex32(table.checksum) << "\"  # gnc::trajectory_checksum\n"
@@ -272,6 +275,19 @@ LoadResult parse_trajectory_file(const std::string& text, const std::string& nam
     f.settings.tolerance = as_double(need(settings, "tolerance", "planner."), "planner.tolerance");
     f.settings.refinement_limit =
         as_double(need(settings, "refinement_limit", "planner."), "planner.refinement_limit");
+    // Optional: files written before the coarsening check were checked by bisection.
+    if (const YAML::Node check = settings["refinement_check"]) {
+      const std::string method = check.IsScalar() ? check.as<std::string>() : std::string();
+      if (method == "coarsen") {
+        f.settings.refinement_check = PlanSettings::RefinementCheck::kCoarsen;
+      } else if (method == "bisect") {
+        f.settings.refinement_check = PlanSettings::RefinementCheck::kBisect;
+      } else {
+        throw Reject("planner.refinement_check: \"" + method + "\" is not coarsen or bisect");
+      }
+    } else {
+      f.settings.refinement_check = PlanSettings::RefinementCheck::kBisect;
+    }
     f.settings.propagation_limit =
         as_double(need(settings, "propagation_limit", "planner."), "planner.propagation_limit");
     f.problem_hash = as_hex(need(settings, "problem_hash", "planner."), "planner.problem_hash");

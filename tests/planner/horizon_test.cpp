@@ -306,5 +306,33 @@ TEST(PlannerHorizon, HorizonsBeyondTheActiveOneShareTheSameDespin) {
   EXPECT_LE(a.fuel_kg, c.fuel_kg);
 }
 
+// The candidates of a long horizon solved in worker processes (PlanSettings::jobs) give the plan
+// solved one after the other in this process, bit for bit: the workers share nothing, and the
+// choice among the candidates does not depend on the order they finish in.
+TEST(PlannerHorizon, CandidatesSolvedInWorkerProcessesGiveTheSamePlanAsInProcess) {
+  PlanProblem p;
+  p.model = study_case_model(200.0, 0.0, 0.0);
+  p.settings.active_horizon_max = 3000.0;  // candidates 1 390 s, 3 000 s
+  p.settings.t_final_max = 22000.0;
+  p.settings.jobs = 1;
+  const PlanResult serial = plan(p);
+  p.settings.jobs = 2;
+  const PlanResult parallel = plan(p);
+  ASSERT_TRUE(serial.ok) << serial.error;
+  ASSERT_TRUE(parallel.ok) << parallel.error;
+  EXPECT_EQ(serial.fuel_kg, parallel.fuel_kg);
+  EXPECT_EQ(serial.t_active, parallel.t_active);
+  EXPECT_EQ(serial.iterations, parallel.iterations);
+  EXPECT_EQ(serial.nodes, parallel.nodes);
+  EXPECT_EQ(serial.verification.refined_fuel_kg, parallel.verification.refined_fuel_kg);
+  ASSERT_EQ(serial.samples.size(), parallel.samples.size());
+  for (std::size_t i = 0; i < serial.samples.size(); ++i) {
+    EXPECT_EQ(serial.samples[i].t, parallel.samples[i].t) << i;
+    EXPECT_EQ(serial.samples[i].omega_d, parallel.samples[i].omega_d) << i;
+    EXPECT_EQ(serial.samples[i].omega_d_dot, parallel.samples[i].omega_d_dot) << i;
+    EXPECT_EQ(serial.samples[i].u_d, parallel.samples[i].u_d) << i;
+  }
+}
+
 }  // namespace
 }  // namespace rocksteady::ground::planner

@@ -229,6 +229,46 @@ TEST(Planner, PlansFromConcurrentThreadsEqualTheSerialPlan) {
   }
 }
 
+// The grid-convergence check (PlanSettings::refinement_check): the default re-solves the plan on
+// every other node. Its fuel is that of the same problem planned on its own on that grid, and a
+// plan on a grid too coarse to resolve the despin is refused by it, with the reason.
+TEST(PlannerGridCheck, CoarseningReSolvesOnEveryOtherNodeAndRefusesAnUnresolvedGrid) {
+  PlanProblem p;
+  p.model = study_case_model(200.0, 0.0, 0.0);
+  p.settings.t_final_max = 1390.0;
+  p.settings.nodes = 101;
+  const PlanResult r = plan(p);
+  ASSERT_TRUE(r.ok) << r.error;
+  ASSERT_TRUE(r.verification.refinement_checked);
+  EXPECT_EQ(r.verification.refined_nodes, 51);
+  // The same problem on 51 nodes, planned cold and without a check of its own.
+  PlanProblem coarse = p;
+  coarse.settings.nodes = 51;
+  coarse.settings.verify_refinement = false;
+  coarse.settings.propagation_limit = 1.0;  // its open-loop error is not what is compared here
+  const PlanResult c = plan(coarse);
+  ASSERT_TRUE(c.ok) << c.error;
+  EXPECT_NEAR(r.verification.refined_fuel_kg, c.fuel_kg, 1e-4 * c.fuel_kg);
+  EXPECT_NEAR(r.verification.refinement_change, std::abs(c.fuel_kg - r.fuel_kg) / r.fuel_kg, 1e-4);
+  // Bisection, the other check, re-solves on 201 nodes.
+  PlanProblem bisect = p;
+  bisect.settings.refinement_check = PlanSettings::RefinementCheck::kBisect;
+  const PlanResult b = plan(bisect);
+  ASSERT_TRUE(b.ok) << b.error;
+  EXPECT_EQ(b.verification.refined_nodes, 201);
+  EXPECT_EQ(b.fuel_kg, r.fuel_kg);  // the check does not change the plan
+  // A grid of 9 nodes (174 s intervals, about one turn of the body each) does not resolve the
+  // despin: halving it again changes the fuel by more than the limit.
+  PlanProblem unresolved = p;
+  unresolved.settings.nodes = 9;
+  unresolved.settings.propagation_limit = 1.0;
+  const PlanResult u = plan(unresolved);
+  EXPECT_FALSE(u.ok);
+  EXPECT_NE(u.error.find("grid coarsening (9 -> 5 nodes) changes the fuel by"), std::string::npos)
+      << u.error;
+  EXPECT_GT(u.verification.refinement_change, p.settings.refinement_limit);
+}
+
 TEST(Planner, InfeasibleHorizonIsAClearErrorAndWritesNoFile) {
   PlanProblem p;
   p.case_name = "too-short";

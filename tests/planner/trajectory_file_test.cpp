@@ -70,6 +70,7 @@ TEST_F(TrajectoryFileTest, RoundTripIsExact) {
   EXPECT_EQ(f.model.b_hat, problem_->model.b_hat);
   EXPECT_EQ(f.model.omega_init, problem_->model.omega_init);
   EXPECT_EQ(f.settings.nodes, 51);
+  EXPECT_EQ(f.settings.refinement_check, problem_->settings.refinement_check);
   EXPECT_EQ(f.problem_hash, problem_hash(*problem_));
   EXPECT_EQ(f.fuel_kg, result_->fuel_kg);
   EXPECT_EQ(f.t_final, result_->t_final);
@@ -142,6 +143,8 @@ TEST_F(TrajectoryFileTest, RejectsMalformedFilesWithAReason) {
                   "format");
   expect_rejected(with_fresh_crc(replace_once(t, "  u_max: ", "  u_maximum: ")), "model.u_max");
   expect_rejected(with_fresh_crc(replace_once(t, "model:", "model: [\n")), "malformed");
+  expect_rejected(with_fresh_crc(replace_once(t, "refinement_check: coarsen", "refinement_check: half")),
+                  "planner.refinement_check: \"half\" is not coarsen or bisect");
   // A sample row with a missing value.
   const std::size_t row = t.find("  - [");
   const std::size_t last_comma = t.rfind(", ", t.find('\n', row));
@@ -152,6 +155,22 @@ TEST_F(TrajectoryFileTest, RejectsMalformedFilesWithAReason) {
   std::string dropped = t;
   dropped.erase(row, t.find('\n', row) + 1 - row);
   expect_rejected(with_fresh_crc(dropped), "does not match");
+}
+
+// A file written before the coarsening check has no refinement_check key: its plan was checked by
+// bisection, which it loads as, and the problem hash then tells it from a coarsening-checked plan.
+TEST_F(TrajectoryFileTest, AFileWithoutTheGridCheckMethodLoadsAsBisected) {
+  const std::string t = text();
+  const std::size_t at = t.find("  refinement_check: coarsen\n");
+  ASSERT_NE(at, std::string::npos);
+  std::string older = t;
+  older.erase(at, std::string("  refinement_check: coarsen\n").size());
+  const LoadResult r = parse(with_fresh_crc(older));
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.file.settings.refinement_check, PlanSettings::RefinementCheck::kBisect);
+  PlanProblem bisected = *problem_;
+  bisected.settings.refinement_check = PlanSettings::RefinementCheck::kBisect;
+  EXPECT_NE(problem_hash(bisected), problem_hash(*problem_));
 }
 
 TEST_F(TrajectoryFileTest, RejectsSamplesThatNoLongerSolveTheDynamics) {
