@@ -207,6 +207,11 @@ int main(int argc, char** argv) {
                     "replan strategies: a confident identified model that the flight does not fly "
                     "yet is planned for after its adoption, waiting at most this long, s (0: off)")
         ->capture_default_str();
+    sub->add_option("--replan-adopt-settle", spec.replan.adopt_settle_tau,
+                    "replan strategies: after the flight adopts a model, no plan for this many "
+                    "time constants of its rate stage (the rate estimate relaxes to the new "
+                    "model; noisy sensors only; 0: off)")
+        ->capture_default_str();
     sub->add_option("--plan-cache", plan_cache,
                     "folder of verified trajectory files reused per model and case (default "
                     "<out>/plans; '' to replan)");

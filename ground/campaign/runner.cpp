@@ -88,6 +88,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     pol.refuted_max_s = o.refuted_max_s;
     pol.on_identified = o.on_identified;
     pol.adopt_wait_s = o.adopt_wait_s;
+    pol.adopt_settle_tau = o.adopt_settle_tau;
     replanner = std::make_unique<ground::planner::Replanner>(fs.params, pol);
   }
 #else

@@ -123,6 +123,7 @@ struct ReplanOptions {
   // with the model it was planned for (0: only beyond the fixed confidence bounds, 1 % of |J|).
   double adopt_sigmas{3.0};
   double adopt_wait_s{60.0};  // a confident model the flight does not fly yet: wait for its adoption
+  double adopt_settle_tau{3.0};  // after an adoption, no plan for this many rate-stage time constants
 };
 
 // One plan of the re-planner, and what the flight did with it.

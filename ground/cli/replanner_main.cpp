@@ -177,6 +177,10 @@ int main(int argc, char** argv) {
                  "a confident identified model the flight does not fly yet: wait at most this long "
                  "for its adoption before planning for it, s (0: off)")
       ->capture_default_str();
+  app.add_option("--adopt-settle", pol.adopt_settle_tau,
+                 "after the flight adopts a model, no plan for this many time constants of its "
+                 "rate stage (the rate estimate relaxes to the new model; 0: off)")
+      ->capture_default_str();
   app.add_option("--first-upload-id", first_upload_id, "upload id of the first plan")
       ->capture_default_str();
   app.add_option("--duration", duration, "exit after this many wall seconds (< 0: never)");

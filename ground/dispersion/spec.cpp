@@ -386,6 +386,7 @@ DispersionSpec load_spec(const std::string& path) {
     if (r.has("refuted_max_s")) s.replan.refuted_max_s = r.non_negative("refuted_max_s");
     if (r.has("adopt_sigmas")) s.replan.adopt_sigmas = r.non_negative("adopt_sigmas");
     if (r.has("adopt_wait_s")) s.replan.adopt_wait_s = r.non_negative("adopt_wait_s");
+    if (r.has("adopt_settle_tau")) s.replan.adopt_settle_tau = r.non_negative("adopt_settle_tau");
     if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
       r.fail("first_plan_max_s", "must not be below first_plan_s");
     }

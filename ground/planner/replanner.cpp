@@ -90,6 +90,14 @@ Replanner::Replanner(const gnc::GncParams& flight, const ReplanPolicy& policy,
       policy_(policy),
       next_upload_id_(first_upload_id) {}
 
+double Replanner::settle_s() const {
+  if (!(policy_.adopt_settle_tau > 0.0)) return 0.0;
+  double omega_c = 0.0;  // the rate stage's cutoff, rad/s (0: the rate is the gyro's)
+  if (flight_.estimator.kind == gnc::EstimatorKind::kFilter) omega_c = flight_.estimator.omega_c;
+  if (flight_.estimator.kind == gnc::EstimatorKind::kMekf) omega_c = flight_.mekf.rate_cutoff;
+  return omega_c > 0.0 ? policy_.adopt_settle_tau / omega_c : 0.0;
+}
+
 bool Replanner::awaiting_adoption(const gnc::GncTelemetry& tl) const {
   if (!identified_ || !(policy_.adopt_wait_s > 0.0)) return false;
   if (tl.t - t_identified_ >= policy_.adopt_wait_s) return false;
@@ -133,6 +141,7 @@ std::optional<Delivery> Replanner::update(const gnc::GncTelemetry& tl) {
   if (tl.est.adoptions != adoptions_flown_) {
     // The flight adopted its identified model at this boundary: the one in this telemetry.
     adoptions_flown_ = tl.est.adoptions;
+    t_adopted_ = tl.t;
     if (const auto id = identified_params(flight_, tl.est)) flown_ = *id;
   }
   if (resync_ && flying_table_ != nullptr) {
@@ -197,7 +206,7 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
     }
     if (tl.t < policy_.first_plan_s) return std::nullopt;
     if (!identified_ && tl.t < policy_.first_plan_max_s) return std::nullopt;
-    if (awaiting_adoption(tl)) return std::nullopt;
+    if (awaiting_adoption(tl) || settling(tl)) return std::nullopt;
     if (!identified_ && tl.t < policy_.refuted_max_s && tl.est.identifying &&
         tl.est.windows > 0 &&
         !apriori_confirmed(flight_, tl.est, policy_.early_sigmas,
@@ -207,7 +216,7 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
     }
     return ReplanTrigger::kFirst;
   }
-  if (tl.mode != gnc::Mode::kTrack || resync_) return std::nullopt;
+  if (tl.mode != gnc::Mode::kTrack || resync_ || settling(tl)) return std::nullopt;
   const double w = tl.omega_hat.norm();
   const PlanModel m = replan_model(model_, tl.omega_hat);
   if (w < policy_.stop_rate_fraction * first_rate_ || t_end_ - tl.t < shortest_despin(m)) {

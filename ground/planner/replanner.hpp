@@ -69,6 +69,15 @@ struct ReplanPolicy {
   // the flight adopts such a model at its next boundary), the plan waits for the adoption, at
   // most adopt_wait_s after the model became confident (<= 0: off).
   double adopt_wait_s{60.0};
+  // After the flight adopts a model, no plan for adopt_settle_tau time constants of its rate
+  // stage (<= 0: off). With noisy sensors the flight's rate estimate is predicted through Eq. (2)
+  // with its model and pulled towards the gyro with the gain 1 - exp(-omega_c dt) (the SPEC §6
+  // filter, and the MEKF's rate stage M8): a model off by dJ biases it by about
+  // |J^-1 (dJ w) x w| / omega_c (case 7 on its a-priori model: 2.3e-3 rad/s, 7 % of |w|), and
+  // after an adoption that bias decays as exp(-omega_c t). A plan made meanwhile starts from a
+  // rate that is not the flight's. 3 time constants (48 s at the SPEC's omega_c) leave 5 %. No
+  // wait when the estimate is the measurement (noise-free sensors, no rate stage).
+  double adopt_settle_tau{3.0};
   double stop_rate_fraction{0.05};
   int max_plans{20};
 };
@@ -135,6 +144,12 @@ class Replanner {
   gnc::GncParams model_;
   gnc::GncParams flown_;  // the flight's active model: the table, then each adopted model
   std::uint32_t adoptions_flown_{0};
+  double t_adopted_{0.0};  // flight time of the last adoption seen
+  // After an adoption, the rate stage's settling time (ReplanPolicy::adopt_settle_tau), s.
+  double settle_s() const;
+  bool settling(const gnc::GncTelemetry& tl) const {
+    return adoptions_flown_ > 0 && tl.t - t_adopted_ < settle_s();
+  }
   bool identified_{false};
   double t_identified_{0.0};
   ReplanPolicy policy_;
