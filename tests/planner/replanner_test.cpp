@@ -343,5 +343,47 @@ TEST(Replanner, AConfidentModelTheFlightDoesNotFlyYetIsPlannedForAfterItsAdoptio
   EXPECT_NEAR(off[0].t_state, 20.0, 1e-9);
 }
 
+// adopt_settle_tau: with noisy sensors the flight's rate estimate is predicted with its model and
+// pulled towards the gyro at the rate stage's cutoff omega_c, so after an adoption it relaxes to
+// the new model's value as exp(-omega_c t); no plan is made for adopt_settle_tau / omega_c after
+// it. The SPEC §6 filter's omega_c and the MEKF's rate stage each set their own wait; with the
+// measurement as the estimate (noise-free sensors) there is nothing to wait for.
+TEST(Replanner, AfterAnAdoptionNoPlanIsMadeUntilTheRateStageHasSettled) {
+  const Vec3 w(0.01, 0.02, 0.03);
+  const auto first_plan = [&](const gnc::GncParams& table, double tau) {
+    ReplanPolicy pol = policy(0.0);
+    pol.first_plan_s = 10.0;
+    pol.first_plan_max_s = 200.0;
+    pol.adopt_wait_s = 60.0;
+    pol.adopt_settle_tau = tau;
+    const double sj = 5e-4 * gnc::total_inertia(table.mass_hat).norm();
+    Replanner rp(table, pol);
+    for (int k = 0; k < 3000; ++k) {
+      const double t = k * table.dt;
+      gnc::GncTelemetry tl = tlm(t, gnc::Mode::kDetumble, w);
+      tl.est = report(table, sj, 0.01, 0, 10.0 * sj);  // refutes the table: waits for adoption
+      tl.est.inertia_confident = t >= 20.0 - 1e-9;
+      tl.est.offset_confident = tl.est.inertia_confident;
+      tl.est.adoptions = t >= 35.0 - 1e-9 ? 1u : 0u;
+      if (rp.update(tl)) break;
+    }
+    EXPECT_EQ(rp.records().size(), 1u);
+    return rp.records().empty() ? -1.0 : rp.records().front().t_state;
+  };
+  gnc::GncParams filter = case1_table();
+  filter.estimator.kind = gnc::EstimatorKind::kFilter;  // omega_c = 0.02 pi rad/s
+  const double settle = 3.0 / filter.estimator.omega_c;  // 47.7 s
+  // The first telemetry tick at or after the adoption + the settling time.
+  EXPECT_NEAR(first_plan(filter, 3.0), std::ceil((35.0 + settle) / filter.dt) * filter.dt, 1e-6);
+  gnc::GncParams mekf = case1_table();
+  mekf.estimator.kind = gnc::EstimatorKind::kMekf;
+  mekf.mekf.rate_cutoff = 0.1;  // 30 s
+  EXPECT_NEAR(first_plan(mekf, 3.0), 65.0, 1e-6);
+  mekf.mekf.rate_cutoff = 0.0;  // the MEKF's rate is the bias-corrected gyro: no rate stage
+  EXPECT_NEAR(first_plan(mekf, 3.0), 35.0, 1e-9);
+  EXPECT_NEAR(first_plan(case1_table(), 3.0), 35.0, 1e-9);  // the measurement is the estimate
+  EXPECT_NEAR(first_plan(filter, 0.0), 35.0, 1e-9);         // off
+}
+
 }  // namespace
 }  // namespace rocksteady::ground::planner
