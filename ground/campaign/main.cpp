@@ -207,6 +207,11 @@ int main(int argc, char** argv) {
                     "replan strategies: a confident identified model that the flight does not fly "
                     "yet is planned for after its adoption, waiting at most this long, s (0: off)")
         ->capture_default_str();
+    sub->add_option("--replan-offset-confident", spec.replan.offset_confident_m,
+                    "replan strategies: the flight's offset confidence bound, m (adoption and "
+                    "planning once every observable offset direction is within it; 0: the "
+                    "flight's identification.offset_confident_m)")
+        ->capture_default_str();
     sub->add_option("--replan-adopt-settle", spec.replan.adopt_settle_tau,
                     "replan strategies: after the flight adopts a model, no plan for this many "
                     "time constants of its rate stage (the rate estimate relaxes to the new "

@@ -58,7 +58,12 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   PlantBinding ports(plant);
   FlightSetup fs;
   fs.params = flight_params(setup, strategy);
-  if (strategy.replans()) fs.params.identification.adopt_sigmas = options.replan.adopt_sigmas;
+  if (strategy.replans()) {
+    fs.params.identification.adopt_sigmas = options.replan.adopt_sigmas;
+    if (options.replan.offset_confident_m > 0.0) {
+      fs.params.identification.config.r_confident = options.replan.offset_confident_m;
+    }
+  }
   fs.start_mode = strategy.needs_trajectory() ? gnc::Mode::kTrack : gnc::Mode::kDetumble;
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;
   flight.setup(fs, ports, ports);

@@ -124,6 +124,10 @@ struct ReplanOptions {
   double adopt_sigmas{3.0};
   double adopt_wait_s{60.0};  // a confident model the flight does not fly yet: wait for its adoption
   double adopt_settle_tau{3.0};  // after an adoption, no plan for this many rate-stage time constants
+  // The flight's offset confidence bound for these strategies (identification.offset_confident_m;
+  // <= 0: the flight's own): a model is adopted and planned for once the inertia is confident and
+  // every observable offset direction is within this 1 sigma.
+  double offset_confident_m{0.0};
 };
 
 // One plan of the re-planner, and what the flight did with it.

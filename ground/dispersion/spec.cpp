@@ -387,6 +387,9 @@ DispersionSpec load_spec(const std::string& path) {
     if (r.has("adopt_sigmas")) s.replan.adopt_sigmas = r.non_negative("adopt_sigmas");
     if (r.has("adopt_wait_s")) s.replan.adopt_wait_s = r.non_negative("adopt_wait_s");
     if (r.has("adopt_settle_tau")) s.replan.adopt_settle_tau = r.non_negative("adopt_settle_tau");
+    if (r.has("offset_confident_m")) {
+      s.replan.offset_confident_m = r.non_negative("offset_confident_m");
+    }
     if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
       r.fail("first_plan_max_s", "must not be below first_plan_s");
     }
