@@ -154,6 +154,46 @@ TEST(ReplanStrategy, FlightAdoptsAResolvedSmallModelErrorWithAdoptSigmas) {
   EXPECT_EQ(b.estimation.model_adoptions, 0u);
 }
 
+// Case 7 (noisy gyro, J_hat 1e7 kg m^2 and r_hat 1 m off) on the D+PD reference with the MEKF: the
+// identifier's inertia becomes confident, its offset does not reach the flight's 5 cm bound, so
+// by 1000 s nothing is adopted and no plan is made (the refuted a-priori model is waited out).
+// With the replan strategies' offset bound at 1 m (--replan-offset-confident) the flight adopts the
+// identified model and the first plan, for it, follows before 1000 s, after the rate stage has
+// settled on the adopted model (adopt_settle_tau: no plan within 3 / omega_c of the adoption).
+TEST(ReplanStrategy, AWiderOffsetBoundAdoptsAndPlansForTheIdentifiedModelInCase7) {
+  ASSERT_TRUE(have_planner());
+  const config::RunSetup s = config::load_run(kConfigs + "/mission.yaml", kConfigs + "/gnc.yaml",
+                                              kConfigs + "/cases/case7.yaml");
+  const auto fly7 = [&](double offset_confident_m, double settle_tau = 3.0) {
+    FswFlightSide flight;
+    RunOptions opt;
+    opt.duration_s = 1000.0;
+    opt.log_interval_s = 0.0;
+    opt.replan.offset_confident_m = offset_confident_m;
+    opt.replan.adopt_settle_tau = settle_tau;
+    return run_closed_loop(s, *parse_strategy("ntcl+replan:mekf"), flight, nullptr, opt);
+  };
+  const RunResult flight_bound = fly7(0.0);
+  const RunResult wide = fly7(1.0);
+  ASSERT_EQ(flight_bound.status, RunStatus::kOk) << flight_bound.note;
+  ASSERT_EQ(wide.status, RunStatus::kOk) << wide.note;
+  EXPECT_EQ(flight_bound.estimation.model_adoptions, 0u);
+  EXPECT_TRUE(flight_bound.replan.events.empty());
+  ASSERT_GE(wide.estimation.model_adoptions, 1u);
+  ASSERT_FALSE(wide.replan.events.empty());
+  const ReplanEvent& first = wide.replan.events.front();
+  EXPECT_TRUE(first.ok) << first.error;
+  EXPECT_TRUE(first.identified);
+  EXPECT_LT(first.t_state_s, 1000.0);
+  // Without the settle the plan is made at the adoption (the flight is the same until then): the
+  // settle moves it by 3 time constants of the MEKF's rate stage, to the next telemetry sample.
+  const RunResult at_adoption = fly7(1.0, 0.0);
+  ASSERT_FALSE(at_adoption.replan.events.empty());
+  const double settle = 3.0 / s.flight.mekf.rate_cutoff;
+  EXPECT_GE(first.t_state_s - at_adoption.replan.events.front().t_state_s, settle - 1e-6);
+  EXPECT_LT(first.t_state_s - at_adoption.replan.events.front().t_state_s, settle + 0.2);
+}
+
 // The bare flight core has no uplink: the replan strategy says so instead of flying half a plan.
 TEST(ReplanStrategy, CoreOnlyFlightSideRefusesTheUplinkAndTheRunSaysWhy) {
   ASSERT_TRUE(have_planner());
