@@ -704,18 +704,25 @@ Candidate solve_candidate(const PlanProblem& problem, double horizon) {
   return c;
 }
 
-// A candidate as bytes, for the pipe from its worker process (same machine, same build).
-class Bytes {
+// A candidate as bytes, for the pipe from its worker process (same machine, same build). One field
+// list (transfer) serves both directions, so writer and reader cannot disagree.
+class Writer {
  public:
   template <typename T>
-  void put(const T& v) {
+  void value(const T& v) {
     static_assert(std::is_trivially_copyable_v<T>);
     buf_.append(reinterpret_cast<const char*>(&v), sizeof v);
   }
-  void put_string(const std::string& v) {
-    put(v.size());
+  void text(const std::string& v) {
+    value(v.size());
     buf_.append(v);
   }
+  template <typename V>
+  bool count(const V& v) {
+    value(v.size());
+    return true;
+  }
+  bool ok() const { return true; }
   const std::string& str() const { return buf_; }
 
  private:
@@ -726,92 +733,90 @@ class Reader {
  public:
   explicit Reader(const std::string& buf) : buf_(buf) {}
   template <typename T>
-  bool get(T& v) {
+  void value(T& v) {
     static_assert(std::is_trivially_copyable_v<T>);
-    if (buf_.size() - at_ < sizeof v) return false;
+    if (!ok_ || buf_.size() - at_ < sizeof v) {
+      ok_ = false;
+      return;
+    }
     std::memcpy(&v, buf_.data() + at_, sizeof v);
     at_ += sizeof v;
-    return true;
   }
-  bool get_string(std::string& v) {
+  void text(std::string& v) {
     std::size_t n = 0;
-    if (!get(n) || buf_.size() - at_ < n) return false;
+    value(n);
+    if (!ok_ || buf_.size() - at_ < n) {
+      ok_ = false;
+      return;
+    }
     v.assign(buf_, at_, n);
     at_ += n;
-    return true;
   }
-  bool done() const { return at_ == buf_.size(); }
+  // Reads a length and sizes the container to it (at most 2^20 elements).
+  template <typename V>
+  bool count(V& v) {
+    std::size_t n = 0;
+    value(n);
+    ok_ = ok_ && n <= static_cast<std::size_t>(1) << 20;
+    if (ok_) v.resize(n);
+    return ok_;
+  }
+  bool ok() const { return ok_ && at_ == buf_.size(); }
 
  private:
   const std::string& buf_;
   std::size_t at_{0};
+  bool ok_{true};
 };
 
-std::string encode(const Candidate& c) {
-  Bytes b;
-  const PlanResult& r = c.result;
-  b.put(r.ok);
-  b.put_string(r.error);
-  b.put(r.cost_ns);
-  b.put(r.fuel_kg);
-  b.put(r.t_final);
-  b.put(r.t_final_min);
-  b.put(r.t_final_max);
-  b.put(r.nodes);
-  b.put(r.t_active);
-  b.put(r.iterations);
-  b.put(r.solve_seconds);
-  b.put(r.samples.size());
-  for (const PlanSample& s : r.samples) {
-    b.put(s.t);
-    for (int k = 0; k < 3; ++k) b.put(s.omega_d[k]);
-    for (int k = 0; k < 3; ++k) b.put(s.omega_d_dot[k]);
-    for (int k = 0; k < 8; ++k) b.put(s.u_d[k]);
+template <typename Io, typename C>  // C: Candidate or const Candidate
+void transfer(Io& io, C& c) {
+  auto& r = c.result;
+  io.value(r.ok);
+  io.text(r.error);
+  io.value(r.cost_ns);
+  io.value(r.fuel_kg);
+  io.value(r.t_final);
+  io.value(r.t_final_min);
+  io.value(r.t_final_max);
+  io.value(r.nodes);
+  io.value(r.t_active);
+  io.value(r.iterations);
+  io.value(r.solve_seconds);
+  if (!io.count(r.samples)) return;
+  for (auto& smp : r.samples) {
+    io.value(smp.t);
+    for (int k = 0; k < 3; ++k) io.value(smp.omega_d[k]);
+    for (int k = 0; k < 3; ++k) io.value(smp.omega_d_dot[k]);
+    for (int k = 0; k < 8; ++k) io.value(smp.u_d[k]);
   }
-  const Verification& v = r.verification;
-  b.put(v.passed);
-  b.put_string(v.failure);
-  b.put(v.max_defect);
-  b.put(v.max_rate_excess);
-  b.put(v.max_control_excess);
-  b.put(v.boundary_error);
-  b.put(v.propagation_error);
-  b.put(v.propagated_final_rate);
-  b.put(c.spec.nodes);
-  b.put(c.spec.grid.size());
-  for (const double g : c.spec.grid) b.put(g);
-  b.put(c.spec.t_min);
-  b.put(c.spec.t_max);
-  b.put(c.spec.rest_at_end);
-  return b.str();
+  auto& v = r.verification;
+  io.value(v.passed);
+  io.text(v.failure);
+  io.value(v.max_defect);
+  io.value(v.max_rate_excess);
+  io.value(v.max_control_excess);
+  io.value(v.boundary_error);
+  io.value(v.propagation_error);
+  io.value(v.propagated_final_rate);
+  io.value(c.spec.nodes);
+  if (!io.count(c.spec.grid)) return;
+  for (auto& g : c.spec.grid) io.value(g);
+  io.value(c.spec.t_min);
+  io.value(c.spec.t_max);
+  io.value(c.spec.rest_at_end);
+}
+
+std::string encode(const Candidate& c) {
+  Writer w;
+  transfer(w, c);
+  return w.str();
 }
 
 bool decode(const std::string& bytes, Candidate& c) {
   Reader in(bytes);
-  PlanResult& r = c.result;
-  std::size_t n = 0;
-  bool ok = in.get(r.ok) && in.get_string(r.error) && in.get(r.cost_ns) && in.get(r.fuel_kg) &&
-            in.get(r.t_final) && in.get(r.t_final_min) && in.get(r.t_final_max) &&
-            in.get(r.nodes) && in.get(r.t_active) && in.get(r.iterations) &&
-            in.get(r.solve_seconds) && in.get(n) && n <= static_cast<std::size_t>(1) << 20;
-  if (!ok) return false;
-  r.samples.resize(n);
-  for (PlanSample& s : r.samples) {
-    ok = ok && in.get(s.t);
-    for (int k = 0; k < 3; ++k) ok = ok && in.get(s.omega_d[k]);
-    for (int k = 0; k < 3; ++k) ok = ok && in.get(s.omega_d_dot[k]);
-    for (int k = 0; k < 8; ++k) ok = ok && in.get(s.u_d[k]);
-  }
-  Verification& v = r.verification;
-  ok = ok && in.get(v.passed) && in.get_string(v.failure) && in.get(v.max_defect) &&
-       in.get(v.max_rate_excess) && in.get(v.max_control_excess) && in.get(v.boundary_error) &&
-       in.get(v.propagation_error) && in.get(v.propagated_final_rate) && in.get(c.spec.nodes) &&
-       in.get(n) && n <= static_cast<std::size_t>(1) << 20;
-  if (!ok) return false;
-  c.spec.grid.resize(n);
-  for (double& g : c.spec.grid) ok = ok && in.get(g);
-  return ok && in.get(c.spec.t_min) && in.get(c.spec.t_max) && in.get(c.spec.rest_at_end) &&
-         in.done();
+  transfer(in, c);
+  return in.ok();
 }
 
 // The candidates of a long horizon, in the order of `horizons`. With PlanSettings::jobs != 1 each is
