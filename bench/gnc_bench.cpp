@@ -58,8 +58,9 @@ BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_hold, LawId::kNtcl, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, so3_hold, LawId::kSo3, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
 
-// Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (joint, study
-// priors, 20 s windows, automatic adoption), fault detection, L1 allocation under limits, NTCL in DETUMBLE. The rate
+// Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (gnc.yaml's
+// flight settings for this gyro: 60 s windows, the second-order term, the gate, the gyro bias;
+// study priors, automatic adoption), fault detection, L1 allocation under limits, NTCL in DETUMBLE. The rate
 // changes every tick so the identifier cycles through its windows. Reports the mean per tick and,
 // as counters, the median, 99.9th percentile and maximum single tick over the run.
 void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc) {
@@ -72,6 +73,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.mekf.rate_cutoff = 0.02 * 3.14159265358979323846;  // the rate stage (M8), as flown
   p.identification.enabled = true;
   p.identification.adopt = ModelAdoption::kAuto;
+  apply_flight_identification_settings(p, p.mekf.gyro_arw / std::sqrt(p.dt));
   p.fdi.enabled = fdi;
   p.fdi.identified_isolation = fdi;  // (F14) the identifier's fault torque, as flown
   p.mode.auto_hold = false;

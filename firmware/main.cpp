@@ -191,6 +191,9 @@ int firmware_main() {
     g_params.identification.adopt = gnc::ModelAdoption::kAuto;
     g_params.fdi.enabled = true;
     g_params.fdi.identified_isolation = true;  // (F14) the identifier's fault torque, as flown
+    // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the
+    // second-order term (I20), the gate (I18), the noise correction (I25), the gyro bias (I17).
+    gnc::apply_flight_identification_settings(g_params, g_params.mekf.gyro_arw / std::sqrt(g_params.dt));
     if (opt.excite) {  // gnc.yaml's excitation settings (§I.6)
       g_params.identification.excitation.enabled = true;
       g_params.identification.excitation.force_n = gnc::Vec3(100.0, 100.0, 400.0);

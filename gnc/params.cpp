@@ -28,6 +28,31 @@ MekfConfig build_mekf_config(const GncParams& p) {
   return c;
 }
 
+void apply_flight_identification_settings(GncParams& p, double gyro_sigma) {
+  IdentifierConfig& c = p.identification.config;
+  const bool noisy = gyro_sigma > 0.0;
+  c.mode = IdentifierMode::kJoint;
+  c.window_s = noisy ? 60.0 : 20.0;
+  c.j_prior_sigma = 1e7;
+  c.r_prior_sigma = 1.0;
+  c.k_prior_sigma = 0.01;
+  c.disturbance_sigma = 0.57735026918962576;
+  c.gyro_sigma = gyro_sigma;
+  c.gyro_bias_sigma = noisy ? 3e-5 : 0.0;
+  c.gyro_bias_estimated = false;
+  c.second_order_noise = true;
+  c.gate_chi2 = 16.27;
+  c.gate_reinflate_after = 3;
+  c.j_forget_s = 3000.0;
+  c.r_forget_s = 3000.0;
+  c.j_confident_rel = 0.01;
+  c.r_confident = 0.05;
+  c.k_confident = 0.02;
+  p.identification.adopt_interval_s = 300.0;
+  p.identification.adopt_sigmas = 0.0;
+  p.identification.mekf_bias_sigma_floor = 3e-6;
+}
+
 IdentifierConfig build_identifier_config(const GncParams& p) {
   IdentifierConfig c = p.identification.config;
   c.dt = p.dt;

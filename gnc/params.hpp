@@ -54,6 +54,13 @@ struct GncParams {
 // The study's parameters (Tables 2 and 4) with the estimated mass properties equal to the true ones.
 GncParams study_gnc_params(double u_max);
 
+// The identifier's flight settings, as configs/gnc.yaml's identification section gives them for a
+// gyro of per-sample noise gyro_sigma (rad/s): the noisy sensors' window when gyro_sigma > 0, the
+// data sheet's gyro bias only then. Enabling and adoption are left as they are. The bare-metal
+// firmware has no YAML reader and flies these; tests/config holds them equal to what the
+// configuration loader reads from gnc.yaml.
+void apply_flight_identification_settings(GncParams& p, double gyro_sigma);
+
 // The gains of every law, as ControlLaws takes them.
 LawGains law_gains(const GncParams& p);
 

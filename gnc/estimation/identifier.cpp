@@ -63,6 +63,43 @@ Mat36 inertia_regressor(const Vec3& v) {
   return l;
 }
 
+Mat3 cross_product_covariance(const Mat3& a, const Mat3& b) {
+  // E[S(a) B S(a)'] entry (i, j) = sum eps_ipk eps_jql A_pq B_kl, which for symmetric A and B
+  // is the closed form below (I20).
+  const double ta = a.trace(), tb = b.trace();
+  const Mat3 ab = a * b;
+  Mat3 out = ab + ab.transpose() - ta * b - tb * a;
+  out.diagonal().array() += ta * tb - ab.trace();
+  return out;
+}
+
+void bias_jacobian_times(const Vec3& m, const Mat6& p_a, Mat36 (&out)[3]) {
+  // Row r of L(e_k) selects parameter kSel[k][r] (I1): J e_1 = (Jxx, Jxy, Jxz), and so on.
+  static constexpr int kSel[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+  const Mat36 lmp = inertia_regressor(m) * p_a;  // L(m) P_a
+  const Mat3 sm = skew(m);
+  for (int k = 0; k < 3; ++k) {
+    Mat36 lep;
+    for (int r = 0; r < 3; ++r) lep.row(r) = p_a.row(kSel[k][r]);
+    out[k].noalias() = sm * lep;
+    out[k].noalias() += skew(Vec3::Unit(k)) * lmp;
+  }
+}
+
+Mat3 bilinear_bias_covariance(const Vec3& m, const Mat36 (&bpa)[3], const Mat3& p_b) {
+  // sum_kl P_b(k, l) (B_k P_a) B_l' = sum_k (B_k P_a) D_k',  D_k = sum_l P_b(k, l) B_l.
+  const Mat3 sm = skew(m);
+  const Mat36 lm = inertia_regressor(m);
+  Mat36 b[3];
+  for (int l = 0; l < 3; ++l) b[l] = sm * inertia_regressor(Vec3::Unit(l)) + skew(Vec3::Unit(l)) * lm;
+  Mat3 out = Mat3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const Mat36 dk = p_b(k, 0) * b[0] + p_b(k, 1) * b[1] + p_b(k, 2) * b[2];
+    out.noalias() += bpa[k] * dk.transpose();
+  }
+  return out;
+}
+
 Vec3 thruster_direction(const RcsLayout& l, int i) {
   const Vec3& d = l.channel_direction[i / 2];
   return (i % 2 == 0) ? d : Vec3(-d);
@@ -184,10 +221,11 @@ void Identifier::configure(const IdentifierConfig& c) {
   c_ = c;
   n_ = static_cast<int>(std::lround(c.window_s / c.dt));
   dist_factor_ = held_disturbance_factor(c.window_s, c.disturbance_corr_s);
-  // Ticks of one joint step: linearisation, gain rows, apply, covariance rows, finish, strengths
-  // and report. Smallest blocks that let the step end well before the next window closes.
+  // Ticks of one joint step: linearisation, the second-order term (3), gain rows, gain, a gate
+  // re-inflation (4), apply, covariance rows, finish, strengths and report. Smallest blocks that
+  // let the step end well before the next window closes.
   const auto ticks_for = [](int g, int r) {
-    return 1 + (kIdParams + g - 1) / g + 1 + 1 + (kIdParams + r - 1) / r +
+    return 1 + 3 + (kIdParams + g - 1) / g + 1 + 4 + 1 + (kIdParams + r - 1) / r +
            (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
            (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1 +
            (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick +
@@ -221,6 +259,7 @@ void Identifier::reset() {
   bias_shift_.setZero();
   bias_consider_pending_ = false;
   gated_in_row_ = 0;
+  gate_reinflation_due_ = 0;
   innovation_chi2_ = 0.0;
   fill_pending_ = false;
   p_all_.setZero();
@@ -322,6 +361,7 @@ void Identifier::reinflate_all() {
     kept[static_cast<std::size_t>(kIdD + a)] = !d_live;
   }
   finish_kept_rows(kept);
+  gate_reinflation_due_ = 0;  // this re-inflation covers the gate's (I18)
   joint_.pending = false;  // a gain from the old covariance is dropped
   joint_.started = false;
   // The joint covariance itself is rewritten on the identifier's next free tick
@@ -564,7 +604,9 @@ void Identifier::joint_gain() {
   if (joint_.any_thruster && c_.k_forget_s > 0.0) {
     d.segment<kThrusters>(kIdK).setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
   }
-  joint_.second_order = c_.second_order_noise ? second_order_noise() : Mat3::Zero();
+  // (I20) on the next ticks (second_order_step), one part per tick.
+  joint_.second_order.setZero();
+  joint_.second_order_part = 0;
   // P_f H' = D P D H' without forming P_f, a block of rows per tick (joint_gain_rows).
   joint_.h = h;
   joint_.dht = d.asDiagonal() * h.transpose();
@@ -601,14 +643,7 @@ bool Identifier::joint_gain_rows() {
     ++counters_.windows_gated;
     if (++gated_in_row_ >= c_.gate_reinflate_after) {
       gated_in_row_ = 0;
-      reinflate_block<kIdParams>(p_all_, kIdJ, 6, c_.j_prior_sigma * c_.j_prior_sigma);
-      reinflate_block<kIdParams>(p_all_, kIdR, 3, c_.r_prior_sigma * c_.r_prior_sigma);
-      reinflate_block<kIdParams>(p_all_, kIdK, kThrusters, c_.k_prior_sigma * c_.k_prior_sigma);
-      reinflate_block<kIdParams>(p_all_, kIdD, 3, c_.fault_torque_sigma * c_.fault_torque_sigma);
-      d_held_zero_ = false;
-      settle_streak_ = 0;
-      ++counters_.reinflations;
-      ++counters_.gate_reinflations;
+      gate_reinflation_due_ = 1;  // on the next blocks (gate_reinflate)
     }
     return true;
   }
@@ -619,6 +654,39 @@ bool Identifier::joint_gain_rows() {
   // (I17) b as a consider parameter: no gain, its covariance kept (Schmidt).
   if (!c_.gyro_bias_estimated) joint_.k.middleRows<3>(kIdB).setZero();
   joint_.pending = true;
+  return true;
+}
+
+bool Identifier::gate_reinflate() {
+  // (I18) Too many refused windows in a row: J, r, k and d back to their prior covariance. On the
+  // blocks after the refusal, at most eight rows and columns per block, not on the gain's own tick
+  // (the Cortex-M7 tick budget: all at once on the gain's tick it was 25.6 k instructions, on a
+  // tick of its own 22.8 k). Until the last part the covariance is the one the refused step left
+  // untouched; the step's later blocks and the published copies (sync_blocks) come after it.
+  constexpr int kHalf = kThrusters / 2;
+  switch (gate_reinflation_due_) {
+    case 1:
+      reinflate_block<kIdParams>(p_all_, kIdJ, 6, c_.j_prior_sigma * c_.j_prior_sigma);
+      break;
+    case 2:
+      reinflate_block<kIdParams>(p_all_, kIdR, 3, c_.r_prior_sigma * c_.r_prior_sigma);
+      reinflate_block<kIdParams>(p_all_, kIdD, 3, c_.fault_torque_sigma * c_.fault_torque_sigma);
+      break;
+    case 3:
+      reinflate_block<kIdParams>(p_all_, kIdK, kHalf, c_.k_prior_sigma * c_.k_prior_sigma);
+      break;
+    case 4:
+      reinflate_block<kIdParams>(p_all_, kIdK + kHalf, kHalf, c_.k_prior_sigma * c_.k_prior_sigma);
+      gate_reinflation_due_ = 0;
+      d_held_zero_ = false;
+      settle_streak_ = 0;
+      ++counters_.reinflations;
+      ++counters_.gate_reinflations;
+      return true;
+    default:
+      return false;
+  }
+  ++gate_reinflation_due_;
   return true;
 }
 
@@ -924,13 +992,17 @@ void Identifier::step_phase() {
       } else {
         update_inertia();
       }
-      phase_ = Phase::kGain;
+      phase_ = Phase::kSecondOrder;
+      break;
+    case Phase::kSecondOrder:
+      if (c_.mode != IdentifierMode::kJoint || second_order_step()) phase_ = Phase::kGain;
       break;
     case Phase::kGain:
       if (c_.mode != IdentifierMode::kJoint || joint_gain_rows()) phase_ = Phase::kOffset;
       break;
     case Phase::kOffset:
       if (c_.mode == IdentifierMode::kJoint) {
+        if (gate_reinflate()) break;
         joint_apply();
       } else {
         update_offset();
@@ -1027,7 +1099,7 @@ double Identifier::window_noise() const {
   return gyro + dist + floor * floor;
 }
 
-Mat3 Identifier::second_order_noise() const {
+bool Identifier::second_order_step() {
   // (I20): e(x) is bilinear in (k, r) and in (a, b), so linearised at the estimate it leaves
   //   e2 = dr x dF - G(da) db,   dF = sum_i dk_i I_i e_i,   G(da) db = sum_k db_k B_k da,
   //   B_k = S(m) L(e_k) + S(e_k) L(m)   (I17),
@@ -1035,39 +1107,42 @@ Mat3 Identifier::second_order_noise() const {
   // from the case-4 priors, it is much larger than the window noise; ignoring it makes the step
   // overconfident and freezes the linearisation error in. Its covariance (the second-order
   // filter's term, the errors taken as independent zero-mean Gaussians) joins S:
-  //   cov(dr x dF) = sum_kl Q_kl S(e_k) P_r S(e_l)',  Q = Phi_F P_k Phi_F',
+  //   cov(dr x dF) = cross_product_covariance(P_r, Q),  Q = Phi_F P_k Phi_F',
   //   cov(G(da) db) = sum_kl P_b,kl B_k P_a B_l'.
-  const Mat3 p_r = p_all_.block<3, 3>(kIdR, kIdR);
-  Mat316 phi_f;
-  for (int i = 0; i < kThrusters; ++i) phi_f.col(i) = latched_.impulse(i) * e_[i];
-  const Mat3 q = phi_f * p_all_.block<kThrusters, kThrusters>(kIdK, kIdK) * phi_f.transpose();
-  std::array<Mat3, 3> se;
-  for (int k = 0; k < 3; ++k) se[static_cast<std::size_t>(k)] = skew(Vec3::Unit(k));
-  Mat3 out = Mat3::Zero();
-  for (int k = 0; k < 3; ++k) {
-    const Mat3 sp = se[static_cast<std::size_t>(k)] * p_r;
-    for (int l = 0; l < 3; ++l) {
-      out.noalias() += q(k, l) * (sp * se[static_cast<std::size_t>(l)].transpose());
-    }
-  }
+  // Three parts on three ticks (the Cortex-M7 tick budget: the whole term on the linearisation's
+  // tick made it 30 k instructions): Q and the cross product; B_k P_a; the bias term.
+  if (!joint_.started || !c_.second_order_noise) return true;
   const Mat3 p_b = p_all_.block<3, 3>(kIdB, kIdB);
-  if (p_b.diagonal().maxCoeff() > 0.0) {
-    const Mat6 p_a = p_all_.topLeftCorner<6, 6>();
-    const Mat3 sm = skew(latched_.m);
-    const Mat36 lm = inertia_regressor(latched_.m);
-    std::array<Mat36, 3> bk;
-    for (int k = 0; k < 3; ++k) {
-      bk[static_cast<std::size_t>(k)] =
-          sm * inertia_regressor(Vec3::Unit(k)) + se[static_cast<std::size_t>(k)] * lm;
-    }
-    for (int k = 0; k < 3; ++k) {
-      const Mat36 bp = bk[static_cast<std::size_t>(k)] * p_a;
-      for (int l = 0; l < 3; ++l) {
-        out.noalias() += p_b(k, l) * (bp * bk[static_cast<std::size_t>(l)].transpose());
+  switch (joint_.second_order_part) {
+    case 0: {
+      // Q = Phi_F P_k Phi_F' over the thrusters that fired in the window (Phi_F col i = I_i e_i).
+      Mat3 q = Mat3::Zero();
+      for (int i = 0; i < kThrusters; ++i) {
+        const double ii = latched_.impulse(i);
+        if (ii == 0.0) continue;
+        Vec3 v = Vec3::Zero();  // sum_j P_k(i, j) I_j e_j
+        for (int j = 0; j < kThrusters; ++j) {
+          const double ij = latched_.impulse(j);
+          if (ij != 0.0) v += (p_all_(kIdK + i, kIdK + j) * ij) * e_[j];
+        }
+        q.noalias() += (ii * e_[i]) * v.transpose();
       }
+      joint_.second_order = cross_product_covariance(p_all_.block<3, 3>(kIdR, kIdR), q);
+      joint_.second_order_part = 1;
+      return false;
     }
+    case 1:
+      if (p_b.diagonal().maxCoeff() <= 0.0) break;
+      bias_jacobian_times(latched_.m, p_all_.topLeftCorner<6, 6>(), joint_.bpa);
+      joint_.second_order_part = 2;
+      return false;
+    default:
+      joint_.second_order += bilinear_bias_covariance(latched_.m, joint_.bpa, p_b);
+      break;
   }
-  return 0.5 * (out + out.transpose());
+  joint_.second_order = 0.5 * (joint_.second_order + joint_.second_order.transpose()).eval();
+  joint_.second_order_part = 0;
+  return true;
 }
 
 Mat3 Identifier::window_noise_matrix() const {

@@ -34,6 +34,16 @@ Vec6 inertia_params(const Mat3& j);
 Mat3 inertia_matrix(const Vec6& a);
 // L(v) with L(v) a = J v (I1).
 Mat36 inertia_regressor(const Vec3& v);
+// (I20) Covariance of the cross product x = a x b of independent zero-mean vectors with
+// covariances A and B (symmetric), in closed form:
+//   E[x x'] = (tr A tr B - tr(AB)) I - tr(A) B - tr(B) A + AB + BA.
+Mat3 cross_product_covariance(const Mat3& a, const Mat3& b);
+// (I20) B_k P_a, k = 0..2, with B_k = S(m) L(e_k) + S(e_k) L(m) (I17's Jacobian G(a) b = sum_k
+// b_k B_k a); L(e_k) only selects rows, so B_k P_a costs one L(m) P_a and three S(m) products.
+void bias_jacobian_times(const Vec3& m, const Mat6& p_a, Mat36 (&out)[3]);
+// (I20) cov(G(da) db) = sum_kl P_b(k, l) B_k P_a B_l' for independent da ~ N(0, P_a) and
+// db ~ N(0, P_b), from the B_k P_a of bias_jacobian_times.
+Mat3 bilinear_bias_covariance(const Vec3& m, const Mat36 (&bpa)[3], const Mat3& p_b);
 // Unit force direction e_i and position p_i (F_S, relative to SO) of physical thruster i.
 Vec3 thruster_direction(const RcsLayout& l, int i);
 Vec3 thruster_position(const RcsLayout& l, int i);
@@ -295,7 +305,7 @@ class Identifier {
     Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
   };
   enum class Phase : std::uint8_t {
-    kIdle, kInertia, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
+    kIdle, kInertia, kSecondOrder, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
     kSettleStart, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
@@ -328,11 +338,14 @@ class Identifier {
   double sample_weight(int i) const;  // w(t_i)
   double window_noise() const;        // row variance of the latched window (I5)
   Mat3 window_noise_matrix() const;   // covariance of the latched window's equation (I19)
+  bool gate_reinflate();                    // (I18) a re-inflation the gate asked for, a part per block
+  int gate_reinflation_due_{0};             // ... its next part, 1-4 (0: none)
   double torque_threshold() const;    // (I16)
   Vec3 model_torque_impulse(const Vec16& k, const Vec3& r) const;  // ∫ w tau dt (I6)
   Vec3 net_force_impulse() const;     // sum k_i e_i ∫ w F_i dt with k_hat
   Mat3 bias_jacobian() const;         // G(J_hat) of (I17)
-  Mat3 second_order_noise() const;    // (I20)
+  // (I20) The bilinear terms' covariance, one part per tick (true when it is complete).
+  bool second_order_step();
   Mat316 strength_regressor() const;  // (I11) with r_hat
   Mat3 consider_inertia() const;      // (I7)
   Mat3 consider_offset() const;
@@ -415,6 +428,8 @@ class Identifier {
     Vec3 e0{Vec3::Zero()};
     Mat3 s{Mat3::Identity()};
     Mat3 second_order{Mat3::Zero()};  // (I20) the bilinear terms' covariance
+    int second_order_part{0};          // ... the next of its parts (second_order_step)
+    Mat36 bpa[3]{};                    // ... B_k P_a (bias_jacobian_times)
     Eigen::Matrix<double, kIdParams, 3> p_ht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
     Eigen::Matrix<double, kIdParams, 3> k{Eigen::Matrix<double, kIdParams, 3>::Zero()};
   };

@@ -166,6 +166,41 @@ TEST(ConfigShipped, MekfRateCutoffIsOptionalAndChecked) {
               0.02 * 3.141592653589793, 1e-15);
 }
 
+// The bare-metal firmware flies gnc::apply_flight_identification_settings (it has no YAML
+// reader): the identifier's settings must be the ones gnc.yaml gives, with a noisy gyro (case 6)
+// and with the study's perfect one (case 1). Fails when either side changes alone.
+TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
+  for (const int n : {1, 6}) {
+    SCOPED_TRACE("case " + std::to_string(n));
+    const RunSetup run = load_run(kMission, kGnc, case_file(n));
+    const gnc::IdentificationParams& y = run.flight.identification;
+    gnc::GncParams p = gnc::study_gnc_params(200.0);
+    gnc::apply_flight_identification_settings(p, y.config.gyro_sigma);
+    const gnc::IdentificationParams& f = p.identification;
+    EXPECT_EQ(f.config.mode, y.config.mode);
+    EXPECT_EQ(f.config.window_s, y.config.window_s);
+    EXPECT_EQ(f.config.j_prior_sigma, y.config.j_prior_sigma);
+    EXPECT_EQ(f.config.r_prior_sigma, y.config.r_prior_sigma);
+    EXPECT_EQ(f.config.k_prior_sigma, y.config.k_prior_sigma);
+    EXPECT_EQ(f.config.disturbance_sigma, y.config.disturbance_sigma);
+    EXPECT_EQ(f.config.gyro_sigma, y.config.gyro_sigma);
+    EXPECT_EQ(f.config.gyro_bias_sigma, y.config.gyro_bias_sigma);
+    EXPECT_EQ(f.config.gyro_bias_estimated, y.config.gyro_bias_estimated);
+    EXPECT_EQ(f.config.second_order_noise, y.config.second_order_noise);
+    EXPECT_EQ(f.config.gate_chi2, y.config.gate_chi2);
+    EXPECT_EQ(f.config.gate_reinflate_after, y.config.gate_reinflate_after);
+    EXPECT_EQ(f.config.j_forget_s, y.config.j_forget_s);
+    EXPECT_EQ(f.config.r_forget_s, y.config.r_forget_s);
+    EXPECT_EQ(f.config.j_confident_rel, y.config.j_confident_rel);
+    EXPECT_EQ(f.config.r_confident, y.config.r_confident);
+    EXPECT_EQ(f.config.k_confident, y.config.k_confident);
+    EXPECT_EQ(f.adopt_interval_s, y.adopt_interval_s);
+    EXPECT_EQ(f.adopt_sigmas, y.adopt_sigmas);
+    EXPECT_EQ(f.mekf_bias_sigma_floor, y.mekf_bias_sigma_floor);
+  }
+  EXPECT_GT(load_run(kMission, kGnc, case_file(6)).flight.identification.config.gyro_sigma, 0.0);
+}
+
 TEST(ConfigErrors, UnreadableFile) {
   const std::string missing = kConfigs + "/cases/no_such_case.yaml";
   expect_error([&] { load_case(missing); }, missing, "", "cannot read file");
