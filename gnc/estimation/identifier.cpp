@@ -229,7 +229,7 @@ void Identifier::configure(const IdentifierConfig& c) {
            (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
            (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1 +
            (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick +
-           1 + (kIdParams + kSettleRowsPerTick - 1) / kSettleRowsPerTick;
+           2 + (kIdParams + kSettleRowsPerTick - 1) / kSettleRowsPerTick;
   };
   gain_rows_per_tick_ = 4;
   cov_rows_per_tick_ = 1;
@@ -1063,12 +1063,16 @@ void Identifier::step_phase() {
           settle_streak_ = quiet ? settle_streak_ + 1 : 0;
           if (settle_streak_ >= kSettleWindows) {
             settle_streak_ = 0;
-            phase_ = Phase::kSettleStart;  // its own tick (the Cortex-M7 tick budget)
+            phase_ = Phase::kSettleFactors;  // its own ticks (the Cortex-M7 tick budget)
           }
         }
       }
       break;
     }
+    case Phase::kSettleFactors:
+      settle_factors();
+      phase_ = settle_.factored ? Phase::kSettleStart : Phase::kIdle;
+      break;
     case Phase::kSettleStart:
       start_settle();
       phase_ = settle_.pending ? Phase::kSettle : Phase::kIdle;
@@ -1400,15 +1404,26 @@ void Identifier::score_fault_torque(int first, int n) {
   }
 }
 
-void Identifier::start_settle() {
+void Identifier::settle_factors() {
   // (I24) The perfect pseudo-measurement d = 0: x <- x - P_:d P_dd^-1 d, P <- P - P_:d P_dd^-1 P_d:
-  // (the state now, the covariance a block of rows per tick in settle_rows).
+  // its factors here, the state on the next tick (start_settle), the covariance a block of rows
+  // per tick (settle_rows). Two ticks, not one (the Cortex-M7 tick budget: together 1.5 k
+  // instructions, which with the identification excitation made one HOLD tick 20.3 k).
+  settle_.factored = false;
   if (d_held_zero_) return;
   const Mat3 p_dd = p_all_.block<3, 3>(kIdD, kIdD);
   const Eigen::LDLT<Mat3> l(p_dd);
   if (l.info() != Eigen::Success || !l.isPositive()) return;
   settle_.pd = p_all_.middleCols<3>(kIdD);
   settle_.g = settle_.pd * l.solve(Mat3::Identity());
+  settle_.factored = true;
+  settle_.generation = counters_.reinflations;
+}
+
+void Identifier::start_settle() {
+  // A re-inflation since the factors (a confirmed fault, the gate) changed P: no settling.
+  if (!settle_.factored || d_held_zero_ || settle_.generation != counters_.reinflations) return;
+  settle_.factored = false;
   VecId x;
   x << a_, r_, k_, b_, d_;
   x -= settle_.g * d_;

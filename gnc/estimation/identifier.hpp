@@ -306,7 +306,7 @@ class Identifier {
   };
   enum class Phase : std::uint8_t {
     kIdle, kInertia, kSecondOrder, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
-    kSettleStart, kSettle
+    kSettleFactors, kSettleStart, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).
   static constexpr int kFaultJetsPerTick = 2;
@@ -325,9 +325,12 @@ class Identifier {
     int rows{0};
     Eigen::Matrix<double, kIdParams, 3> pd{Eigen::Matrix<double, kIdParams, 3>::Zero()};  // P_:d
     Eigen::Matrix<double, kIdParams, 3> g{Eigen::Matrix<double, kIdParams, 3>::Zero()};   // P_:d P_dd^-1
+    bool factored{false};        // pd and g are ready (settle_factors)
+    std::uint32_t generation{0};  // ... for the covariance of this re-inflation count
   };
   SettleStep settle_{};
-  void start_settle();   // (I24) the state, and the rank-3 covariance term's factors
+  void settle_factors();  // (I24) the rank-3 covariance term's factors, on a tick of its own
+  void start_settle();   // (I24) the state from those factors
   bool settle_rows();    // ... a block of rows of the covariance (true when done)
   void finish_settle();  // ... every remaining row
   void score_fault_torque(int first, int n);  // (I23) thrusters [first, first + n)
