@@ -249,6 +249,9 @@ GncConfig load_gnc(const std::string& path) {
     }
     if (r.has("identified_windows")) fd.identified_windows = r.integer("identified_windows");
     if (r.has("identified_sweep")) fd.identified_sweep = r.boolean("identified_sweep");  // (F17)
+    if (r.has("degraded_min_loss")) {  // (F18), off when absent
+      fd.degraded_min_loss = r.non_negative("degraded_min_loss");
+    }
     p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
     r.finish();
   }

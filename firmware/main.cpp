@@ -17,6 +17,10 @@
 //                 (default 1000) until the flight closes its pod's latch valve: the fault detector,
 //                 its isolation test, the valve and the reallocation run on the counted ticks;
 //                 success then also needs that thruster, and only it, confirmed stuck on
+//   alloc=pinv    with modules=all: the pseudoinverse allocator (gnc.yaml's) instead of L1
+//   degraded=N    thruster N delivers half of what is commanded from onset=T s: the partial-loss
+//                 confirmation (gnc/fdi/README.md F18) runs on the counted ticks; success then also
+//                 needs that thruster, and only it, confirmed degraded
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -55,6 +59,8 @@ struct Options {
   bool all_modules{false};
   bool excite{false};
   int stuck{-1};                // thruster stuck on (-1: none)
+  int degraded{-1};             // thruster at half strength (-1: none)
+  bool pinv{false};             // modules=all with the pseudoinverse allocator
   std::uint32_t onset_s{1000};  // ... from this simulated time
 };
 
@@ -86,6 +92,11 @@ Options parse_options() {
     if (const char* v = value_of("stuck=")) {
       const std::uint32_t n = to_u32(v);
       o.stuck = n < 16U ? static_cast<int>(n) : -1;
+    }
+    if (const char* v = value_of("alloc=")) o.pinv = std::strncmp(v, "pinv", 4) == 0;
+    if (const char* v = value_of("degraded=")) {
+      const std::uint32_t n = to_u32(v);
+      o.degraded = n < 16U ? static_cast<int>(n) : -1;
     }
     if (const char* v = value_of("onset=")) o.onset_s = to_u32(v);
   }
@@ -186,11 +197,12 @@ int firmware_main() {
     g_params.mekf.gyro_arw = 1e-6;
     g_params.mekf.star_sigma = 4e-4;
     g_params.mekf.rate_cutoff = 0.02 * 3.14159265358979323846;  // the rate stage (M8), as flown
-    g_params.allocator = gnc::AllocatorKind::kL1;
+    g_params.allocator = opt.pinv ? gnc::AllocatorKind::kPseudoInverse : gnc::AllocatorKind::kL1;
     g_params.identification.enabled = true;
     g_params.identification.adopt = gnc::ModelAdoption::kAuto;
     g_params.fdi.enabled = true;
     g_params.fdi.identified_isolation = true;  // (F14) the identifier's fault torque, as flown
+    g_params.fdi.degraded_min_loss = 0.1;      // (F18) partial losses of thrust, as flown
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the
     // second-order term (I20), the gate (I18), the noise correction (I25), the gyro bias (I17).
     gnc::apply_flight_identification_settings(g_params, g_params.mekf.gyro_arw / std::sqrt(g_params.dt));
@@ -228,7 +240,8 @@ int firmware_main() {
   line.str("firmware: Cortex-M7 (fpv5-d16), sizeof(Gnc)=").u32(sizeof(gnc::Gnc))
       .str(" B, sizeof(GncParams)=").u32(sizeof(gnc::GncParams))
       .str(" B, dt=").fix(g_params.dt, 2).str(" s, run ").u32(opt.seconds).str(" s")
-      .str(opt.all_modules ? ", modules: MEKF + identification + FDI + L1" : ", modules: study")
+      .str(opt.all_modules ? ", modules: MEKF + identification + FDI + " : ", modules: study")
+      .str(opt.all_modules ? (opt.pinv ? "pseudoinverse" : "L1") : "")
       .str(opt.all_modules && opt.excite ? " + excitation" : "")
       .str(opt.stuck >= 0 ? ", a thruster stuck on" : "");
   line.flush();
@@ -306,6 +319,11 @@ int firmware_main() {
       const double asked = applied(c);
       applied(c) = (opt.stuck % 2 == 0) ? u_max - std::fmax(-asked, 0.0) : -u_max + std::fmax(asked, 0.0);
     }
+    if (opt.degraded >= 0 && t >= static_cast<double>(opt.onset_s)) {
+      // Thruster `degraded` delivers half of its command; its partner is unaffected.
+      const int c = opt.degraded / 2;
+      if ((opt.degraded % 2 == 0) == (applied(c) > 0.0)) applied(c) *= 0.5;
+    }
     for (int c = 0; c < gnc::kChannels; ++c) {  // a closed latch valve: the pod produces nothing
       const auto pod = static_cast<std::size_t>(g_params.rcs.channel_pod[static_cast<std::size_t>(c)]);
       if (!g_out.command.valve_open[pod]) applied(c) = 0.0;
@@ -313,6 +331,10 @@ int firmware_main() {
     const gnc::Vec3 torque = b_true * applied;
     if (opt.stuck >= 0 && confirmed_at_s < 0.0 &&
         ((g_gnc.fault_detector().confirmed_on() >> opt.stuck) & 1U) != 0) {
+      confirmed_at_s = t;
+    }
+    if (opt.degraded >= 0 && confirmed_at_s < 0.0 &&
+        ((g_gnc.fault_detector().confirmed_degraded() >> opt.degraded) & 1U) != 0) {
       confirmed_at_s = t;
     }
     body.step(dt, torque);
@@ -379,8 +401,11 @@ int firmware_main() {
   const bool safe = g_gnc.mode() == gnc::Mode::kSafe;
   // With stuck=N: the flight also confirmed that thruster stuck on, and nothing else.
   const gnc::FaultDetectorStatus& fdi = g_gnc.fault_detector().status();
-  const bool isolated = opt.stuck < 0 || (confirmed_at_s >= 0.0 && fdi.confirmed_off == 0 &&
-                                          fdi.confirmed_on == (1U << opt.stuck));
+  const bool isolated =
+      (opt.stuck < 0 || (confirmed_at_s >= 0.0 && fdi.confirmed_off == 0 &&
+                         fdi.confirmed_degraded == 0 && fdi.confirmed_on == (1U << opt.stuck))) &&
+      (opt.degraded < 0 || (confirmed_at_s >= 0.0 && fdi.confirmed_off == 0 &&
+                            fdi.confirmed_on == 0 && fdi.confirmed_degraded == (1U << opt.degraded)));
   const bool ok = isolated && (opt.start_hold ? always_hold
                                               : monotone && fell && !safe &&
                                                     (!opt.require_hold || reached_hold));
@@ -399,6 +424,20 @@ int firmware_main() {
     }
     line.str(", isolation tests ").u32(st.probes).str(", confirmed on/off masks ")
         .u32(st.confirmed_on).str("/").u32(st.confirmed_off);
+    line.flush();
+  }
+  if (opt.degraded >= 0) {
+    const gnc::FaultDetector& d = g_gnc.fault_detector();
+    line.str("fault: thruster ").u32(static_cast<std::uint32_t>(opt.degraded))
+        .str(" at half strength from ").u32(opt.onset_s).str(" s: ");
+    if (confirmed_at_s >= 0.0) {
+      line.str("confirmed degraded at ").fix(confirmed_at_s, 1).str(" s, factor ")
+          .fix(d.strength_factor(opt.degraded), 3);
+    } else {
+      line.str("NOT confirmed");
+    }
+    line.str(", confirmed on/off/degraded masks ").u32(fdi.confirmed_on).str("/")
+        .u32(fdi.confirmed_off).str("/").u32(fdi.confirmed_degraded);
     line.flush();
   }
   return ok ? 0 : 1;

@@ -102,10 +102,14 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
     // The detector takes the table now active; what it has confirmed stays latched.
     const std::uint16_t on = fdi_.confirmed_on();
     const std::uint16_t off = fdi_.confirmed_off();
+    const std::uint16_t degraded = fdi_.confirmed_degraded();
+    Vec16 factor;
+    for (int i = 0; i < kThrusters; ++i) factor(i) = fdi_.strength_factor(i);
     fdi_.configure(params_.fdi, params_.rcs, params_.rcs.u_max, params_.dt);
     for (int i = 0; i < kThrusters; ++i) {
       if ((on >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOn);
       if ((off >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOff);
+      if ((degraded >> i) & 1u) fdi_.declare(i, FaultKind::kDegraded, factor(i));
     }
   }
   if (estimator_changed) {
@@ -191,7 +195,7 @@ void Gnc::apply_fault_overrides(const GncCommands& commands, ModeEvents& events)
     if (commands.fault_kind == FaultKind::kNone) {
       fdi_.clear(i);
     } else if (i >= 0 && i < kThrusters) {
-      fdi_.declare(i, commands.fault_kind);
+      fdi_.declare(i, commands.fault_kind, commands.fault_factor);
       if (params_.identification.enabled) ident_.reinflate_thruster(i);
     }
     ModeEvent e{EventId::kFaultOverride, mode, mode, TransitionCheck::kOk};
@@ -304,6 +308,12 @@ AllocatorLimits Gnc::allocation_limits() const {
     l.lo(c) = minus_ok ? -params_.rcs.strength(tm) * u_max : 0.0;
     if (open && ((on >> tp) & 1u)) l.bias += b.col(c) * (params_.rcs.strength(tp) * u_max);
     if (open && ((on >> tm) & 1u)) l.bias -= b.col(c) * (params_.rcs.strength(tm) * u_max);
+  }
+  if (fdi_.confirmed_degraded() != 0) {  // (F18) a jet latched degraded: its factor of it
+    for (int c = 0; c < kChannels; ++c) {
+      l.hi(c) *= fdi_.strength_factor(2 * c);
+      l.lo(c) *= fdi_.strength_factor(2 * c + 1);
+    }
   }
   return l;
 }
@@ -451,6 +461,13 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     in.omega = mekf ? Vec3(m.omega - id_bias_) : m.omega;
     in.omega_valid = m.omega_valid && (!mekf || mekf_.initialised());
     in.force = last_force_;
+    // (F18) A thruster latched degraded delivers its factor of what was commanded: the identifier
+    // fits its strength relative to that (k_hat near 1 again once the factor is right).
+    if (fdi_.confirmed_degraded() != 0) {
+      for (int c = 0; c < kChannels; ++c) {
+        in.force(c) *= fdi_.strength_factor(in.force(c) >= 0.0 ? 2 * c : 2 * c + 1);
+      }
+    }
     // While the detector suspects a fault it has not isolated, the identifier does not fit it
     // into J, r and k: those windows are discarded (gnc/fdi/README.md (F7)).
     // With the stuck-on isolation inside identification (F14), a suspected stuck-on is what the
@@ -612,6 +629,13 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       }
     }
   }
+  if (fdi_.confirmed_degraded() != 0) {
+    // (F18) A thruster latched degraded produces its factor of its strength: commanded that much
+    // more (the limits above kept it within u_max).
+    for (int c = 0; c < kChannels; ++c) {
+      u(c) /= fdi_.strength_factor(u(c) >= 0.0 ? 2 * c : 2 * c + 1);
+    }
+  }
   Vec8 force = Vec8::Zero();
   for (int c = 0; c < kChannels; ++c) {
     const double k = u(c) >= 0.0 ? params_.rcs.strength(2 * c) : params_.rcs.strength(2 * c + 1);
@@ -657,6 +681,12 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   f.suspected_off = fs.suspected_off;
   f.confirmed_on = fs.confirmed_on;
   f.confirmed_off = fs.confirmed_off;
+  // The factors are all 1 unless a thruster is latched degraded: copied only then, or when the
+  // last latch was cleared (the Cortex-M7 budget: 16 copies a tick otherwise).
+  if (fs.confirmed_degraded != 0 || f.confirmed_degraded != 0) {
+    for (int i = 0; i < kThrusters; ++i) f.strength_factor(i) = fdi_.strength_factor(i);
+  }
+  f.confirmed_degraded = fs.confirmed_degraded;
   f.valve_open = commanded_valves();
   f.isolation_inhibited = isolation_inhibited_;
   f.windows = fs.windows;
@@ -667,9 +697,12 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
 
 void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
   EstimationTelemetry& e = tl.est;
-  e = EstimationTelemetry{};
-  if (params_.estimator.kind == EstimatorKind::kMekf) {
-    e.mekf = true;
+  const bool mekf = params_.estimator.kind == EstimatorKind::kMekf;
+  // With the MEKF and the identifier both running every field is written below; otherwise the
+  // telemetry is cleared first (the clear alone is 270 Cortex-M7 instructions a tick).
+  if (!mekf || !params_.identification.enabled) e = EstimationTelemetry{};
+  e.mekf = mekf;
+  if (mekf) {
     e.gyro_bias = mekf_.bias();
     e.attitude_sigma = mekf_.attitude_sigma();
     e.bias_sigma = mekf_.bias_sigma();
@@ -688,11 +721,15 @@ void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
   e.k_sigma = est.k_sigma;
   e.inertia_confident = est.inertia_confident;
   e.offset_confident = est.offset_confident;
+  std::uint16_t confident = 0;
+  std::uint16_t excited = 0;
   for (int i = 0; i < kThrusters; ++i) {
     const auto b = static_cast<std::uint16_t>(1u << i);
-    if (est.thruster_confident[static_cast<std::size_t>(i)]) e.thruster_confident |= b;
-    if (exc.thruster[static_cast<std::size_t>(i)]) e.excited_thrusters |= b;
+    if (est.thruster_confident[static_cast<std::size_t>(i)]) confident |= b;
+    if (exc.thruster[static_cast<std::size_t>(i)]) excited |= b;
   }
+  e.thruster_confident = confident;
+  e.excited_thrusters = excited;
   e.excited_inertia = exc.inertia_scale;
   e.excited_offset = exc.offset;
   e.offset_unobservable = static_cast<std::uint8_t>(ident_.observability().offset_unobservable);

@@ -77,6 +77,7 @@ const char* to_string(FaultKind k) {
     case FaultKind::kNone: return "none";
     case FaultKind::kStuckOn: return "stuck-on";
     case FaultKind::kStuckOff: return "stuck-off";
+    case FaultKind::kDegraded: return "degraded";
   }
   return "?";
 }

@@ -72,7 +72,7 @@ enum class EventId : std::uint8_t {
 };
 
 // Thruster fault kinds the flight software declares (gnc/fdi).
-enum class FaultKind : std::uint8_t { kNone = 0, kStuckOn = 1, kStuckOff = 2 };
+enum class FaultKind : std::uint8_t { kNone = 0, kStuckOn = 1, kStuckOff = 2, kDegraded = 3 };
 const char* to_string(FaultKind k);
 const char* to_string(EventId e);
 
@@ -127,6 +127,7 @@ struct GncCommands {
   bool has_fault_declaration{false};
   std::int8_t fault_thruster{-1};        // 0..15; -1 with kNone: clear every declaration
   FaultKind fault_kind{FaultKind::kNone};  // kNone: clear
+  double fault_factor{1.0};  // kDegraded: the fraction of its thrust the thruster still delivers
   bool has_valve{false};
   std::int8_t valve_pod{0};
   bool valve_open{true};
@@ -190,6 +191,8 @@ struct FdiTelemetry {
   std::uint16_t suspected_off{0};
   std::uint16_t confirmed_on{0};
   std::uint16_t confirmed_off{0};
+  std::uint16_t confirmed_degraded{0};  // (F18) latched partial losses of thrust
+  Vec16 strength_factor{Vec16::Ones()};  // (F18) latched strength factor per thruster, 1 unless degraded
   std::array<bool, kPods> valve_open{{true, true, true, true}};
   bool isolation_inhibited{false};
   std::uint32_t windows{0};

@@ -146,6 +146,8 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   m.fdi_suspected_off = f.suspected_off;
   m.fdi_confirmed_on = f.confirmed_on;
   m.fdi_confirmed_off = f.confirmed_off;
+  m.fdi_confirmed_degraded = f.confirmed_degraded;
+  for (int i = 0; i < gnc::kThrusters; ++i) m.fdi_strength_factor[i] = f.strength_factor(i);
   for (int p = 0; p < gnc::kPods; ++p) m.valve_open[p] = f.valve_open[static_cast<std::size_t>(p)] ? 1 : 0;
   m.isolation_inhibited = f.isolation_inhibited ? 1 : 0;
   m.fdi_windows = f.windows;

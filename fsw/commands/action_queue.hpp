@@ -33,6 +33,7 @@ struct Action {
   std::int8_t thruster{-1};  // kFaultDeclare; kValve: the pod
   gnc::FaultKind fault{gnc::FaultKind::kNone};
   bool flag{false};          // kValve: open; kIsolation: inhibited
+  double factor{1.0};        // kFaultDeclare of a degraded thruster: its strength factor
 };
 
 class ActionQueue {

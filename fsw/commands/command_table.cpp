@@ -42,7 +42,7 @@ constexpr std::array<OpcodeSpec, kOpcodeCount> kTable{{
     {Opcode::kParamDump, 0, 0, kAllModes, {}},
     {Opcode::kKeyRotate, 1, 1, kAllModes, {integer(1, kIdMax)}},
     {Opcode::kParamLoadIdentified, 0, 0, kAllModes, {}},
-    {Opcode::kFaultDeclare, 2, 2, kAllModes, {integer(0, 15), integer(1, 2)}},
+    {Opcode::kFaultDeclare, 2, 3, kAllModes, {integer(0, 15), integer(1, 3), real(0.01, 0.99)}},
     {Opcode::kFaultClear, 1, 1, kAllModes, {integer(-1, 15)}},
     {Opcode::kValve, 2, 2, kAllModes, {integer(0, 3), integer(0, 1)}},
     {Opcode::kIsolationInhibit, 1, 1, kAllModes, {integer(0, 1)}},

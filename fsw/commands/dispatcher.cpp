@@ -161,6 +161,15 @@ CommandCheck CommandDispatcher::execute(const GroundCommand& cmd, const Dispatch
       a.kind = ActionKind::kFaultDeclare;
       a.thruster = static_cast<std::int8_t>(cmd.args[0]);
       a.fault = static_cast<gnc::FaultKind>(static_cast<int>(cmd.args[1]));
+      // A degraded thruster is declared with the fraction of its thrust it still delivers; a
+      // stuck one has none.
+      if (a.fault == gnc::FaultKind::kDegraded && cmd.arg_count < 3) {
+        return reject(RejectReason::kBadLength, 2, "a degraded thruster needs its strength factor");
+      }
+      if (a.fault != gnc::FaultKind::kDegraded && cmd.arg_count > 2) {
+        return reject(RejectReason::kBadLength, 2, "only a degraded thruster has a strength factor");
+      }
+      if (a.fault == gnc::FaultKind::kDegraded) a.factor = cmd.args[2];
       return enqueue_one(a);
     case Opcode::kFaultClear:
       a.kind = ActionKind::kFaultDeclare;
@@ -303,6 +312,7 @@ void CommandDispatcher::apply_pending(gnc::GncCommands& cmds, BoundaryActions& a
           cmds.has_fault_declaration = true;
           cmds.fault_thruster = a.thruster;
           cmds.fault_kind = a.fault;
+          cmds.fault_factor = a.factor;
         }
         break;
       case ActionKind::kValve:

@@ -43,6 +43,9 @@ Check validate(const FaultDetectorParams& p) {
   if (p.identified_windows < 1 || p.identified_windows > 1000) {
     return bad("fdi.identified_windows", "must be in [1, 1000]");
   }
+  if (!(p.degraded_min_loss >= 0.0 && p.degraded_min_loss < 1.0)) {
+    return bad("fdi.degraded_min_loss", "must be in [0, 1)");
+  }
   return Check{};
 }
 
@@ -60,8 +63,11 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
     }
   }
   st_ = FaultDetectorStatus{};
+  factor_.fill(1.0);
   reset_scores();
-  suspecting_ = false;  // before set_model: nothing suspected, the model is taken (F7)
+  // Before set_model: nothing suspected, the model is taken (F7).
+  suspecting_ = false;
+  deg_suspecting_ = false;
   FaultModel m;
   m.j = Mat3::Identity();
   set_model(m);
@@ -71,6 +77,9 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
 
 void FaultDetector::reset_scores() {
   score_.fill(0.0);
+  deg_cusum_.fill(0.0);
+  deg_sr_.fill(0.0);
+  deg_e_.fill(0.0);
   pool_llr_.fill(0.0);
   pool_energy_.fill(0.0);
 }
@@ -97,6 +106,7 @@ void FaultDetector::reset() {
   cancel_evaluation();
   reset_scores();
   suspecting_ = false;
+  deg_suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
@@ -106,9 +116,11 @@ void FaultDetector::reset() {
   sweep_llr_off_.fill(0.0);
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
+  const std::uint16_t degraded = st_.confirmed_degraded;
   st_ = FaultDetectorStatus{};
   st_.confirmed_on = on;
   st_.confirmed_off = off;
+  st_.confirmed_degraded = degraded;
 }
 
 void FaultDetector::set_model(const FaultModel& m) {
@@ -146,16 +158,23 @@ void FaultDetector::apply_model(const FaultModel& m) {
   }
 }
 
-void FaultDetector::declare(int thruster, FaultKind kind) {
+void FaultDetector::declare(int thruster, FaultKind kind, double factor) {
   if (thruster < 0 || thruster >= kThrusters) return;
   const auto bit = static_cast<std::uint16_t>(1u << thruster);
   st_.confirmed_on = static_cast<std::uint16_t>(st_.confirmed_on & ~bit);
   st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
+  st_.confirmed_degraded = static_cast<std::uint16_t>(st_.confirmed_degraded & ~bit);
+  factor_[static_cast<std::size_t>(thruster)] = 1.0;
   if (kind == FaultKind::kStuckOn) st_.confirmed_on |= bit;
   if (kind == FaultKind::kStuckOff) st_.confirmed_off |= bit;
+  if (kind == FaultKind::kDegraded && factor > 0.0 && factor < 1.0) {
+    st_.confirmed_degraded |= bit;
+    factor_[static_cast<std::size_t>(thruster)] = factor;
+  }
   cancel_evaluation();  // that window was scored without the fault in the model
   reset_scores();
   suspecting_ = false;
+  deg_suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
@@ -173,14 +192,19 @@ void FaultDetector::clear(int thruster) {
   if (thruster < 0) {
     st_.confirmed_on = 0;
     st_.confirmed_off = 0;
+    st_.confirmed_degraded = 0;
+    factor_.fill(1.0);
   } else if (thruster < kThrusters) {
     const auto bit = static_cast<std::uint16_t>(1u << thruster);
     st_.confirmed_on = static_cast<std::uint16_t>(st_.confirmed_on & ~bit);
     st_.confirmed_off = static_cast<std::uint16_t>(st_.confirmed_off & ~bit);
+    st_.confirmed_degraded = static_cast<std::uint16_t>(st_.confirmed_degraded & ~bit);
+    factor_[static_cast<std::size_t>(thruster)] = 1.0;
   }
   cancel_evaluation();
   reset_scores();
   suspecting_ = false;
+  deg_suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
   end_probe_verdict();
@@ -253,6 +277,15 @@ void FaultDetector::identified_evidence(const StuckOnEvidence& e) {
 FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   pending_ = FaultEvents{};
   if (!p_.enabled) return pending_;
+  // (F18) A jet latched degraded delivers its factor of what is commanded: everything (the
+  // prediction, the hypotheses' ramps, the sweep's delivered thrust) sees the delivered thrust.
+  if (st_.confirmed_degraded == 0) return step(in);
+  scaled_ = in;
+  for (int i = 0; i < kThrusters; ++i) scaled_.thrust(i) *= factor_[static_cast<std::size_t>(i)];
+  return step(scaled_);
+}
+
+FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   if (identified_confirm_ >= 0) {
     // (F14) The identifier isolated a stuck-on jet: the same latch and event as (F6).
     const int thruster = identified_confirm_;
@@ -421,7 +454,7 @@ void FaultDetector::start_window(const Vec3& omega) {
 void FaultDetector::close_window() {
   // (F10) The closed set is evaluated over the next kEvaluationSteps updates while the other set
   // accumulates the next window. An evaluation still running (a window shorter than the steps:
-  // not with window_ticks >= 4) is finished first.
+  // not with window_ticks >= 4, or 5 with the partial-loss step (F18)) is finished first.
   while (eval_phase_ != 0) evaluate_step();
   win_[static_cast<std::size_t>(acc_)].n = n_;
   acc_ ^= 1;
@@ -457,9 +490,14 @@ void FaultDetector::evaluate_step() {
       if (block_scan_.h >= 0) blocking_scan(block_scan_.h, kScanSplit, kHypotheses, block_scan_);
       eval_phase_ = 4;
       break;
+    case 4:
+      // (F18) The partial-loss step follows the decision (a declaration there cancels it).
+      eval_phase_ = p_.degraded_min_loss > 0.0 ? 5 : 0;
+      decide();
+      break;
     default:
       eval_phase_ = 0;
-      decide();
+      evaluate_partial_losses();
       break;
   }
 }
@@ -522,6 +560,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
       pool_llr_[k] = 0.0;
       pool_energy_[k] = 0.0;
       window_llr_[k] = 0.0;
+      if (h >= kThrusters) window_energy_[k - static_cast<std::size_t>(kThrusters)] = 0.0;
       continue;
     }
     const Vec3& b = b_[k % static_cast<std::size_t>(kThrusters)];
@@ -536,6 +575,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     lambda_[k] += llr;
     info_[k] += cc / var;
     const double energy = ss / var;
+    if (h >= kThrusters) window_energy_[k - static_cast<std::size_t>(kThrusters)] = energy;  // (F18)
     if (energy >= p_.min_signature) {  // observable in this window alone
       score_[k] = std::fmax(0.0, score_[k] + llr);
     } else if (energy > 0.0) {
@@ -1007,6 +1047,109 @@ int FaultDetector::partial_loss_alternative(int h) const {
     if (lh - partial_loss_llr(g) <= p_.margin_llr) return g;
   }
   return -1;
+}
+
+void FaultDetector::evaluate_partial_losses() {
+  // (F18) Step 5 of a window's evaluation (F10), after the decision: each jet's partial-loss
+  // CUSUM at the design loss a_c = 2 x degraded_min_loss (any loss above degraded_min_loss drifts
+  // it up, a healthy jet down), from the window's stuck-off LLR and energy (step 2):
+  //   sum S~.r~ / var = llr + E / 2,   C_g <- max(0, C_g + a_c SR_w - a_c^2 E_w / 2),
+  // and the sums of the segment since C_g was last zero. A partial loss past half the
+  // confirmation level is suspected (F7: the model is held and the identifier does not fit it).
+  const double ac = std::fmin(1.0, 2.0 * p_.degraded_min_loss);
+  const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);
+  deg_suspecting_ = false;
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto g = static_cast<std::size_t>(i);
+    if (((latched >> i) & 1u) != 0) {
+      deg_cusum_[g] = 0.0;
+      deg_sr_[g] = 0.0;
+      deg_e_[g] = 0.0;
+      continue;
+    }
+    const double ev = window_energy_[g];
+    const double srv = window_llr_[g + static_cast<std::size_t>(kThrusters)] + 0.5 * ev;
+    deg_cusum_[g] += ac * srv - 0.5 * ac * ac * ev;
+    if (deg_cusum_[g] <= 0.0) {
+      deg_cusum_[g] = 0.0;
+      deg_sr_[g] = 0.0;
+      deg_e_[g] = 0.0;
+      continue;
+    }
+    deg_sr_[g] += srv;
+    deg_e_[g] += ev;
+    if (degraded_llr(i) > 0.5 * p_.confirm_llr) deg_suspecting_ = true;
+  }
+  if (!deg_suspecting_ || probe_left_ > 0 || verdict_pending_ || sweeping()) return;
+  double loss = 0.0;
+  const int g = degraded_candidate(loss);
+  if (g < 0) return;
+  // The fitted loss's 1 sigma is 1 / sqrt(E_g) (the LLR is quadratic in it with curvature E_g),
+  // in units of the factor it multiplies.
+  const double before = factor_[static_cast<std::size_t>(g)];
+  const double factor = before * (1.0 - loss);
+  const double sigma = before / std::sqrt(deg_e_[static_cast<std::size_t>(g)]);
+  declare(g, FaultKind::kDegraded, factor);
+  ++st_.degraded_confirmations;
+  pending_.confirmed = true;
+  pending_.thruster = g;
+  pending_.kind = FaultKind::kDegraded;
+  pending_.factor = factor;
+  pending_.factor_sigma = sigma;
+}
+
+double FaultDetector::degraded_llr(int g) const {
+  // (F18) The segment's LLR of "thruster g lost a fraction a of its thrust", a in (0, 1] fitted:
+  // max_a (a SR - a^2 E / 2) = SR^2 / (2 E) for SR < E, SR - E / 2 (a = 1) beyond.
+  const auto k = static_cast<std::size_t>(g);
+  const double sr = deg_sr_[k];
+  const double e = deg_e_[k];
+  if (sr <= 0.0 || e <= 0.0) return 0.0;
+  return sr >= e ? sr - 0.5 * e : sr * sr / (2.0 * e);
+}
+
+int FaultDetector::degraded_candidate(double& loss) const {
+  // (F18) Each jet's partial-loss CUSUM (scored in step 2 at the design loss 2 x
+  // degraded_min_loss, so that any loss above degraded_min_loss drifts it up and a healthy jet
+  // drifts it down) keeps the sums SR_g, E_g of the windows since it was last zero. On them the
+  // jet's fitted loss is a = SR_g / E_g and its LLR Gamma_g = SR_g^2 / (2 E_g). The leading g is
+  // confirmed degraded when
+  //   Gamma_g > confirm_llr,
+  //   a >= degraded_min_loss + model_sigmas eps_g, with eps_g the model's relative error of g's
+  //     signature (strength, inertia, and the centre of mass against g's arm): a model error
+  //     alone does not make a loss,
+  //   Gamma_g - (SR_g - E_g / 2) > margin_llr: a partial loss, not a total one (a = 1, the
+  //     stuck-off that (F6)/(F13) decide),
+  //   Gamma_g leads every other jet's Gamma and every stuck-on / stuck-off score by margin_llr.
+  const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);
+  int g = -1;
+  double gamma_g = 0.0;
+  double second = 0.0;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (((latched >> i) & 1u) != 0) continue;
+    const double gi = degraded_llr(i);
+    if (gi > gamma_g) {
+      second = gamma_g;
+      gamma_g = gi;
+      g = i;
+    } else if (gi > second) {
+      second = gi;
+    }
+  }
+  if (g < 0 || gamma_g <= p_.confirm_llr || gamma_g - second <= p_.margin_llr) return -1;
+  const auto kg = static_cast<std::size_t>(g);
+  const double a = deg_sr_[kg] / deg_e_[kg];
+  const double arm = (pos_[kg] + m_.r).cross(dir_[kg]).norm();
+  const double kk = std::fabs(m_.k(g));
+  const double eps = (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma +
+                     (arm > 0.0 ? r_sigma_ / arm : 1.0);
+  if (a >= 1.0 || a < p_.degraded_min_loss + p_.model_sigmas * eps) return -1;
+  if (gamma_g - (deg_sr_[kg] - 0.5 * deg_e_[kg]) <= p_.margin_llr) return -1;
+  for (int h = 0; h < kHypotheses; ++h) {
+    if (gamma_g - score_[static_cast<std::size_t>(h)] <= p_.margin_llr) return -1;
+  }
+  loss = a;
+  return g;
 }
 
 void FaultDetector::blocking_scan(int h, int g_begin, int g_end, BlockingScan& scan) const {

@@ -69,6 +69,12 @@ struct FaultDetectorParams {
   // windows (pods ordered by their best-matching jet) and the step of the unexplained angular
   // acceleration at the closure and at the reopening names the stuck jet.
   bool identified_sweep{false};
+  // (F18) Partial loss of thrust ("degraded"): the jet whose fitted partial loss (F13) explains the
+  // episode best is confirmed degraded, its strength multiplied by 1 - the fitted loss, when that
+  // loss is at least degraded_min_loss (smaller is the identifier's calibration of k), it is a
+  // partial loss (not a stuck-off: its own a = 1 trails by margin_llr), and it leads every other
+  // hypothesis by margin_llr plus model_sigmas of the model's error. 0: off.
+  double degraded_min_loss{0.0};
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -112,6 +118,7 @@ struct FaultDetectorStatus {
   std::uint16_t suspected_off{0};
   std::uint16_t confirmed_on{0};   // latched
   std::uint16_t confirmed_off{0};
+  std::uint16_t confirmed_degraded{0};  // latched (F18); the strength factors are strength_factor()
   int best{-1};                 // leading hypothesis: 0..15 stuck-on, 16..31 stuck-off, -1 none
   double best_llr{0.0};
   double runner_up_llr{0.0};
@@ -128,6 +135,7 @@ struct FaultDetectorStatus {
   std::uint32_t identified_confirmations{0};  // faults confirmed through (F14)
   std::uint32_t sweeps{0};                    // (F17) pod sweeps started
   std::uint32_t sweep_confirmations{0};       // faults confirmed through (F17)
+  std::uint32_t degraded_confirmations{0};    // partial losses confirmed through (F18)
 };
 
 // Raised by update(); the caller turns them into events.
@@ -136,6 +144,8 @@ struct FaultEvents {
   bool confirmed{false};       // a fault was confirmed this tick
   int thruster{-1};
   FaultKind kind{FaultKind::kNone};
+  double factor{0.0};  // kDegraded: the strength factor now latched (0 < factor < 1)
+  double factor_sigma{0.0};  // ... its 1 sigma from the fit (F18)
 };
 
 class FaultDetector {
@@ -155,11 +165,14 @@ class FaultDetector {
            (eval_phase_ == 3 && st_.best_llr > p_.confirm_llr) ||
            (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping()));
   }
+  // The steps up to the decision; with the partial-loss confirmation (F18) on, a fifth follows.
   static constexpr int kEvaluationSteps = 4;
   FaultEvents update(const FaultDetectorInput& in);
 
   // Ground overrides and what the flight does after isolation.
-  void declare(int thruster, FaultKind kind);  // latches it (as if confirmed)
+  // Latches it (as if confirmed). kDegraded: the thruster delivers `factor` (0, 1] of its
+  // model's thrust from now on (a factor of 1 or out of range leaves it healthy).
+  void declare(int thruster, FaultKind kind, double factor = 1.0);
   void clear(int thruster);                    // -1: every thruster
   // (F14) Evidence from the identifier's fault torque, after each of its windows. A stuck-on it
   // isolates is confirmed on the next update (the same event and latch as (F6)).
@@ -167,10 +180,14 @@ class FaultDetector {
   const FaultDetectorStatus& status() const { return st_; }
   std::uint16_t confirmed_on() const { return st_.confirmed_on; }
   std::uint16_t confirmed_off() const { return st_.confirmed_off; }
+  std::uint16_t confirmed_degraded() const { return st_.confirmed_degraded; }
+  // (F18) The latched strength factor of thruster i: 1 unless it is confirmed degraded. The
+  // detector predicts the thruster at factor x its model's thrust; the flight allocates with it.
+  double strength_factor(int i) const { return factor_[static_cast<std::size_t>(i)]; }
   const FaultDetectorParams& params() const { return p_; }
   // A hypothesis is suspected (its score above half the confirmation level): the model it is
   // tested against is held (F7), and the identifier should not absorb the fault either.
-  bool suspecting() const { return suspecting_; }
+  bool suspecting() const { return suspecting_ || deg_suspecting_; }
   // (F17) A pod sweep is under way: the identifier's windows are not fitted meanwhile (its fault
   // torque d is constant only while every valve stays as it is).
   bool sweeping() const { return sweep_next_ >= 0; }
@@ -181,6 +198,12 @@ class FaultDetector {
   // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
   const Vec3& signature(int h) const { return sig_[static_cast<std::size_t>(h)]; }
   static constexpr int kHypotheses = 2 * kThrusters;
+  // (F13) The episode's LLR of hypothesis g (16..31, thruster g - 16) as a partial loss of
+  // thrust, its lost fraction fitted in (0, 1]; and the episode's unfloored LLR of h.
+  double partial_loss_llr(int g) const;
+  double episode_llr(int h) const { return lambda_[static_cast<std::size_t>(h)]; }
+  // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
+  double degraded_llr(int g) const;
 
  private:
   void close_window();
@@ -204,7 +227,21 @@ class FaultDetector {
   // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
   // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.
   int partial_loss_alternative(int h) const;
-  double partial_loss_llr(int g) const;
+  // (F18) The jet to confirm degraded now (and its fitted loss), or -1.
+  int degraded_candidate(double& loss) const;
+  void evaluate_partial_losses();
+  FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
+  std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
+  bool deg_suspecting_{false};  // (F18) a partial loss past half the confirmation level
+  FaultDetectorInput scaled_{};  // (F18) the input with degraded jets at their factor
+  std::array<double, kThrusters> deg_cusum_{};  // (F18) partial-loss CUSUM per thruster
+  std::array<double, kThrusters> deg_sr_{};     // ... its segment's sum S~.r~ / var
+  std::array<double, kThrusters> deg_e_{};      // ... and sum |S~|^2 / var
+  std::array<double, kThrusters> factor_ = [] {  // (F18) latched strength factors, 1 healthy
+    std::array<double, kThrusters> a{};
+    a.fill(1.0);
+    return a;
+  }();
 
   FaultDetectorParams p_{};
   double u_max_{200.0};

@@ -77,6 +77,8 @@ nlohmann::json fdi_json(const FdiReport& f) {
           {"confirmations", f.confirmations},
           {"confirmed_on", f.confirmed_on},
           {"confirmed_off", f.confirmed_off},
+          {"confirmed_degraded", f.confirmed_degraded},
+          {"factor", f.factor},
           {"valve_closed_s", opt(f.valve_closed_s)},
           {"suspicions", f.suspicions},
           {"fault_first_commanded_s", opt(f.fault_first_commanded_s)},
@@ -97,6 +99,10 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
   f.valve_closed_s = to_opt(j.at("valve_closed_s"));
   f.suspicions = j.at("suspicions").get<std::uint32_t>();
   // Absent from draws written before these were measured.
+  if (j.contains("confirmed_degraded")) {
+    f.confirmed_degraded = j.at("confirmed_degraded").get<std::uint16_t>();
+    f.factor = j.at("factor").get<double>();
+  }
   if (j.contains("fault_first_commanded_s")) {
     f.fault_first_commanded_s = to_opt(j.at("fault_first_commanded_s"));
     f.fault_commanded_s = j.at("fault_commanded_s").get<double>();

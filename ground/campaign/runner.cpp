@@ -239,17 +239,21 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       d.enabled = true;
       const double t = plant.t();
       if (!d.first_suspicion_s && f.suspicions > 0) d.first_suspicion_s = t;
-      const std::uint16_t now = static_cast<std::uint16_t>(f.confirmed_on | f.confirmed_off);
+      const std::uint16_t now =
+          static_cast<std::uint16_t>(f.confirmed_on | f.confirmed_off | f.confirmed_degraded);
       if (!d.first_confirmation_s && now != 0) {
         d.first_confirmation_s = t;
         for (int i = 0; i < 16; ++i) {
           if ((now >> i) & 1u) {
             d.thruster = i;
-            d.kind = ((f.confirmed_on >> i) & 1u) ? "stuck-on" : "stuck-off";
+            d.kind = ((f.confirmed_on >> i) & 1u)    ? "stuck-on"
+                     : ((f.confirmed_off >> i) & 1u) ? "stuck-off"
+                                                     : "degraded";
             break;
           }
         }
       }
+      if (d.thruster >= 0) d.factor = f.strength_factor(d.thruster);
       if (!d.valve_closed_s) {
         for (bool v : f.valve_open) {
           if (!v) d.valve_closed_s = t;
@@ -257,6 +261,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       }
       d.confirmed_on = f.confirmed_on;
       d.confirmed_off = f.confirmed_off;
+      d.confirmed_degraded = f.confirmed_degraded;
       d.suspicions = f.suspicions;
       if (!setup.truth.faults.empty()) {
         // The first injected fault's jet, commanded by the flight this tick (held over it).
@@ -318,7 +323,8 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
   }
   est.model_adoptions = out.telemetry.est.adoptions;
   for (int i = 0; i < 16; ++i) {
-    r.fdi.confirmations += (((r.fdi.confirmed_on | r.fdi.confirmed_off) >> i) & 1u) ? 1 : 0;
+    r.fdi.confirmations +=
+        (((r.fdi.confirmed_on | r.fdi.confirmed_off | r.fdi.confirmed_degraded) >> i) & 1u) ? 1 : 0;
   }
 #ifdef ROCKSTEADY_HAVE_PLANNER
   if (replanner) {

@@ -83,10 +83,12 @@ struct FdiReport {
   std::optional<double> first_suspicion_s;  // first window above the no-fault bound
   std::optional<double> first_confirmation_s;
   int thruster{-1};           // first confirmed thruster (flight index 2c "+", 2c+1 "-")
-  std::string kind;           // stuck-on | stuck-off
+  std::string kind;           // stuck-on | stuck-off | degraded
+  double factor{1.0};         // that thruster's latched strength factor at the end (degraded)
   int confirmations{0};       // thrusters confirmed over the run
   std::uint16_t confirmed_on{0};
   std::uint16_t confirmed_off{0};
+  std::uint16_t confirmed_degraded{0};
   std::optional<double> valve_closed_s;
   std::uint32_t suspicions{0};
   // The injected fault's jet as the flight commanded it after onset (from the truth's fault list

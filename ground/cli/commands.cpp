@@ -43,8 +43,9 @@ const std::vector<CommandHelp> kHelp{
     {"load-identified", "load-identified",
      "load the flight's identified model (J_tot, r_SO/BCM, thruster strengths) into the inactive "
      "table; refused unless the identification is confident (activate-gains flies it)"},
-    {"declare-fault", "declare-fault THRUSTER stuck-on|stuck-off",
-     "declare a thruster (0-15, 4 x pod + position) failed; latched like a confirmed fault"},
+    {"declare-fault", "declare-fault THRUSTER stuck-on|stuck-off|degraded [FACTOR]",
+     "declare a thruster (0-15, 4 x pod + position) failed, or degraded to FACTOR (0.01-0.99) of "
+     "its thrust; latched like a confirmed fault"},
     {"clear-fault", "clear-fault THRUSTER|all",
      "clear a thruster's declared or confirmed fault (valves are commanded separately)"},
     {"valve", "valve POD open|close", "command a pod's latch valve (0-3)"},
@@ -294,12 +295,29 @@ Encoded encode_command(const std::string& name, const std::vector<std::string>& 
     }
   };
   if (name == "declare-fault") {
-    if (args.size() != 2) return wrong_count(name, "2 arguments", args.size());
+    if (args.size() < 2 || args.size() > 3) return wrong_count(name, "2 or 3 arguments", args.size());
     int t = 0;
     if (!index(args[0], 0, 15, t)) return fail(name + ": thruster must be 0..15, got '" + args[0] + "'");
-    if (args[1] != "stuck-on" && args[1] != "stuck-off") {
-      return fail(name + ": kind must be stuck-on or stuck-off, got '" + args[1] + "'");
+    if (args[1] != "stuck-on" && args[1] != "stuck-off" && args[1] != "degraded") {
+      return fail(name + ": kind must be stuck-on, stuck-off or degraded, got '" + args[1] + "'");
     }
+    if (args[1] == "degraded") {
+      if (args.size() != 3) return fail(name + ": a degraded thruster needs its FACTOR (0.01-0.99)");
+      double f = 0.0;
+      try {
+        std::size_t used = 0;
+        f = std::stod(args[2], &used);
+        if (used != args[2].size()) f = -1.0;
+      } catch (const std::exception&) {
+        f = -1.0;
+      }
+      if (!(f >= 0.01 && f <= 0.99)) {
+        return fail(name + ": FACTOR must be a number in 0.01..0.99, got '" + args[2] + "'");
+      }
+      return make(Msg::OP_FAULT_DECLARE, {static_cast<double>(t), 3.0, f},
+                  "FAULT_DECLARE thruster " + args[0] + " degraded x" + args[2]);
+    }
+    if (args.size() != 2) return fail(name + ": only a degraded thruster takes a FACTOR");
     const double kind = args[1] == "stuck-on" ? 1.0 : 2.0;
     return make(Msg::OP_FAULT_DECLARE, {static_cast<double>(t), kind},
                 "FAULT_DECLARE thruster " + args[0] + " " + args[1]);

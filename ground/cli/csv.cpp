@@ -94,7 +94,8 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_I(id_excitation_active); RS_A(id_excitation_force); RS_D(id_excitation_gamma); RS_I(id_candidate); RS_I(model_adoptions);
   RS_I(fdi_enabled); RS_A(fdi_residual); RS_D(fdi_chi2); RS_D(fdi_noise_sigma); RS_I(fdi_best);
   RS_D(fdi_best_llr); RS_D(fdi_runner_up_llr); RS_I(fdi_suspected_on); RS_I(fdi_suspected_off);
-  RS_I(fdi_confirmed_on); RS_I(fdi_confirmed_off); RS_A(valve_open); RS_I(isolation_inhibited);
+  RS_I(fdi_confirmed_on); RS_I(fdi_confirmed_off);
+  RS_I(fdi_confirmed_degraded); RS_A(fdi_strength_factor); RS_A(valve_open); RS_I(isolation_inhibited);
   RS_I(fdi_windows); RS_I(fdi_probe_pod); RS_I(fdi_probes); RS_I(reduced_authority); RS_I(alloc_rank);
   RS_I(base_ticks); RS_I(base_missed); RS_I(rate_group_count);
   RS_A(rg_cycles); RS_A(rg_last_exec_ns); RS_A(rg_max_exec_ns); RS_A(rg_slips); RS_A(rg_missed);

@@ -297,6 +297,29 @@ TEST(FaultCommands, DeclareValveInhibitAndClearReachTheCoreAtTheBoundary) {
   EXPECT_EQ(f.send(Opcode::kFaultClear, {-2.0}).reason, RejectReason::kOutOfRange);
 }
 
+// A degraded thruster is declared with the fraction of its thrust it delivers (F18): latched at
+// the boundary with that factor; without a factor, or a factor on a stuck kind, or out of
+// (0.01, 0.99), the command is refused with the reason.
+TEST(FaultCommands, ADegradedThrusterIsDeclaredWithItsFactor) {
+  test::AppFixture f;
+  f.ticks(2);
+  EXPECT_EQ(f.send(Opcode::kFaultDeclare, {6.0, 3.0}).reason, RejectReason::kBadLength);
+  EXPECT_EQ(f.send(Opcode::kFaultDeclare, {6.0, 2.0, 0.5}).reason, RejectReason::kBadLength);
+  EXPECT_EQ(f.send(Opcode::kFaultDeclare, {6.0, 3.0, 1.5}).reason, RejectReason::kOutOfRange);
+  EXPECT_EQ(f.send(Opcode::kFaultDeclare, {6.0, 3.0, 0.0}).reason, RejectReason::kOutOfRange);
+  f.ticks(1);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_degraded, 0u);  // nothing refused reached the core
+  EXPECT_TRUE(f.send(Opcode::kFaultDeclare, {6.0, 3.0, 0.7}).accepted);
+  f.ticks(1);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_degraded, 1u << 6);
+  EXPECT_DOUBLE_EQ(f.out.telemetry.fdi.strength_factor(6), 0.7);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_on | f.out.telemetry.fdi.confirmed_off, 0u);
+  EXPECT_TRUE(f.send(Opcode::kFaultClear, {6.0}).accepted);
+  f.ticks(1);
+  EXPECT_EQ(f.out.telemetry.fdi.confirmed_degraded, 0u);
+  EXPECT_DOUBLE_EQ(f.out.telemetry.fdi.strength_factor(6), 1.0);
+}
+
 TEST(FaultCommands, LoadIdentifiedIsRefusedWithTheReasonWhileIdentificationIsOff) {
   test::AppFixture f;
   f.ticks(1);

@@ -109,7 +109,8 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
   id.config.min_torque_impulse = 0.05;
   id.config.min_force_impulse = 0.02;
   id.config.min_thruster_impulse = 0.005;
-  p.fdi.enabled = true;  // and fault detection, with a ground declaration and a valve closure
+  p.fdi.enabled = true;  // and fault detection, with ground declarations and a valve closure
+  p.fdi.degraded_min_loss = 0.1;
   ASSERT_TRUE(loop->gnc.init(p).ok);
   long counted = -1;
   {
@@ -128,6 +129,13 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
     o.valve_open = false;
     loop->tick(o);
     for (int i = 0; i < 1200; ++i) loop->tick();
+    GncCommands g;  // (F18) a degraded declaration: its factor in the limits and the command
+    g.has_fault_declaration = true;
+    g.fault_thruster = 5;
+    g.fault_kind = FaultKind::kDegraded;
+    g.fault_factor = 0.6;
+    loop->tick(g);
+    for (int i = 0; i < 600; ++i) loop->tick();
     counted = rocksteady::test::heap_allocations();
   }
   EXPECT_EQ(counted, 0);
@@ -314,6 +322,63 @@ TEST(ZeroAllocation, NoHeapInAPodSweep) {
   EXPECT_GE(d.status().sweeps, 1u);
   EXPECT_EQ(d.status().sweep_confirmations, 1u);
   EXPECT_EQ(d.confirmed_on(), 1u << kStuck);
+}
+
+// gnc/fdi/README.md (F18): the partial-loss CUSUMs and their step, the confirmation of a
+// half-strength jet, and the flight after it with the factor latched (the detector's input scaled
+// by it): no heap. A rigid body with the study's inertia, every jet commanded at random, jet 9 at
+// half its command from the first tick.
+TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(0.3, -0.2, 0.1);
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = 1e-7;
+  p.degraded_min_loss = 0.1;
+  FaultDetector d;
+  d.configure(p, rcs, kUmax, kDt);
+  FaultModel m;
+  m.j = j;
+  m.r = r;
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 1e-6;
+  m.k_sigma = 1e-3;
+  d.set_model(m);
+  constexpr int kDegraded = 9;
+  Vec3 w(0.01, 0.02, 0.03);
+  Vec16 cmd = Vec16::Zero();
+  std::uint64_t x = 12345;
+  long counted = -1;
+  {
+    Armed armed;
+    for (int k = 0; k < 3000; ++k) {
+      FaultDetectorInput in;
+      in.omega = w;
+      in.omega_valid = true;
+      in.thrust = cmd;
+      d.update(in);
+      Vec3 tau = Vec3::Zero();
+      for (int i = 0; i < kThrusters; ++i) {
+        x = x * 6364136223846793005ULL + 1442695040888963407ULL;  // a fixed pseudo-random firing
+        cmd(i) = (x >> 62) == 0 ? kUmax * static_cast<double>((x >> 11) & 1023U) / 1023.0 : 0.0;
+        const int c = i / 2;
+        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
+                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
+        const double f = i == kDegraded ? 0.5 * cmd(i) : cmd(i);
+        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
+      }
+      w += kDt * j.inverse() * (tau - w.cross(j * w));
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_EQ(d.status().degraded_confirmations, 1u);
+  EXPECT_EQ(d.confirmed_degraded(), 1u << kDegraded);
+  EXPECT_LT(d.strength_factor(kDegraded), 0.99);
 }
 
 TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {

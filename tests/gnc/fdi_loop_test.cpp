@@ -10,6 +10,7 @@
 
 #include "gnc/gnc.hpp"
 #include "gnc/math/rotation.hpp"
+#include "gnc/model/rcs.hpp"
 #include "rigid_body.hpp"
 
 namespace rocksteady::gnc {
@@ -24,6 +25,8 @@ struct Truth {
   test::RigidBody body;
   int stuck_on{-1};
   int stuck_off{-1};
+  int degraded{-1};  // delivers degraded_factor of its command
+  double degraded_factor{1.0};
   double u_max{200.0};
   explicit Truth(const GncParams& p) {
     for (int k = 0; k < 4; ++k) {
@@ -51,6 +54,7 @@ struct Truth {
       double f = (i % 2 == 0) ? std::fmax(u, 0.0) : std::fmax(-u, 0.0);
       if (i == stuck_on) f = u_max;
       if (i == stuck_off) f = 0.0;
+      if (i == degraded) f *= degraded_factor;
       tau += (pos[static_cast<std::size_t>(i)] + r).cross(f * dir[static_cast<std::size_t>(i)]);
     }
     body.step(dt, tau);
@@ -426,6 +430,93 @@ TEST(GncFdi, GroundOverridesActAtTheBoundary) {
   gnc.step(truth.sample(t), clear, out);
   EXPECT_EQ(gnc.fault_detector().confirmed_off(), 0u);
   EXPECT_FALSE(out.command.valve_open[2]);  // valves are commanded separately
+}
+
+// (F18) A thruster declared degraded is flown at its factor: the allocator bounds its half of the
+// channel at factor x u_max of produced force and commands it 1 / factor more, so the torque the
+// allocator reports equals B_hat times the force the thrusters produce (recomputed here from the
+// command and the factor); clearing the declaration restores it. Undeclared, the detector finds
+// the same half-strength thruster by itself, and the despin goes on.
+TEST(GncFdi, ADegradedThrusterIsFlownAtItsFactorAndFoundByTheDetector) {
+  GncParams p = fdi_params();
+  p.fdi.degraded_min_loss = 0.1;
+  const Mat38 b_hat = torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
+  {
+    Truth truth(p);
+    truth.degraded = 9;  // channel 4 "-", which the despin fires from the start
+    truth.degraded_factor = 0.5;
+    Gnc gnc;
+    ASSERT_TRUE(gnc.init(p).ok);
+    GncOutput out;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    c.has_fault_declaration = true;
+    c.fault_thruster = 9;
+    c.fault_kind = FaultKind::kDegraded;
+    c.fault_factor = 0.5;
+    double t = 0.0;
+    gnc.step(truth.sample(t), c, out);
+    EXPECT_EQ(out.telemetry.fdi.confirmed_degraded, 1u << 9);
+    EXPECT_DOUBLE_EQ(out.telemetry.fdi.strength_factor(9), 0.5);
+    double max_minus = 0.0;
+    for (int k = 0; k < 600; ++k) {
+      Vec8 produced = out.command.force;
+      if (produced(4) < 0.0) produced(4) *= 0.5;
+      max_minus = std::fmax(max_minus, -produced(4));
+      EXPECT_GE(produced(4), -0.5 * p.rcs.u_max - 1e-9);
+      EXPECT_LE(out.command.force.cwiseAbs().maxCoeff(), p.rcs.u_max + 1e-9);
+      const Vec3 tau = b_hat * produced;
+      EXPECT_LT((tau - out.telemetry.alloc.torque_achieved).norm(), 1e-9 * (1.0 + tau.norm()))
+          << "tick " << k;
+      truth.advance(out.command, p.dt);
+      t += p.dt;
+      gnc.step(truth.sample(t), {}, out);
+    }
+    EXPECT_GT(max_minus, 0.0);  // the degraded half was flown
+    EXPECT_EQ(gnc.fault_detector().confirmed_on() | gnc.fault_detector().confirmed_off(), 0u);
+    GncCommands clear;
+    clear.has_fault_declaration = true;
+    clear.fault_thruster = -1;
+    clear.fault_kind = FaultKind::kNone;
+    gnc.step(truth.sample(t + p.dt), clear, out);
+    EXPECT_EQ(out.telemetry.fdi.confirmed_degraded, 0u);
+    EXPECT_DOUBLE_EQ(out.telemetry.fdi.strength_factor(9), 1.0);
+  }
+  for (int jet : {4, 9}) {
+    Truth truth(p);
+    truth.degraded = jet;
+    truth.degraded_factor = 0.5;
+    Gnc gnc;
+    ASSERT_TRUE(gnc.init(p).ok);
+    GncOutput out;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    double t = 0.0;
+    gnc.step(truth.sample(t), c, out);
+    const double w0 = truth.body.omega.norm();
+    double confirmed_at = -1.0;
+    int confirmations = 0;
+    for (int k = 0; k < 30000 && (confirmed_at < 0.0 || t < confirmed_at + 600.0); ++k) {
+      truth.advance(out.command, p.dt);
+      t += p.dt;
+      gnc.step(truth.sample(t), {}, out);
+      if (count(out, EventId::kFaultConfirmed) > 0) {
+        ++confirmations;
+        if (confirmed_at < 0.0) confirmed_at = t;
+      }
+    }
+    ASSERT_GE(confirmed_at, 0.0) << "thruster " << jet << " never confirmed";
+    EXPECT_EQ(confirmations, 1) << "thruster " << jet;
+    EXPECT_EQ(out.telemetry.fdi.confirmed_degraded, 1u << jet) << "thruster " << jet;
+    EXPECT_EQ(out.telemetry.fdi.confirmed_on | out.telemetry.fdi.confirmed_off, 0u);
+    // The truth and the model are noise-free here: the fitted factor is the truth's.
+    EXPECT_NEAR(out.telemetry.fdi.strength_factor(jet), 0.5, 0.01) << "thruster " << jet;
+    EXPECT_LT(truth.body.omega.norm(), w0) << "thruster " << jet;
+    std::printf("thruster %d degraded x0.5: confirmed at %.1f s, factor %.3f\n", jet, confirmed_at,
+                out.telemetry.fdi.strength_factor(jet));
+  }
 }
 
 TEST(GncFdi, InhibitedIsolationConfirmsButKeepsTheValveOpen) {

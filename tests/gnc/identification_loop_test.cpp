@@ -406,6 +406,101 @@ TEST(GncIdentification, OffByDefaultAndTelemetryZero) {
   EXPECT_EQ(loop.gnc.identified_model(m), ModelCandidate::kDisabled);
 }
 
+// With the MEKF and the identifier running, Gnc::step writes every field of the estimation
+// telemetry each tick (it no longer clears the record first): a record pre-filled with junk
+// before every tick comes out equal, field by field, to the record of a second, identical loop.
+TEST(GncIdentification, TheEstimationTelemetryIsWrittenWholeEveryTick) {
+  const GncParams truth = test::small_vehicle_params();
+  GncParams p = wrong_table(identifying_params(ModelAdoption::kAuto));
+  p.estimator.kind = EstimatorKind::kMekf;
+  p.mekf.gyro_arw = 1e-6;
+  p.mekf.star_sigma = 1e-5;
+  auto* a = new test::SmallLoop(truth);
+  auto* b = new test::SmallLoop(truth);
+  ASSERT_TRUE(a->gnc.init(p).ok);
+  ASSERT_TRUE(b->gnc.init(p).ok);
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  for (int k = 0; k < 400; ++k) {
+    EstimationTelemetry& j = b->out.telemetry.est;  // junk in every field
+    j.mekf = false;
+    j.gyro_bias.setConstant(7.0);
+    j.attitude_sigma.setConstant(7.0);
+    j.bias_sigma.setConstant(7.0);
+    j.star_gated = 777;
+    j.identifying = false;
+    j.j.setConstant(7.0);
+    j.j_sigma.setConstant(7.0);
+    j.r.setConstant(7.0);
+    j.r_sigma.setConstant(7.0);
+    j.k.setConstant(7.0);
+    j.k_sigma.setConstant(7.0);
+    j.inertia_confident = !a->out.telemetry.est.inertia_confident;
+    j.offset_confident = !a->out.telemetry.est.offset_confident;
+    j.thruster_confident = 0xffff;
+    j.excited_inertia = !a->out.telemetry.est.excited_inertia;
+    j.excited_offset = !a->out.telemetry.est.excited_offset;
+    j.excited_thrusters = 0xffff;
+    j.offset_unobservable = 77;
+    j.residual_torque.setConstant(7.0);
+    j.residual_chi2 = 7.0;
+    j.windows = 777;
+    j.rate_bias_sigma.setConstant(7.0);
+    j.windows_gated = 777;
+    j.gate_reinflations = 777;
+    j.guard_refusals = 777;
+    j.excitation_active = true;
+    j.excitation_force.setConstant(7.0);
+    j.excitation_gamma = 7.0;
+    j.candidate = ModelCandidate::kInvalid;
+    j.adoptions = 777;
+    a->tick(k == 0 ? c : GncCommands{});
+    b->tick(k == 0 ? c : GncCommands{});
+    const EstimationTelemetry& x = a->out.telemetry.est;
+    const EstimationTelemetry& y = b->out.telemetry.est;
+    ASSERT_TRUE(x.mekf && x.identifying);
+    EXPECT_EQ(x.mekf, y.mekf);
+    EXPECT_EQ(x.gyro_bias, y.gyro_bias);
+    EXPECT_EQ(x.attitude_sigma, y.attitude_sigma);
+    EXPECT_EQ(x.bias_sigma, y.bias_sigma);
+    EXPECT_EQ(x.star_gated, y.star_gated);
+    EXPECT_EQ(x.identifying, y.identifying);
+    EXPECT_EQ(x.j, y.j);
+    EXPECT_EQ(x.j_sigma, y.j_sigma);
+    EXPECT_EQ(x.r, y.r);
+    EXPECT_EQ(x.r_sigma, y.r_sigma);
+    EXPECT_EQ(x.k, y.k);
+    EXPECT_EQ(x.k_sigma, y.k_sigma);
+    EXPECT_EQ(x.inertia_confident, y.inertia_confident);
+    EXPECT_EQ(x.offset_confident, y.offset_confident);
+    EXPECT_EQ(x.thruster_confident, y.thruster_confident);
+    EXPECT_EQ(x.excited_inertia, y.excited_inertia);
+    EXPECT_EQ(x.excited_offset, y.excited_offset);
+    EXPECT_EQ(x.excited_thrusters, y.excited_thrusters);
+    EXPECT_EQ(x.offset_unobservable, y.offset_unobservable);
+    EXPECT_EQ(x.residual_torque, y.residual_torque);
+    EXPECT_EQ(x.residual_chi2, y.residual_chi2);
+    EXPECT_EQ(x.windows, y.windows);
+    EXPECT_EQ(x.rate_bias_sigma, y.rate_bias_sigma);
+    EXPECT_EQ(x.windows_gated, y.windows_gated);
+    EXPECT_EQ(x.gate_reinflations, y.gate_reinflations);
+    EXPECT_EQ(x.guard_refusals, y.guard_refusals);
+    EXPECT_EQ(x.excitation_active, y.excitation_active);
+    EXPECT_EQ(x.excitation_force, y.excitation_force);
+    EXPECT_EQ(x.excitation_gamma, y.excitation_gamma);
+    EXPECT_EQ(x.candidate, y.candidate);
+    EXPECT_EQ(x.adoptions, y.adoptions);
+    if (::testing::Test::HasFailure()) {
+      ADD_FAILURE() << "tick " << k;
+      break;
+    }
+  }
+  EXPECT_GT(a->out.telemetry.est.windows, 5u);  // the identifier's windows ran meanwhile
+  delete a;
+  delete b;
+}
+
 TEST(GncMekf, SelectedEstimatorFliesTheLoopToHold) {
   GncParams p = test::small_vehicle_params();
   p.estimator.kind = EstimatorKind::kMekf;

@@ -123,6 +123,8 @@ std::vector<Case> cases() {
       {"load-identified", {}, false, M::kDetumble, O::kParamLoadIdentified, {}},
       {"declare-fault", {"7", "stuck-on"}, false, M::kDetumble, O::kFaultDeclare, {7.0, 1.0}},
       {"declare-fault", {"15", "stuck-off"}, false, M::kHold, O::kFaultDeclare, {15.0, 2.0}},
+      {"declare-fault", {"4", "degraded", "0.6"}, false, M::kDetumble, O::kFaultDeclare,
+       {4.0, 3.0, 0.6}},
       {"clear-fault", {"all"}, false, M::kHold, O::kFaultClear, {-1.0}},
       {"clear-fault", {"3"}, false, M::kSafe, O::kFaultClear, {3.0}},
       {"valve", {"2", "close"}, false, M::kDetumble, O::kValve, {2.0, 0.0}},
@@ -236,6 +238,11 @@ TEST(GroundCommands, BadOperatorInputIsRefusedLocallyWithAClearMessage) {
       {"abort-uplink", {"1.5"}, false, "must be an integer in [0, 2147483647]"},
       {"abort-uplink", {"2147483648"}, false, "must be an integer in [0, 2147483647]"},
       {"noop", {}, true, "--quat applies to set-target only"},
+      {"declare-fault", {"4", "leaking"}, false, "kind must be stuck-on, stuck-off or degraded"},
+      {"declare-fault", {"4", "degraded"}, false, "a degraded thruster needs its FACTOR"},
+      {"declare-fault", {"4", "degraded", "1.2"}, false, "FACTOR must be a number in 0.01..0.99"},
+      {"declare-fault", {"4", "degraded", "half"}, false, "FACTOR must be a number in 0.01..0.99"},
+      {"declare-fault", {"4", "stuck-on", "0.5"}, false, "only a degraded thruster takes a FACTOR"},
   };
   for (const Bad& b : bad) {
     EncodeOptions o;
