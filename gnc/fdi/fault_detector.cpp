@@ -97,6 +97,7 @@ void FaultDetector::cancel_evaluation() {
   // one open (partly predicted without it) are dropped; the next valid sample starts afresh. A
   // staged model is taken on the next update.
   eval_phase_ = 0;
+  partial_loss_pending_ = false;
   have_start_ = false;
 }
 
@@ -304,9 +305,12 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   // that arrived meanwhile is taken once it is done (before this tick's sample, like any other).
   if (eval_phase_ != 0) {
     evaluate_step();
-  } else if (model_staged_) {
-    model_staged_ = false;
-    set_model(staged_);
+  } else {
+    if (partial_loss_pending_) evaluate_partial_losses();  // (F18)
+    if (model_staged_) {
+      model_staged_ = false;
+      set_model(staged_);
+    }
   }
   if (!in.omega_valid || !in.thrust_valid || !in.omega.allFinite() || !in.thrust.allFinite()) {
     have_start_ = false;  // a gap breaks the window; the next valid sample starts another
@@ -454,8 +458,9 @@ void FaultDetector::start_window(const Vec3& omega) {
 void FaultDetector::close_window() {
   // (F10) The closed set is evaluated over the next kEvaluationSteps updates while the other set
   // accumulates the next window. An evaluation still running (a window shorter than the steps:
-  // not with window_ticks >= 4, or 5 with the partial-loss step (F18)) is finished first.
+  // not with window_ticks >= 4) is finished first, and so is the partial-loss step (F18).
   while (eval_phase_ != 0) evaluate_step();
+  if (partial_loss_pending_) evaluate_partial_losses();  // (F18), before step 2 rewrites its input
   win_[static_cast<std::size_t>(acc_)].n = n_;
   acc_ ^= 1;
   eval_phase_ = 1;
@@ -490,14 +495,12 @@ void FaultDetector::evaluate_step() {
       if (block_scan_.h >= 0) blocking_scan(block_scan_.h, kScanSplit, kHypotheses, block_scan_);
       eval_phase_ = 4;
       break;
-    case 4:
-      // (F18) The partial-loss step follows the decision (a declaration there cancels it).
-      eval_phase_ = p_.degraded_min_loss > 0.0 ? 5 : 0;
-      decide();
-      break;
     default:
       eval_phase_ = 0;
-      evaluate_partial_losses();
+      // (F18) The partial-loss step follows the decision, on the next update that carries no
+      // evaluation step (a declaration in the decision cancels it).
+      partial_loss_pending_ = p_.degraded_min_loss > 0.0;
+      decide();
       break;
   }
 }
@@ -1050,12 +1053,14 @@ int FaultDetector::partial_loss_alternative(int h) const {
 }
 
 void FaultDetector::evaluate_partial_losses() {
-  // (F18) Step 5 of a window's evaluation (F10), after the decision: each jet's partial-loss
-  // CUSUM at the design loss a_c = 2 x degraded_min_loss (any loss above degraded_min_loss drifts
-  // it up, a healthy jet down), from the window's stuck-off LLR and energy (step 2):
+  // (F18) After a window's decision, on the next update free of evaluation steps (F10), or at the
+  // next window's close: each jet's partial-loss CUSUM at the design loss
+  // a_c = 2 x degraded_min_loss (any loss above degraded_min_loss drifts it up, a healthy jet
+  // down), from the window's stuck-off LLR and energy (step 2):
   //   sum S~.r~ / var = llr + E / 2,   C_g <- max(0, C_g + a_c SR_w - a_c^2 E_w / 2),
   // and the sums of the segment since C_g was last zero. A partial loss past half the
   // confirmation level is suspected (F7: the model is held and the identifier does not fit it).
+  partial_loss_pending_ = false;
   const double ac = std::fmin(1.0, 2.0 * p_.degraded_min_loss);
   const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);
   deg_suspecting_ = false;

@@ -159,13 +159,15 @@ class FaultDetector {
   // with the cross sums), and, when a hypothesis is past the confirmation level, step 3 (the
   // rest of its bias-bounded margins (F8) against every alternative, begun in step 2) and the
   // decision (it may start an isolation test), or the decision when a pod sweep reads its step
-  // (F17). The executive keeps other periodic work off those ticks.
+  // (F17), and the partial-loss step (F18) after the decision. The executive keeps other periodic
+  // work off those ticks.
   bool heavy_step_next() const {
-    return eval_phase_ == 1 || eval_phase_ == 2 ||
+    return eval_phase_ == 1 || eval_phase_ == 2 || (eval_phase_ == 0 && partial_loss_pending_) ||
            (eval_phase_ == 3 && st_.best_llr > p_.confirm_llr) ||
            (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping()));
   }
-  // The steps up to the decision; with the partial-loss confirmation (F18) on, a fifth follows.
+  // The steps up to the decision; with the partial-loss confirmation (F18) on, its step follows on
+  // the next update that carries none of them.
   static constexpr int kEvaluationSteps = 4;
   FaultEvents update(const FaultDetectorInput& in);
 
@@ -233,6 +235,7 @@ class FaultDetector {
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
   bool deg_suspecting_{false};  // (F18) a partial loss past half the confirmation level
+  bool partial_loss_pending_{false};  // (F18) its step is due (after the decision)
   FaultDetectorInput scaled_{};  // (F18) the input with degraded jets at their factor
   std::array<double, kThrusters> deg_cusum_{};  // (F18) partial-loss CUSUM per thruster
   std::array<double, kThrusters> deg_sr_{};     // ... its segment's sum S~.r~ / var

@@ -341,6 +341,61 @@ TEST(FaultDetector, APartialLossOfThrustIsConfirmedDegradedWithItsFactor) {
   }
 }
 
+// (F18) With 5-tick windows (the study table's) the four evaluation steps and the partial-loss
+// step leave no update free of an evaluation step inside a window: a model given during an
+// evaluation must still be taken (at the update after the decision, before the partial-loss step
+// runs there, or at the close). The detector starts from a model 30 % wrong in J and gets the
+// right one on every tick from tick 100, as the flight's identifier refresh does; a stuck-on jet
+// from tick 300 is isolated to itself. (When the staged model was never taken, nothing was.)
+TEST(FaultDetector, AModelGivenDuringTheEvaluationIsTakenWithFiveTickWindowsAndPartialLossesOn) {
+  for (int i : {0, 6, 11}) {
+    Truth t;
+    FaultDetectorParams p;
+    p.enabled = true;
+    p.window_ticks = 5;
+    p.gyro_sigma = t.gyro_sigma;
+    p.disturbance_sigma = 0.0;
+    p.degraded_min_loss = 0.1;
+    FaultDetector d;
+    d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+    FaultModel right;
+    right.j = t.body.j;
+    right.r = t.r;
+    right.j_rel_sigma = 1e-4;
+    right.r_cov = Mat3::Identity() * 1e-6;
+    right.k_sigma = 1e-3;
+    FaultModel wrong = right;  // an unidentified model, honestly uncertain
+    wrong.j *= 1.3;
+    wrong.j_rel_sigma = 0.3;
+    wrong.r_cov = Mat3::Identity() * 0.25;
+    wrong.k_sigma = 0.05;
+    d.set_model(wrong);
+    std::mt19937_64 cmd_rng(11);
+    Vec16 prev = Vec16::Zero();
+    RunResult r;
+    for (int k = 0; k < 1000 && r.confirmed_at < 0; ++k) {
+      if (k == 300) t.stuck_on = i;
+      FaultDetectorInput in;
+      in.omega = t.gyro();
+      in.omega_valid = true;
+      in.thrust = prev;
+      const FaultEvents e = d.update(in);
+      if (k >= 100) d.set_model(right);  // after the update, as Gnc::step refreshes it
+      if (e.confirmed) {
+        r.confirmed_at = k;
+        r.thruster = e.thruster;
+        r.kind = e.kind;
+      }
+      const Vec16 cmd = random_firing(cmd_rng);
+      t.advance(cmd);
+      prev = cmd;
+    }
+    ASSERT_GE(r.confirmed_at, 300) << "thruster " << i;
+    EXPECT_EQ(r.thruster, i);
+    EXPECT_EQ(r.kind, FaultKind::kStuckOn);
+  }
+}
+
 TEST(FaultDetector, HealthyFiringNeverConfirmsAPartialLoss) {
   for (double sigma : {3.1623e-6, 3.1623e-5}) {
     Truth t;
