@@ -488,6 +488,13 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     if (reinflating) {  // a fault confirmed on the last tick (step 1c)
       reinflate_pending_ = false;
       ident_.reinflate_all();
+      // (F12) The detector held the model from before the identifier's gate refused the fault's
+      // windows; the identifier fitted the unmodelled fault since. The fault is modelled now
+      // (latched): the identifier starts again from the held model and its uncertainty.
+      if (fault_model_held_) {
+        const FaultModel& h = fault_model_given_;
+        ident_.restart_at(h.j, h.j_rel_sigma * h.j.norm(), h.r, h.r_cov, h.k, h.k_sigma);
+      }
       release_fault_model();
       fault_model_stale_ = true;  // the detector takes the re-inflated model on a later tick
     }

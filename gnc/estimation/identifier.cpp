@@ -376,6 +376,9 @@ void Identifier::reinflate_all() {
   const double vj = c_.j_prior_sigma * c_.j_prior_sigma;
   const double vr = c_.r_prior_sigma * c_.r_prior_sigma;
   const double vk = c_.k_prior_sigma * c_.k_prior_sigma;
+  fill_.vj = vj;
+  fill_.p_r = vr * Mat3::Identity();
+  fill_.vk = vk;
   if (d_live) {
     // (I22) d too: a fault the detector isolated changes the constant torque; its estimate is
     // kept as the starting point. A d settled at zero was never in the fault and stays out.
@@ -389,16 +392,34 @@ void Identifier::reinflate_all() {
   ++counters_.reinflations;
 }
 
-void Identifier::complete_reinflation() {
-  if (!fill_pending_) return;
-  fill_pending_ = false;
+void Identifier::restart_at(const Mat3& j, double j_sigma, const Vec3& r, const Mat3& r_cov,
+                            const Vec16& k, double k_sigma) {
+  if (!fill_pending_) return;  // only right after reinflate_all
   const double vj = c_.j_prior_sigma * c_.j_prior_sigma;
   const double vr = c_.r_prior_sigma * c_.r_prior_sigma;
   const double vk = c_.k_prior_sigma * c_.k_prior_sigma;
+  a_ = inertia_params(j);
+  r_ = r;
+  k_ = k;
+  fill_.vj = std::fmin(vj, j_sigma * j_sigma);
+  fill_.p_r = 0.5 * (r_cov + r_cov.transpose());
+  if (!(fill_.p_r.trace() <= 3.0 * vr)) fill_.p_r = vr * Mat3::Identity();
+  fill_.vk = std::fmin(vk, k_sigma * k_sigma);
+  p_j_ = fill_.vj * Mat6::Identity();
+  p_r_ = fill_.p_r;
+  p_k_ = fill_.vk * Mat16::Identity();
+  est_.j = inertia_matrix(a_);
+  est_.r = r_;
+  est_.k = k_;
+}
+
+void Identifier::complete_reinflation() {
+  if (!fill_pending_) return;
+  fill_pending_ = false;
   p_all_.setZero();
-  for (int i = 0; i < 6; ++i) p_all_(i, i) = vj;
-  for (int i = 0; i < 3; ++i) p_all_(kIdR + i, kIdR + i) = vr;
-  for (int i = 0; i < kThrusters; ++i) p_all_(kIdK + i, kIdK + i) = vk;
+  for (int i = 0; i < 6; ++i) p_all_(i, i) = fill_.vj;
+  p_all_.block<3, 3>(kIdR, kIdR) = fill_.p_r;
+  for (int i = 0; i < kThrusters; ++i) p_all_(kIdK + i, kIdK + i) = fill_.vk;
   p_all_.block<3, 3>(kIdB, kIdB) = fill_.p_bb;
   if (fill_.d_live) {
     const double vd = c_.fault_torque_sigma * c_.fault_torque_sigma;

@@ -256,6 +256,12 @@ class Identifier {
   void reinflate_offset();
   void reinflate_thruster(int i);
   void reinflate_all();  // also the fault torque d (I22)
+  // Right after reinflate_all: J, r and k start again from a model known better than the
+  // identifier's estimate, with its uncertainty (each at most the prior's): per-parameter 1 sigma
+  // of J, the covariance of r, the 1 sigma of each k. The fault detector's held model (gnc/fdi
+  // README F12) after the fault the identifier absorbed meanwhile is confirmed.
+  void restart_at(const Mat3& j, double j_sigma, const Vec3& r, const Mat3& r_cov, const Vec16& k,
+                  double k_sigma);
   void reinflate_fault_torque();
   // The rate given from the next window on has `delta` subtracted beyond what was subtracted so
   // far (e.g. a new gyro-bias estimate from the attitude filter): the bias state follows,
@@ -377,6 +383,9 @@ class Identifier {
     Mat3 p_bd{Mat3::Zero()};
     Mat3 p_dd{Mat3::Zero()};
     bool d_live{false};
+    double vj{0.0};  // J's, r's and k's blocks after the rewrite (the priors, or restart_at's)
+    Mat3 p_r{Mat3::Zero()};
+    double vk{0.0};
   };
   Fill fill_{};
   bool fill_pending_{false};

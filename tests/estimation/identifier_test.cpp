@@ -366,6 +366,69 @@ TEST(Identifier, WithAGyroBiasTheNormalisedErrorsStayInsideTheChiSquareBand) {
 // covariance); after gate_reinflate_after such windows in a row J, r and k go back to their prior
 // covariance. Without the gate the same data move r-hat by centimetres while the reported 1 sigma
 // stays at millimetres.
+// restart_at (gnc/fdi/README.md F12, after a confirmed fault): right after reinflate_all, J, r and k
+// start again from the given model with its uncertainty, each block at most the prior's, their
+// cross-covariances cleared, the rate bias's block kept; without a re-inflation just before, it
+// does nothing. Then the windows that follow move the estimate from there.
+TEST(Identifier, ARestartAfterAReinflationTakesTheGivenModelAndItsUncertainty) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  IdentifierConfig c = config_with_priors(s.j, s.r);
+  Identifier id;
+  id.configure(c);
+  TruthRun truth(s);
+  RandomFiring fire(7);
+  truth.run(static_cast<int>(200.0 / kDt), fire,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  ASSERT_GT(id.counters().windows, 5u);
+  Mat3 j = s.j;
+  j(0, 1) += 1e5;
+  j(1, 0) += 1e5;
+  const Vec3 r = s.r + Vec3(0.01, -0.02, 0.03);
+  Vec16 k = Vec16::Ones();
+  k(3) = 0.7;
+  Mat3 r_cov;
+  r_cov << 4e-4, 1e-5, 0.0, 1e-5, 9e-4, 0.0, 0.0, 0.0, 1e-4;
+  // Without a re-inflation first: nothing changes.
+  const Mat3 j_was = id.estimate().j;
+  id.restart_at(j, 1e4, r, r_cov, k, 1e-3);
+  EXPECT_TRUE(id.estimate().j == j_was);
+  const Mat3 p_bb = id.joint_covariance().block<3, 3>(kIdB, kIdB);
+  id.reinflate_all();
+  id.restart_at(j, 1e4, r, r_cov, k, 1e-3);
+  EXPECT_LT((id.estimate().j - j).norm(), 1e-9 * j.norm());
+  EXPECT_TRUE(id.estimate().r == r);
+  EXPECT_TRUE(id.estimate().k == k);
+  EXPECT_TRUE(id.inertia_covariance() == Mat6(1e8 * Mat6::Identity()));
+  EXPECT_TRUE(id.offset_covariance() == r_cov);
+  EXPECT_TRUE(id.strength_covariance() == Mat16(1e-6 * Mat16::Identity()));
+  const MatId& p = id.joint_covariance();
+  EXPECT_TRUE(Mat6(p.block<6, 6>(0, 0)) == Mat6(1e8 * Mat6::Identity()));
+  EXPECT_TRUE(Mat3(p.block<3, 3>(kIdR, kIdR)) == r_cov);
+  EXPECT_TRUE(Mat16(p.block<16, 16>(kIdK, kIdK)) == Mat16(1e-6 * Mat16::Identity()));
+  const double cross_terms = p.block<6, 3>(0, kIdR).norm() + p.block<6, 16>(0, kIdK).norm() +
+                             p.block<3, 16>(kIdR, kIdK).norm();
+  EXPECT_EQ(cross_terms, 0.0);
+  EXPECT_TRUE(Mat3(p.block<3, 3>(kIdB, kIdB)) == p_bb);
+  // Uncertainties above the prior are the prior's.
+  id.reinflate_all();
+  id.restart_at(j, 1e9, r, 1e3 * Mat3::Identity(), k, 1.0);
+  const double vj = c.j_prior_sigma * c.j_prior_sigma;
+  const double vr = c.r_prior_sigma * c.r_prior_sigma;
+  const double vk = c.k_prior_sigma * c.k_prior_sigma;
+  EXPECT_TRUE(id.inertia_covariance() == Mat6(vj * Mat6::Identity()));
+  EXPECT_TRUE(id.offset_covariance() == Mat3(vr * Mat3::Identity()));
+  EXPECT_TRUE(id.strength_covariance() == Mat16(vk * Mat16::Identity()));
+  // The next windows start from the given model.
+  const std::uint32_t w0 = id.counters().windows;
+  truth.run(static_cast<int>(60.0 / kDt), fire,
+            [&](double, const test::V3& w, const test::V8& f) { id.update(id_input(w, f)); });
+  EXPECT_GT(id.counters().windows, w0);
+  EXPECT_LT((id.estimate().k - k).cwiseAbs().maxCoeff(), 0.35);  // moved from k, towards 1
+  EXPECT_GT((id.estimate().k - k).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(Identifier, AnUpdateRefusedByTheInnovationGateLeavesEstimateAndCovarianceAlone) {
   TruthSetup s;
   s.j = study_j();
