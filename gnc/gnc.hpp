@@ -119,6 +119,7 @@ class Gnc {
   // A fault was confirmed: the identifier is re-inflated on the next tick, before its update
   // (the confirmation tick carries the valve and the reallocation; the Cortex-M7 budget).
   bool reinflate_pending_{false};
+  bool restart_after_confirmation_{false};  // (F12) the pending re-inflation restarts the identifier
   // (gnc/fdi/README.md (F12)) The model last given to the detector, and the one it keeps while
   // the identifier re-converges after its innovation gate re-inflated J, r and k (I18).
   FaultModel fault_model_given_{};
