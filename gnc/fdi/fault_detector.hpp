@@ -200,12 +200,6 @@ class FaultDetector {
   // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
   const Vec3& signature(int h) const { return sig_[static_cast<std::size_t>(h)]; }
   static constexpr int kHypotheses = 2 * kThrusters;
-  // (F13) The episode's LLR of hypothesis g (16..31, thruster g - 16) as a partial loss of
-  // thrust, its lost fraction fitted in (0, 1]; and the episode's unfloored LLR of h.
-  double partial_loss_llr(int g) const;
-  double episode_llr(int h) const { return lambda_[static_cast<std::size_t>(h)]; }
-  // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
-  double degraded_llr(int g) const;
 
  private:
   void close_window();
@@ -229,6 +223,10 @@ class FaultDetector {
   // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
   // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.
   int partial_loss_alternative(int h) const;
+  // (F13) The episode's LLR of hypothesis g (16..31) as a partial loss of thrust, fitted in (0, 1].
+  double partial_loss_llr(int g) const;
+  // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
+  double degraded_llr(int g) const;
   // (F18) The jet to confirm degraded now (and its fitted loss), or -1.
   int degraded_candidate(double& loss) const;
   void evaluate_partial_losses();
