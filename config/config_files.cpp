@@ -252,6 +252,14 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("degraded_min_loss")) {  // (F18), off when absent
       fd.degraded_min_loss = r.non_negative("degraded_min_loss");
     }
+    if (r.has("check_llr")) fd.check_llr = r.non_negative("check_llr");  // (F19), off when absent
+    if (r.has("check_force_n")) fd.check_force_n = r.positive("check_force_n");
+    if (r.has("check_windows")) fd.check_windows = r.integer("check_windows");
+    if (r.has("check_interval_s")) fd.check_interval_s = r.non_negative("check_interval_s");
+    if (r.has("check_fit_chi2")) fd.check_fit_chi2 = r.positive("check_fit_chi2");
+    if (r.has("check_max_model_error")) {
+      fd.check_max_model_error = r.positive("check_max_model_error");
+    }
     p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
     r.finish();
   }

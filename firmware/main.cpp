@@ -203,6 +203,7 @@ int firmware_main() {
     g_params.fdi.enabled = true;
     g_params.fdi.identified_isolation = true;  // (F14) the identifier's fault torque, as flown
     g_params.fdi.degraded_min_loss = 0.1;      // (F18) partial losses of thrust, as flown
+    g_params.fdi.check_llr = 5.0;              // (F19) jet checks, as flown
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the
     // second-order term (I20), the gate (I18), the noise correction (I25), the gyro bias (I17).
     gnc::apply_flight_identification_settings(g_params, g_params.mekf.gyro_arw / std::sqrt(g_params.dt));
@@ -422,7 +423,8 @@ int firmware_main() {
     } else {
       line.str("NOT confirmed");
     }
-    line.str(", isolation tests ").u32(st.probes).str(", confirmed on/off masks ")
+    line.str(", isolation tests ").u32(st.probes).str(", jet checks ").u32(st.checks)
+        .str(", confirmed on/off masks ")
         .u32(st.confirmed_on).str("/").u32(st.confirmed_off);
     line.flush();
   }
@@ -436,8 +438,8 @@ int firmware_main() {
     } else {
       line.str("NOT confirmed");
     }
-    line.str(", confirmed on/off/degraded masks ").u32(fdi.confirmed_on).str("/")
-        .u32(fdi.confirmed_off).str("/").u32(fdi.confirmed_degraded);
+    line.str(", jet checks ").u32(fdi.checks).str(", confirmed on/off/degraded masks ")
+        .u32(fdi.confirmed_on).str("/").u32(fdi.confirmed_off).str("/").u32(fdi.confirmed_degraded);
     line.flush();
   }
   return ok ? 0 : 1;

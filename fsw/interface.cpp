@@ -180,6 +180,8 @@ const char* to_string(EventId id) {
       return "trajectory_stale";
     case EventId::kIsolationTest:
       return "isolation_test";
+    case EventId::kJetCheck:
+      return "jet_check";
   }
   return "?";
 }

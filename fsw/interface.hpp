@@ -172,6 +172,8 @@ enum class EventId : std::int32_t {
   kTrajectoryStale = 138,     // the staged trajectory was stale: refused, the active one kept
   kIsolationTest = 139,       // arg0 = pod whose valve the detector closed for an isolation test,
                               // arg1 = 1 started / 0 ended (the valve reopens unless confirmed)
+  kJetCheck = 140,            // arg0 = thruster the detector fires for a jet check (gnc/fdi F19),
+                              // arg1 = 1 started / 0 ended
 };
 const char* to_string(EventId id);
 

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Cholesky>
+
 #include "gnc/math/rotation.hpp"
 
 namespace rocksteady::gnc {
@@ -280,6 +282,45 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
       events.push(v);
     }
   }
+  // (F19) A jet check starts or ends (after the fault events: a tick holds at most four).
+  const int check = fdi_.check_jet();
+  if (check != check_event_) {
+    ModeEvent e{EventId::kJetCheck, mode, mode, TransitionCheck::kOk};
+    e.arg0 = static_cast<std::int16_t>(check >= 0 ? check : check_event_);
+    e.arg1 = static_cast<std::int16_t>(check >= 0 ? 1 : 0);
+    events.push(e);
+    check_event_ = check;
+  }
+}
+
+void Gnc::apply_jet_check(const AllocatorLimits& lim, Vec8& u) {
+  // (F19) Thruster i is the "+" (even) or "-" (odd) half of channel c. The check moves u by
+  //   du = s f (e_c - B^T (B B^T)^-1 B e_c) / (e_c - B^T (B B^T)^-1 B e_c)_c,   s = +1 / -1,
+  // the minimum-norm change with B du = 0 that moves channel c by s f (the projection of e_c on
+  // the kernel of B_hat), then scales it by the largest gamma in [0, 1] that keeps every channel
+  // in [lo, hi] (as the excitation's X5). A channel in the row space of B_hat (no kernel
+  // component) or a jet whose half is unusable (valve closed, latched) is not checked.
+  const int i = fdi_.check_jet();
+  const int c = i / 2;
+  const double s = (i % 2 == 0) ? 1.0 : -1.0;
+  if ((s > 0.0 && !(lim.hi(c) > 0.0)) || (s < 0.0 && !(lim.lo(c) < 0.0))) return;
+  const Mat38& b = alloc_.b_hat();
+  const Mat3 g = b * b.transpose();
+  const Eigen::LDLT<Mat3> ldlt(g);
+  if (ldlt.info() != Eigen::Success) return;
+  Vec8 du = -(b.transpose() * ldlt.solve(Vec3(b.col(c))));
+  du(c) += 1.0;
+  if (!(du(c) > 1e-6) || !du.allFinite()) return;
+  du *= s * fdi_.check_force() / du(c);
+  double gamma = 1.0;
+  for (int j = 0; j < kChannels; ++j) {
+    if (du(j) > 0.0) gamma = std::fmin(gamma, (lim.hi(j) - u(j)) / du(j));
+    if (du(j) < 0.0) gamma = std::fmin(gamma, (lim.lo(j) - u(j)) / du(j));
+  }
+  gamma = std::fmax(0.0, gamma);
+  u += gamma * du;
+  check_jet_ = i;
+  check_gamma_ = gamma;
 }
 
 std::array<bool, kPods> Gnc::commanded_valves() const {
@@ -642,6 +683,11 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       }
     }
   }
+  // 5c. Jet check (gnc/fdi/README.md F19): the detector asks for a jet its evidence suspects of
+  // producing less than commanded to be fired firmly, in the null space of B_hat.
+  check_jet_ = -1;
+  check_gamma_ = 0.0;
+  if (enabled && params_.fdi.enabled && fdi_.check_jet() >= 0) apply_jet_check(limits, u);
   if (fdi_.confirmed_degraded() != 0) {
     // (F18) A thruster latched degraded produces its factor of its strength: commanded that much
     // more (the limits above kept it within u_max).
@@ -706,6 +752,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   f.suspicions = fs.suspicions;
   f.probe_pod = static_cast<std::int8_t>(probe_pod_);
   f.probes = fs.probes;
+  f.check_jet = static_cast<std::int8_t>(check_jet_);
+  f.checks = fs.checks;
+  f.checks_unfit = fs.checks_unfit;
 }
 
 void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {

@@ -68,6 +68,7 @@ const char* to_string(EventId e) {
     case EventId::kFaultOverride: return "fault_override";
     case EventId::kReducedAuthority: return "reduced_authority";
     case EventId::kIsolationTest: return "isolation_test";
+    case EventId::kJetCheck: return "jet_check";
   }
   return "?";
 }

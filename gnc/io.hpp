@@ -69,6 +69,8 @@ enum class EventId : std::uint8_t {
   kReducedAuthority, // the remaining thrusters cannot produce every torque direction
   kIsolationTest,    // (F9) a pod's valve closed for an isolation test, or reopened after it
                      // (arg0 = pod, arg1 = 1 started / 0 ended)
+  kJetCheck,         // (F19) a jet fired in B_hat's null space for a jet check, or the check's
+                     // end (arg0 = thruster, arg1 = 1 started / 0 ended)
 };
 
 // Thruster fault kinds the flight software declares (gnc/fdi).
@@ -199,6 +201,9 @@ struct FdiTelemetry {
   std::uint32_t suspicions{0};
   std::int8_t probe_pod{-1};    // (F9) pod closed for an isolation test this tick, -1 none
   std::uint32_t probes{0};      // isolation tests started
+  std::int8_t check_jet{-1};    // (F19) thruster fired for a jet check this tick, -1 none
+  std::uint32_t checks{0};      // jet checks started
+  std::uint32_t checks_unfit{0};  // check windows not scored: they showed a model error
 };
 
 struct GncTelemetry {

@@ -153,6 +153,8 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   m.fdi_windows = f.windows;
   m.fdi_probe_pod = f.probe_pod;
   m.fdi_probes = f.probes;
+  m.fdi_check_jet = f.check_jet;
+  m.fdi_checks = f.checks;
   m.reduced_authority = g.alloc.reduced_authority ? 1 : 0;
   m.alloc_rank = static_cast<std::int8_t>(g.alloc.rank);
 }

@@ -25,7 +25,7 @@ struct Row {
   const char* text;  // printf with %s: from, to, detail (in that order; each may be unused)
 };
 
-constexpr std::array<Row, 16> kRows{{
+constexpr std::array<Row, 17> kRows{{
     {gnc::EventId::kModeChanged, EventId::kModeChanged, Severity::kInfo, Args::kFromTo,
      Detail::kCause, "mode %s -> %s (%s)"},
     {gnc::EventId::kAutoHold, EventId::kAutoHold, Severity::kInfo, Args::kFromTo, Detail::kNone,
@@ -61,6 +61,8 @@ constexpr std::array<Row, 16> kRows{{
      "staged trajectory refused at the tick boundary (mode %s%.0s): stale, active one kept%s"},
     {gnc::EventId::kIsolationTest, EventId::kIsolationTest, Severity::kWarning, Args::kData,
      Detail::kArgs, "isolation test in %.0s%s: a pod's latch valve closed or reopened (%s)"},
+    {gnc::EventId::kJetCheck, EventId::kJetCheck, Severity::kInfo, Args::kData, Detail::kArgs,
+     "jet check in %.0s%s: a suspected thruster fired torque-free, or its check ended (%s)"},
 }};
 
 const Row* find_row(gnc::EventId id) {

@@ -46,7 +46,26 @@ Check validate(const FaultDetectorParams& p) {
   if (!(p.degraded_min_loss >= 0.0 && p.degraded_min_loss < 1.0)) {
     return bad("fdi.degraded_min_loss", "must be in [0, 1)");
   }
+  if (!finite_non_negative(p.check_llr)) return bad("fdi.check_llr", "must be >= 0 and finite");
+  if (!finite_positive(p.check_force_n)) return bad("fdi.check_force_n", "must be positive");
+  if (p.check_windows < 1 || p.check_windows > 1000) {
+    return bad("fdi.check_windows", "must be in [1, 1000]");
+  }
+  if (!finite_non_negative(p.check_interval_s)) {
+    return bad("fdi.check_interval_s", "must be >= 0 and finite");
+  }
+  if (!finite_positive(p.check_fit_chi2)) return bad("fdi.check_fit_chi2", "must be positive");
+  if (!finite_positive(p.check_max_model_error)) {
+    return bad("fdi.check_max_model_error", "must be positive");
+  }
   return Check{};
+}
+
+double check_normal_chi2(const Vec3& b, const Vec3& slope, double stt, double var) {
+  const double bb = b.squaredNorm();
+  if (!(bb > 0.0) || !(stt > 0.0) || !(var > 0.0)) return 0.0;
+  const double bs = b.dot(slope);
+  return std::fmax(0.0, slope.squaredNorm() - bs * bs / bb) * stt / var;
 }
 
 void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs, double u_max,
@@ -115,6 +134,10 @@ void FaultDetector::reset() {
   end_sweep();
   sweep_llr_.fill(0.0);
   sweep_llr_off_.fill(0.0);
+  end_check();
+  last_check_.fill(0);
+  check_prev_ = -1;
+  eval_unfit_ = false;
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   const std::uint16_t degraded = st_.confirmed_degraded;
@@ -184,6 +207,7 @@ void FaultDetector::declare(int thruster, FaultKind kind, double factor) {
   sweep_llr_.fill(0.0);
   sweep_llr_off_.fill(0.0);
   st_.probe_pod = -1;
+  end_check();
 }
 
 void FaultDetector::clear(int thruster) {
@@ -208,6 +232,7 @@ void FaultDetector::clear(int thruster) {
   deg_suspecting_ = false;
   reset_episode();
   probe_left_ = 0;
+  end_check();
   end_probe_verdict();
   reset_probe_llr();
   end_sweep();
@@ -352,6 +377,9 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   } else {
     accumulate<false>(acc, in, r);
   }
+  // (F19) The thrust of this update was commanded while the check of the previous one ran.
+  if (check_prev_ >= 0) acc.check_jet = check_prev_;
+  check_prev_ = st_.check_jet;
   omega_prev_ = in.omega;
   if (n_ >= p_.window_ticks) {
     close_window();
@@ -453,6 +481,7 @@ void FaultDetector::start_window(const Vec3& omega) {
   w.force_impulse = 0.0;
   w.thrust_motion = 0.0;
   w.live = 0;
+  w.check_jet = -1;
 }
 
 void FaultDetector::close_window() {
@@ -501,6 +530,7 @@ void FaultDetector::evaluate_step() {
       // evaluation step (a declaration in the decision cancels it).
       partial_loss_pending_ = p_.degraded_min_loss > 0.0;
       decide();
+      update_check();
       break;
   }
 }
@@ -528,6 +558,17 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   const Vec3 slope = stt > 0.0 ? Vec3(str / stt) : Vec3::Zero();
   st_.residual = slope * n;  // rate change over the window that the model does not explain
   st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
+  // (F19) A window flown with a jet check: its unexplained rate change must lie along the checked
+  // jet's signature b_i (a jet that produced less than commanded: -a b_i f); the part normal to
+  // b_i is a model error the check exposed, not the jet.
+  eval_unfit_ = false;
+  if (w.check_jet >= 0) {
+    const Vec3& b = b_[static_cast<std::size_t>(w.check_jet)];
+    if (check_normal_chi2(b, slope, stt, var) > p_.check_fit_chi2) {
+      eval_unfit_ = true;
+      ++st_.checks_unfit;
+    }
+  }
   ++st_.windows;
   eval_open_fraction_ =
       probe_tested_pod_ >= 0 ? w.tp[static_cast<std::size_t>(probe_tested_pod_)] / (n * dt_) : 1.0;
@@ -554,6 +595,14 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
   const double n = static_cast<double>(w.n);
   const double var = eval_var_;
   const Vec3 r_mean = w.sum_r / n;
+  if (eval_unfit_) {  // (F19) a check that exposed a model error: the window is not scored
+    for (int h = first; h < last; ++h) {
+      const auto k = static_cast<std::size_t>(h);
+      window_llr_[k] = 0.0;
+      if (h >= kThrusters) window_energy_[k - static_cast<std::size_t>(kThrusters)] = 0.0;
+    }
+    return;
+  }
   for (int h = first; h < last; ++h) {
     const auto k = static_cast<std::size_t>(h);
     const int thruster = h % kThrusters;
@@ -632,6 +681,7 @@ void FaultDetector::rank_hypotheses() {
 void FaultDetector::evaluate_cross(const WindowSums& w) {
   // The episode's mean-centred cross sums of the basis ramps, weighted by the window's 1 / var.
   // A ramp that stayed zero (its row not live) adds nothing: its sums are zero.
+  if (eval_unfit_) return;  // (F19) not scored
   const double n = static_cast<double>(w.n);
   std::array<double, kBasis> sx{};
   for (int i = 0; i < kThrusters; ++i) {
@@ -1101,6 +1151,53 @@ void FaultDetector::evaluate_partial_losses() {
   pending_.kind = FaultKind::kDegraded;
   pending_.factor = factor;
   pending_.factor_sigma = sigma;
+}
+
+void FaultDetector::update_check() {
+  // (F19) Jet check. A stuck-off or partly failed jet shows only through what it is commanded,
+  // and the despin asks most jets for a few newtons (F11): their evidence grows over hundreds of
+  // seconds. Once a jet's stuck-off score or partial-loss CUSUM (F18) reaches check_llr, the
+  // flight fires it at check_force_n for check_windows windows in the null space of B_hat (the
+  // Gnc, no torque on the model). Its stuck-off signature then has the energy of a firm firing:
+  // a healthy jet loses about half of it from each hypothesis (exonerated within a window), a
+  // failed one gains it (confirmed by F6 / F13 / F18 as before). Nothing here decides anything.
+  if (check_left_ > 0) {
+    if (--check_left_ == 0) end_check();
+    return;
+  }
+  if (!(p_.check_llr > 0.0) || pending_.confirmed || probe_left_ > 0 || verdict_pending_ ||
+      sweeping()) {
+    return;
+  }
+  // A stuck-on leader is the isolation test's (F9): no jet check meanwhile.
+  if (st_.best >= 0 && st_.best < kThrusters && st_.best_llr > 0.5 * p_.confirm_llr) return;
+  const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);
+  const double window_s = static_cast<double>(p_.window_ticks) * dt_;
+  const auto interval =
+      static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s));
+  int jet = -1;
+  double evidence = p_.check_llr;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (((latched >> i) & 1u) != 0) continue;
+    const auto k = static_cast<std::size_t>(i);
+    if (last_check_[k] != 0 && st_.windows + 1 - last_check_[k] < interval) continue;
+    const double e = std::fmax(score_[k + static_cast<std::size_t>(kThrusters)], deg_cusum_[k]);
+    if (e < evidence) continue;
+    // The model's relative 1 sigma of the jet's signature (F18's eps).
+    const double arm = (pos_[k] + m_.r).cross(dir_[k]).norm();
+    const double kk = std::fabs(m_.k(i));
+    const double eps = (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma +
+                       (arm > 0.0 ? r_sigma_ / arm : 1.0);
+    if (eps <= p_.check_max_model_error) {
+      evidence = e;
+      jet = i;
+    }
+  }
+  if (jet < 0) return;
+  st_.check_jet = jet;
+  check_left_ = p_.check_windows;
+  last_check_[static_cast<std::size_t>(jet)] = st_.windows + 1;
+  ++st_.checks;
 }
 
 double FaultDetector::degraded_llr(int g) const {

@@ -75,6 +75,25 @@ struct FaultDetectorParams {
   // partial loss (not a stuck-off: its own a = 1 trails by margin_llr), and it leads every other
   // hypothesis by margin_llr plus model_sigmas of the model's error. 0: off.
   double degraded_min_loss{0.0};
+  // (F19) Jet check: when a jet's stuck-off score or partial-loss CUSUM (F18) reaches check_llr
+  // (the evidence of a jet the despin asks for only a few newtons), the flight fires that jet at
+  // check_force_n for check_windows windows in the null space of B_hat (no torque on the model),
+  // so its own hypotheses are confirmed or exonerated within seconds. A jet is checked at most
+  // once per check_interval_s. 0: off.
+  double check_llr{0.0};
+  double check_force_n{100.0};
+  int check_windows{3};
+  double check_interval_s{600.0};
+  // A window flown with a jet check is scored only when its unexplained rate change is along the
+  // checked jet's signature: the part normal to it (chi-square, 2 dof) within check_fit_chi2. A
+  // check that shows a model error instead (a centre of mass or an inertia that absorbed an
+  // earlier fault) decides nothing.
+  double check_fit_chi2{13.82};  // chi-square(2) at 0.999
+  // A jet is checked only when the model knows its signature to this relative 1 sigma (strength,
+  // inertia, and the centre of mass against the jet's arm, as F18's eps): a model that absorbed
+  // an earlier fault while the identifier was far from the truth makes a firm firing look like
+  // a loss of thrust of another jet.
+  double check_max_model_error{0.05};
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -86,6 +105,11 @@ struct StuckOnEvidence {
 };
 
 Check validate(const FaultDetectorParams& p);
+
+// (F19) The part of a window's unexplained rate-change slope normal to a jet's signature b, as a
+// chi-square with 2 dof: |slope - (b.slope / |b|^2) b|^2 stt / var (stt the window's sum of
+// squared sample offsets, var the residual's per-sample variance). 0 when b or stt is zero.
+double check_normal_chi2(const Vec3& b, const Vec3& slope, double stt, double var);
 
 // What the detector reads each tick.
 struct FaultDetectorInput {
@@ -136,6 +160,9 @@ struct FaultDetectorStatus {
   std::uint32_t sweeps{0};                    // (F17) pod sweeps started
   std::uint32_t sweep_confirmations{0};       // faults confirmed through (F17)
   std::uint32_t degraded_confirmations{0};    // partial losses confirmed through (F18)
+  int check_jet{-1};                          // (F19) the jet being checked, -1 none
+  std::uint32_t checks{0};                    // (F19) jet checks started
+  std::uint32_t checks_unfit{0};              // (F19) check windows not scored (model error)
 };
 
 // Raised by update(); the caller turns them into events.
@@ -195,6 +222,10 @@ class FaultDetector {
   bool sweeping() const { return sweep_next_ >= 0; }
   // (F9) The pod whose latch valve the detector asks to be closed for an isolation test (-1 none).
   int probe_pod() const { return st_.probe_pod; }
+  // (F19) The thruster the detector asks to be fired for a jet check (-1 none), and at what
+  // force (N, produced).
+  int check_jet() const { return st_.check_jet; }
+  double check_force() const { return p_.check_force_n; }
 
   // Rate change signature of hypothesis h over the last window (exposed for tests): 0..15
   // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
@@ -230,6 +261,17 @@ class FaultDetector {
   // (F18) The jet to confirm degraded now (and its fitted loss), or -1.
   int degraded_candidate(double& loss) const;
   void evaluate_partial_losses();
+  // (F19) After each decision: the jet check under way counts its windows; otherwise one starts
+  // for the jet with the most stuck-off or partial-loss evidence, when it reaches check_llr.
+  void update_check();
+  void end_check() {
+    st_.check_jet = -1;
+    check_left_ = 0;
+  }
+  int check_left_{0};
+  int check_prev_{-1};      // the jet checked on the previous update (its thrust is this one's)
+  bool eval_unfit_{false};  // the evaluated window's check showed a model error: not scored
+  std::array<std::uint32_t, kThrusters> last_check_{};  // window count at each jet's last check, +1
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
   bool deg_suspecting_{false};  // (F18) a partial loss past half the confirmation level
@@ -290,6 +332,7 @@ class FaultDetector {
     // that stays zero all window contributes nothing and its row is not read.
     std::array<double, kBasisPairs> sum_xx{};
     std::uint32_t live{0};
+    int check_jet{-1};  // (F19) the jet checked during the window, -1 none
   };
   template <bool kFirst>
   void accumulate(WindowSums& w, const FaultDetectorInput& in, const Vec3& r);

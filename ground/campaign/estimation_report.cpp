@@ -81,6 +81,8 @@ nlohmann::json fdi_json(const FdiReport& f) {
           {"factor", f.factor},
           {"valve_closed_s", opt(f.valve_closed_s)},
           {"suspicions", f.suspicions},
+          {"checks", f.checks},
+          {"checks_unfit", f.checks_unfit},
           {"fault_first_commanded_s", opt(f.fault_first_commanded_s)},
           {"fault_commanded_s", f.fault_commanded_s},
           {"fault_commanded_impulse_ns", f.fault_commanded_impulse_ns}};
@@ -98,6 +100,10 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
   f.confirmed_off = j.at("confirmed_off").get<std::uint16_t>();
   f.valve_closed_s = to_opt(j.at("valve_closed_s"));
   f.suspicions = j.at("suspicions").get<std::uint32_t>();
+  if (j.contains("checks")) {  // (F19), newer draws
+    f.checks = j.at("checks").get<std::uint32_t>();
+    f.checks_unfit = j.at("checks_unfit").get<std::uint32_t>();
+  }
   // Absent from draws written before these were measured.
   if (j.contains("confirmed_degraded")) {
     f.confirmed_degraded = j.at("confirmed_degraded").get<std::uint16_t>();

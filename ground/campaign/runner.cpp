@@ -263,6 +263,8 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       d.confirmed_off = f.confirmed_off;
       d.confirmed_degraded = f.confirmed_degraded;
       d.suspicions = f.suspicions;
+      d.checks = f.checks;
+      d.checks_unfit = f.checks_unfit;
       if (!setup.truth.faults.empty()) {
         // The first injected fault's jet, commanded by the flight this tick (held over it).
         const plant::ThrusterFault& inj = setup.truth.faults.front();

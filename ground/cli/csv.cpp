@@ -96,7 +96,8 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_D(fdi_best_llr); RS_D(fdi_runner_up_llr); RS_I(fdi_suspected_on); RS_I(fdi_suspected_off);
   RS_I(fdi_confirmed_on); RS_I(fdi_confirmed_off);
   RS_I(fdi_confirmed_degraded); RS_A(fdi_strength_factor); RS_A(valve_open); RS_I(isolation_inhibited);
-  RS_I(fdi_windows); RS_I(fdi_probe_pod); RS_I(fdi_probes); RS_I(reduced_authority); RS_I(alloc_rank);
+  RS_I(fdi_windows); RS_I(fdi_probe_pod); RS_I(fdi_probes);
+  RS_I(fdi_check_jet); RS_I(fdi_checks); RS_I(reduced_authority); RS_I(alloc_rank);
   RS_I(base_ticks); RS_I(base_missed); RS_I(rate_group_count);
   RS_A(rg_cycles); RS_A(rg_last_exec_ns); RS_A(rg_max_exec_ns); RS_A(rg_slips); RS_A(rg_missed);
   RS_I(cmd_accepted); RS_I(cmd_rejected); RS_I(cmd_last_seq); RS_I(cmd_last_opcode);

@@ -719,11 +719,13 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
   }
   if (any_fdi) {
     md << "\n## Fault detection\n\nPer strategy: runs flown with the detector, runs with at least "
-          "one confirmed fault, with a window above the no-fault bound, and with a latch valve "
-          "closed.\n\n| strategy | runs | confirmed | suspected | valve closed |\n"
-          "|---|---:|---:|---:|---:|\n";
+          "one confirmed fault, with a window above the no-fault bound, with a latch valve "
+          "closed, and with a jet check (F19; the checks started in all).\n\n| strategy | runs | "
+          "confirmed | suspected | valve closed | jet checked (checks) |\n"
+          "|---|---:|---:|---:|---:|---:|\n";
     for (std::size_t k = 0; k < spec.strategies.size(); ++k) {
-      int n = 0, conf = 0, susp = 0, valve = 0;
+      int n = 0, conf = 0, susp = 0, valve = 0, checked = 0;
+      std::uint64_t checks = 0;
       for (const DrawResult& dr : draws) {
         if (k >= dr.runs.size() || !dr.runs[k].fdi.enabled) continue;
         const campaign::FdiReport& f = dr.runs[k].fdi;
@@ -731,9 +733,11 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
         conf += f.confirmations > 0 ? 1 : 0;
         susp += f.suspicions > 0 ? 1 : 0;
         valve += f.valve_closed_s ? 1 : 0;
+        checked += f.checks > 0 ? 1 : 0;
+        checks += f.checks;
       }
       md << "| `" << spec.strategies[k].name << "` | " << n << " | " << conf << " | " << susp
-         << " | " << valve << " |\n";
+         << " | " << valve << " | " << checked << " (" << checks << ") |\n";
     }
   }
   if (!s.faults.empty()) {

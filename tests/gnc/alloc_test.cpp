@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <random>
 
 #include "gnc/fdi/fault_detector.hpp"
 #include "gnc/gnc.hpp"
@@ -379,6 +380,54 @@ TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
   EXPECT_EQ(d.status().degraded_confirmations, 1u);
   EXPECT_EQ(d.confirmed_degraded(), 1u << kDegraded);
   EXPECT_LT(d.strength_factor(kDegraded), 0.99);
+}
+
+// gnc/fdi/README.md (F19): jet checks started by the detector and flown by the Gnc (the null
+// space of B_hat, the channels' box, the event): thruster 0 at 70 % of its thrust, the check level
+// set so low that the first partial-loss evidence starts one: no heap.
+TEST(ZeroAllocation, NoHeapInAJetCheck) {
+  GncParams p = test::small_vehicle_params();
+  p.law = LawId::kNtcl;
+  p.allocator = AllocatorKind::kL1;
+  p.fdi.enabled = true;
+  p.fdi.window_ticks = 10;
+  p.fdi.gyro_sigma = 1e-4;
+  p.fdi.degraded_min_loss = 0.1;
+  p.fdi.check_llr = 1e-3;
+  p.fdi.check_force_n = 0.5;  // the small vehicle's channels reach 2 N
+  p.fdi.check_max_model_error = 1e3;  // (the guard is tested with the detector)
+  p.fdi.check_interval_s = 10.0;
+  p.fdi_table_rel_sigma = 1e-4;
+  auto* loop = new test::SmallLoop(p);
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, p.fdi.gyro_sigma);
+  long counted = -1;
+  int checked_ticks = 0;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    for (int k = 0; k < 3000; ++k) {
+      SensorSample s = loop->sample();
+      s.gyro_rate += Vec3(noise(rng), noise(rng), noise(rng));
+      loop->gnc.step(s, k == 0 ? c : GncCommands{}, loop->out);
+      Vec8 produced = loop->out.command.force;
+      if (produced(0) > 0.0) produced(0) *= 0.7;  // thruster 0 (channel 0 "+") at 70 %
+      loop->body.step(p.dt, loop->b_true * produced);
+      loop->t += p.dt;
+      checked_ticks += loop->gnc.jet_check() >= 0 ? 1 : 0;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(loop->gnc.fault_detector().status().checks, 2u)
+      << "windows " << loop->gnc.fault_detector().status().windows << " best "
+      << loop->gnc.fault_detector().status().best << " llr "
+      << loop->gnc.fault_detector().status().best_llr << " mode " << to_string(loop->gnc.mode());
+  EXPECT_GT(checked_ticks, 0);
+  delete loop;
 }
 
 TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {

@@ -856,5 +856,237 @@ TEST(FaultDetector, AClosedWindowIsScoredOverTheNextTicksWithTheModelItWasPredic
   EXPECT_NE(gap.status().chi2, plain.status().chi2);
 }
 
+// (F19) Jet checks. The detector asks for a jet whose stuck-off or partial-loss evidence reaches
+// check_llr to be fired at check_force_n for check_windows windows; the flight adds it in the
+// null space of B_hat. Here the harness adds it to the command of that jet alone (the truth is
+// the detector's model, so the extra torque is predicted). Weak firing as the D+PD despin's
+// (4-15 N per jet): each window alone is far below the observability threshold.
+struct CheckRun {
+  RunResult r;
+  int confirmations{0};
+  double factor{1.0};
+  double factor_sigma{0.0};
+  std::vector<int> checked;       // the jet of each check, in order
+  std::vector<int> check_ticks;   // the tick each check started
+  int checked_ticks{0};           // ticks flown with a check
+};
+
+CheckRun fly_checked(Truth& t, FaultDetector& d, int ticks, std::uint64_t seed) {
+  WeakFiring firing(seed);
+  Vec16 prev = Vec16::Zero();
+  CheckRun run;
+  for (int k = 0; k < ticks; ++k) {
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    in.valve_open = t.valve;
+    const int before = d.check_jet();
+    const FaultEvents e = d.update(in);
+    if (e.confirmed) {
+      ++run.confirmations;
+      if (run.r.confirmed_at < 0) {
+        run.r.confirmed_at = k;
+        run.r.thruster = e.thruster;
+        run.r.kind = e.kind;
+        run.factor = e.factor;
+        run.factor_sigma = e.factor_sigma;
+      }
+    }
+    if (d.check_jet() >= 0 && d.check_jet() != before) {
+      run.checked.push_back(d.check_jet());
+      run.check_ticks.push_back(k);
+    }
+    Vec16 cmd = firing.next(k);
+    if (d.check_jet() >= 0) {
+      cmd(d.check_jet()) += d.check_force();
+      ++run.checked_ticks;
+    }
+    t.advance(cmd);
+    prev = cmd;
+  }
+  return run;
+}
+
+FaultDetector make_checking_detector(const Truth& t, double check_llr) {
+  FaultDetector d = make_detector(t, t.gyro_sigma, 0.1);
+  FaultDetectorParams p = d.params();
+  p.check_llr = check_llr;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 1e-6;
+  m.k_sigma = 1e-3;
+  d.set_model(m);
+  return d;
+}
+
+TEST(FaultDetector, AJetCheckIsolatesAWeaklyCommandedStuckOffJetWithinItsWindows) {
+  for (int i : {1, 6, 11, 13}) {
+    const std::string what = "thruster " + std::to_string(i);
+    // Without checks: the pooled windows (F11) confirm it, late.
+    Truth t0;
+    t0.stuck_off = i;
+    FaultDetector passive = make_checking_detector(t0, 0.0);
+    const CheckRun slow = fly_checked(t0, passive, 30000, 100 + static_cast<std::uint64_t>(i));
+    ASSERT_GE(slow.r.confirmed_at, 0) << what;
+    EXPECT_TRUE(slow.checked.empty());
+    EXPECT_EQ(passive.status().checks, 0u);
+    // With checks at 5: the jet's evidence reaches 5 long before 25 and it is checked.
+    Truth t;
+    t.stuck_off = i;
+    FaultDetector d = make_checking_detector(t, 5.0);
+    const CheckRun fast = fly_checked(t, d, 30000, 100 + static_cast<std::uint64_t>(i));
+    ASSERT_GE(fast.r.confirmed_at, 0) << what;
+    EXPECT_EQ(fast.r.thruster, i) << what;
+    EXPECT_EQ(fast.r.kind, FaultKind::kStuckOff) << what;
+    EXPECT_EQ(fast.confirmations, 1) << what;
+    // The jet was checked, and confirmed within 20 s of its first check (a check of another jet
+    // that also had evidence may come between).
+    const auto own = std::find(fast.checked.begin(), fast.checked.end(), i);
+    ASSERT_NE(own, fast.checked.end()) << what << ": never checked";
+    const int own_tick = fast.check_ticks[static_cast<std::size_t>(own - fast.checked.begin())];
+    EXPECT_GE(fast.r.confirmed_at, own_tick) << what;
+    EXPECT_LE(fast.r.confirmed_at - own_tick, 200) << what;
+    EXPECT_LT(fast.r.confirmed_at, slow.r.confirmed_at) << what;
+    // The check ends with the confirmation: the jet is latched and no longer fired for it.
+    EXPECT_EQ(d.check_jet(), -1) << what;
+    EXPECT_EQ(d.status().check_jet, -1) << what;
+  }
+}
+
+TEST(FaultDetector, AJetCheckConfirmsAPartialLossWithItsFactor) {
+  for (int i : {4, 9}) {
+    const std::string what = "thruster " + std::to_string(i);
+    Truth t;
+    t.degraded = i;
+    t.degraded_factor = 0.5;
+    FaultDetector d = make_checking_detector(t, 5.0);
+    const CheckRun run = fly_checked(t, d, 30000, 300 + static_cast<std::uint64_t>(i));
+    ASSERT_GE(run.r.confirmed_at, 0) << what;
+    EXPECT_EQ(run.r.thruster, i) << what;
+    EXPECT_EQ(run.r.kind, FaultKind::kDegraded) << what;
+    EXPECT_NEAR(run.factor, 0.5, 3.0 * run.factor_sigma) << what;
+    EXPECT_LT(run.factor_sigma, 0.1) << what;
+    const auto own = std::find(run.checked.begin(), run.checked.end(), i);
+    ASSERT_NE(own, run.checked.end()) << what << ": never checked";
+    EXPECT_GE(run.r.confirmed_at, run.check_ticks[static_cast<std::size_t>(own - run.checked.begin())]);
+    EXPECT_EQ(run.confirmations, 1) << what;
+    // Without checks the same weak firing has not decided it by the time the check has.
+    Truth t0;
+    t0.degraded = i;
+    t0.degraded_factor = 0.5;
+    FaultDetector passive = make_checking_detector(t0, 0.0);
+    const CheckRun slow = fly_checked(t0, passive, run.r.confirmed_at + 1, 300 + static_cast<std::uint64_t>(i));
+    EXPECT_LT(slow.r.confirmed_at, 0) << what;
+  }
+}
+
+// Healthy jets checked (the check level set low enough that weak firing's noise starts checks):
+// each check exonerates the jet and nothing is confirmed; a jet is checked again only after
+// check_interval_s.
+TEST(FaultDetector, JetChecksOfHealthyJetsConfirmNothingAndRespectTheInterval) {
+  for (std::uint64_t seed : {5u, 6u, 7u}) {
+    Truth t;
+    FaultDetector d = make_checking_detector(t, 0.5);
+    const CheckRun run = fly_checked(t, d, 20000, seed);  // 2000 s
+    EXPECT_LT(run.r.confirmed_at, 0) << "false alarm: thruster " << run.r.thruster << " "
+                                     << to_string(run.r.kind) << " at tick " << run.r.confirmed_at;
+    EXPECT_GE(run.checked.size(), 3u) << "seed " << seed;
+    EXPECT_EQ(d.status().checks, run.checked.size());
+    EXPECT_EQ(d.status().checks_unfit, 0u) << "seed " << seed;
+    for (std::size_t a = 0; a < run.checked.size(); ++a) {
+      for (std::size_t b = a + 1; b < run.checked.size(); ++b) {
+        if (run.checked[a] != run.checked[b]) continue;
+        EXPECT_GE(run.check_ticks[b] - run.check_ticks[a], 6000 - 10)
+            << "jet " << run.checked[a] << " checked twice within 600 s";
+      }
+    }
+    // Three windows a check (the first partly), no more.
+    EXPECT_LE(run.checked_ticks, static_cast<int>(run.checked.size()) * 3 * 10);
+    EXPECT_GE(run.checked_ticks, static_cast<int>(run.checked.size()) * 2 * 10);
+  }
+}
+
+// A check is only as good as the model it is flown against: with the inertia known to 10 %
+// (the table's, before identification) no jet is checked, whatever the evidence.
+TEST(FaultDetector, NoJetCheckWithAModelThatDoesNotKnowTheJetsSignature) {
+  Truth t;
+  t.stuck_off = 13;
+  FaultDetector d = make_checking_detector(t, 5.0);
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 0.1;
+  m.r_cov = Mat3::Identity() * 1e-6;
+  m.k_sigma = 1e-3;
+  d.set_model(m);
+  const CheckRun run = fly_checked(t, d, 20000, 113);
+  EXPECT_TRUE(run.checked.empty());
+  EXPECT_EQ(d.status().checks, 0u);
+  // The centre of mass known to 0.5 m (arm of an axial jet 1.8 m): the same.
+  Truth t2;
+  t2.stuck_off = 13;
+  FaultDetector d2 = make_checking_detector(t2, 5.0);
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 0.25;
+  d2.set_model(m);
+  const CheckRun run2 = fly_checked(t2, d2, 20000, 113);
+  for (int jet : run2.checked) {
+    const bool axial = jet % 4 >= 2;
+    EXPECT_FALSE(axial) << "axial jet " << jet << " checked against a 0.5 m centre of mass";
+  }
+}
+
+// The fit of a check window (F19): the part of the window's unexplained slope normal to the
+// checked jet's signature, against an explicit projection.
+TEST(FaultDetector, ACheckWindowsNormalChiSquareIsTheResidualOffTheJetsSignature) {
+  const Vec3 b(1.0, 2.0, -0.5);
+  const double stt = 82.5;  // sum of squared offsets of 10 samples
+  const double var = 4e-12;
+  // Along b: nothing normal.
+  EXPECT_NEAR(check_normal_chi2(b, -3e-7 * b, stt, var), 0.0, 1e-9);
+  // An explicit orthogonal decomposition.
+  const Vec3 n = b.cross(Vec3(0.0, 0.0, 1.0)).normalized();
+  for (double along : {0.0, 2e-7, -5e-7}) {
+    for (double normal : {1e-8, 1e-7, 4e-7}) {
+      const Vec3 slope = along * b.normalized() + normal * n;
+      const double expected = normal * normal * stt / var;
+      EXPECT_NEAR(check_normal_chi2(b, slope, stt, var), expected, 1e-9 * expected);
+    }
+  }
+  // At the bound (chi-square(2) 0.999 = 13.82) either side.
+  const double edge = std::sqrt(13.82 * var / stt);
+  EXPECT_LT(check_normal_chi2(b, 0.999 * edge * n + 1e-7 * b, stt, var), 13.82);
+  EXPECT_GT(check_normal_chi2(b, 1.001 * edge * n + 1e-7 * b, stt, var), 13.82);
+  // Degenerate inputs give 0 (the window is scored).
+  EXPECT_EQ(check_normal_chi2(Vec3::Zero(), n, stt, var), 0.0);
+  EXPECT_EQ(check_normal_chi2(b, n, 0.0, var), 0.0);
+}
+
+TEST(FaultDetector, JetCheckParametersAreValidated) {
+  FaultDetectorParams p;
+  p.check_llr = -1.0;
+  EXPECT_STREQ(validate(p).field, "fdi.check_llr");
+  p = FaultDetectorParams{};
+  p.check_force_n = 0.0;
+  EXPECT_STREQ(validate(p).field, "fdi.check_force_n");
+  p = FaultDetectorParams{};
+  p.check_windows = 0;
+  EXPECT_STREQ(validate(p).field, "fdi.check_windows");
+  p = FaultDetectorParams{};
+  p.check_interval_s = std::nan("");
+  EXPECT_STREQ(validate(p).field, "fdi.check_interval_s");
+  p = FaultDetectorParams{};
+  p.check_fit_chi2 = 0.0;
+  EXPECT_STREQ(validate(p).field, "fdi.check_fit_chi2");
+  p = FaultDetectorParams{};
+  p.check_max_model_error = -0.1;
+  EXPECT_STREQ(validate(p).field, "fdi.check_max_model_error");
+  EXPECT_TRUE(validate(FaultDetectorParams{}).ok);
+}
+
 }  // namespace
 }  // namespace rocksteady::gnc

@@ -85,7 +85,7 @@ TEST(Dictionary, FlightNamesAreTheFlightsOwn) {
     EXPECT_EQ(enum_name("reason", r), fsw::to_string(static_cast<fsw::RejectReason>(r)));
   }
   int events_seen = 0;
-  for (int id = 100; id <= static_cast<int>(fsw::EventId::kIsolationTest); ++id) {
+  for (int id = 100; id <= static_cast<int>(fsw::EventId::kJetCheck); ++id) {
     const EventInfo* e = find_event(id);
     ASSERT_NE(e, nullptr) << id;
     EXPECT_STREQ(e->name, fsw::to_string(static_cast<fsw::EventId>(id)));
