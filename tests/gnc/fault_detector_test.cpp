@@ -72,10 +72,12 @@ struct Truth {
   }
 };
 
-FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_min_loss = 0.0) {
+FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_min_loss = 0.0,
+                            double check_llr = 0.0) {
   FaultDetectorParams p;
   p.enabled = true;
   p.degraded_min_loss = degraded_min_loss;
+  p.check_llr = check_llr;  // (F19) jet checks, off unless asked
   p.window_ticks = 10;
   p.gyro_sigma = gyro_sigma;
   p.disturbance_sigma = 0.0;
@@ -276,6 +278,18 @@ struct DegradedRun {
   double factor{1.0};
   double factor_sigma{0.0};
   int confirmations{0};
+  // Counts a confirmation at tick k; true for the run's first.
+  bool note(const FaultEvents& e, int k) {
+    if (!e.confirmed) return false;
+    ++confirmations;
+    if (r.confirmed_at >= 0) return false;
+    r.confirmed_at = k;
+    r.thruster = e.thruster;
+    r.kind = e.kind;
+    factor = e.factor;
+    factor_sigma = e.factor_sigma;
+    return true;
+  }
 };
 
 DegradedRun fly_degraded(int i, double truth_factor, bool weak, int ticks) {
@@ -293,17 +307,9 @@ DegradedRun fly_degraded(int i, double truth_factor, bool weak, int ticks) {
     in.omega_valid = true;
     in.thrust = prev;
     const FaultEvents e = d.update(in);
-    if (e.confirmed) {
-      ++run.confirmations;
-      if (run.r.confirmed_at < 0) {
-        run.r.confirmed_at = k;
-        run.r.thruster = e.thruster;
-        run.r.kind = e.kind;
-        run.factor = e.factor;
-        run.factor_sigma = e.factor_sigma;
-        EXPECT_DOUBLE_EQ(d.strength_factor(e.thruster), e.factor);
-        ticks = std::min(ticks, k + 10000);  // 1000 s more with the factor latched
-      }
+    if (run.note(e, k)) {
+      EXPECT_DOUBLE_EQ(d.strength_factor(e.thruster), e.factor);
+      ticks = std::min(ticks, k + 10000);  // 1000 s more with the factor latched
     }
     const Vec16 cmd = weak ? firing.next(k) : random_firing(cmd_rng);
     t.advance(cmd);
@@ -861,11 +867,7 @@ TEST(FaultDetector, AClosedWindowIsScoredOverTheNextTicksWithTheModelItWasPredic
 // null space of B_hat. Here the harness adds it to the command of that jet alone (the truth is
 // the detector's model, so the extra torque is predicted). Weak firing as the D+PD despin's
 // (4-15 N per jet): each window alone is far below the observability threshold.
-struct CheckRun {
-  RunResult r;
-  int confirmations{0};
-  double factor{1.0};
-  double factor_sigma{0.0};
+struct CheckRun : DegradedRun {
   std::vector<int> checked;       // the jet of each check, in order
   std::vector<int> check_ticks;   // the tick each check started
   int checked_ticks{0};           // ticks flown with a check
@@ -882,17 +884,7 @@ CheckRun fly_checked(Truth& t, FaultDetector& d, int ticks, std::uint64_t seed) 
     in.thrust = prev;
     in.valve_open = t.valve;
     const int before = d.check_jet();
-    const FaultEvents e = d.update(in);
-    if (e.confirmed) {
-      ++run.confirmations;
-      if (run.r.confirmed_at < 0) {
-        run.r.confirmed_at = k;
-        run.r.thruster = e.thruster;
-        run.r.kind = e.kind;
-        run.factor = e.factor;
-        run.factor_sigma = e.factor_sigma;
-      }
-    }
+    run.note(d.update(in), k);
     if (d.check_jet() >= 0 && d.check_jet() != before) {
       run.checked.push_back(d.check_jet());
       run.check_ticks.push_back(k);
@@ -909,18 +901,7 @@ CheckRun fly_checked(Truth& t, FaultDetector& d, int ticks, std::uint64_t seed) 
 }
 
 FaultDetector make_checking_detector(const Truth& t, double check_llr) {
-  FaultDetector d = make_detector(t, t.gyro_sigma, 0.1);
-  FaultDetectorParams p = d.params();
-  p.check_llr = check_llr;
-  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  FaultModel m;
-  m.j = t.body.j;
-  m.r = t.r;
-  m.j_rel_sigma = 1e-4;
-  m.r_cov = Mat3::Identity() * 1e-6;
-  m.k_sigma = 1e-3;
-  d.set_model(m);
-  return d;
+  return make_detector(t, t.gyro_sigma, 0.1, check_llr);
 }
 
 TEST(FaultDetector, AJetCheckIsolatesAWeaklyCommandedStuckOffJetWithinItsWindows) {
