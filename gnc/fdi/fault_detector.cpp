@@ -136,6 +136,7 @@ void FaultDetector::reset() {
   sweep_llr_off_.fill(0.0);
   end_check();
   last_check_.fill(0);
+  check_backoff_.fill(0);
   check_prev_ = -1;
   eval_unfit_ = false;
   const std::uint16_t on = st_.confirmed_on;
@@ -1180,7 +1181,12 @@ void FaultDetector::update_check() {
   for (int i = 0; i < kThrusters; ++i) {
     if (((latched >> i) & 1u) != 0) continue;
     const auto k = static_cast<std::size_t>(i);
-    if (last_check_[k] != 0 && st_.windows + 1 - last_check_[k] < interval) continue;
+    // A jet checked before waits the interval, doubled for each earlier check of it (at most 4x):
+    // a healthy jet whose evidence builds up again under unmodelled firing is not fired every
+    // interval; a jet checked and confirmed is latched and out of the scan.
+    if (last_check_[k] != 0 && st_.windows + 1 - last_check_[k] < (interval << check_backoff_[k])) {
+      continue;
+    }
     const double e = std::fmax(score_[k + static_cast<std::size_t>(kThrusters)], deg_cusum_[k]);
     if (e < evidence) continue;
     // The model's relative 1 sigma of the jet's signature (F18's eps).
@@ -1196,7 +1202,9 @@ void FaultDetector::update_check() {
   if (jet < 0) return;
   st_.check_jet = jet;
   check_left_ = p_.check_windows;
-  last_check_[static_cast<std::size_t>(jet)] = st_.windows + 1;
+  const auto kj = static_cast<std::size_t>(jet);
+  if (last_check_[kj] != 0 && check_backoff_[kj] < 2) ++check_backoff_[kj];
+  last_check_[kj] = st_.windows + 1;
   ++st_.checks;
 }
 

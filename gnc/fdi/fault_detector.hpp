@@ -79,7 +79,8 @@ struct FaultDetectorParams {
   // (the evidence of a jet the despin asks for only a few newtons), the flight fires that jet at
   // check_force_n for check_windows windows in the null space of B_hat (no torque on the model),
   // so its own hypotheses are confirmed or exonerated within seconds. A jet is checked at most
-  // once per check_interval_s. 0: off.
+  // once per check_interval_s, doubled after each check of it that confirmed nothing (up to four
+  // times the interval). 0: off.
   double check_llr{0.0};
   double check_force_n{100.0};
   int check_windows{3};
@@ -272,6 +273,7 @@ class FaultDetector {
   int check_prev_{-1};      // the jet checked on the previous update (its thrust is this one's)
   bool eval_unfit_{false};  // the evaluated window's check showed a model error: not scored
   std::array<std::uint32_t, kThrusters> last_check_{};  // window count at each jet's last check, +1
+  std::array<std::uint8_t, kThrusters> check_backoff_{};  // doublings of each jet's interval (0..2)
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
   bool deg_suspecting_{false};  // (F18) a partial loss past half the confirmation level
