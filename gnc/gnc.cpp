@@ -320,7 +320,6 @@ void Gnc::apply_jet_check(const AllocatorLimits& lim, Vec8& u) {
   gamma = std::fmax(0.0, gamma);
   u += gamma * du;
   check_jet_ = i;
-  check_gamma_ = gamma;
 }
 
 std::array<bool, kPods> Gnc::commanded_valves() const {
@@ -686,7 +685,6 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   // 5c. Jet check (gnc/fdi/README.md F19): the detector asks for a jet its evidence suspects of
   // producing less than commanded to be fired firmly, in the null space of B_hat.
   check_jet_ = -1;
-  check_gamma_ = 0.0;
   if (enabled && params_.fdi.enabled && fdi_.check_jet() >= 0) apply_jet_check(limits, u);
   if (fdi_.confirmed_degraded() != 0) {
     // (F18) A thruster latched degraded produces its factor of its strength: commanded that much

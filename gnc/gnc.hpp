@@ -67,10 +67,8 @@ class Gnc {
   // The identification excitation (gnc/estimation/README.md §I.6) and what it did this tick.
   const IdentificationExcitation& excitation() const { return excite_; }
   const ExcitationStatus& excitation_status() const { return excite_status_; }
-  // (gnc/fdi/README.md F19) The jet fired for the detector's jet check this tick (-1 none) and
-  // the fraction of its check force that fitted the channels' box.
+  // (gnc/fdi/README.md F19) The jet fired for the detector's jet check this tick (-1 none).
   int jet_check() const { return check_jet_; }
-  double jet_check_gamma() const { return check_gamma_; }
 
  private:
   // (F19) Adds the detector's jet check to the allocated forces u: the thruster's channel pushed
@@ -104,7 +102,6 @@ class Gnc {
   int probe_pod_{-1};  // pod closed for the detector's isolation test this tick, -1 none
   int check_jet_{-1};    // (F19) thruster fired for a jet check this tick, -1 none
   int check_event_{-1};  // ... the one last reported by an event
-  double check_gamma_{0.0};
   bool reduced_reported_{false};
   ModeManager modes_{};
   References refs_{};
