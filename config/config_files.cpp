@@ -201,6 +201,9 @@ GncConfig load_gnc(const std::string& path) {
       ic.gate_reinflate_after = r.integer("gate_reinflate_after");
       if (ic.gate_reinflate_after < 1) r.fail("gate_reinflate_after", "must be >= 1");
     }
+    if (r.has("min_inertia_information")) {
+      ic.min_inertia_information = r.non_negative("min_inertia_information");
+    }
     ic.j_forget_s = r.non_negative("inertia_forget_s");
     ic.r_forget_s = r.non_negative("offset_forget_s");
     ic.j_confident_rel = r.positive("inertia_confident_rel");

@@ -43,8 +43,9 @@ void apply_flight_identification_settings(GncParams& p, double gyro_sigma) {
   c.second_order_noise = true;
   c.gate_chi2 = 16.27;
   c.gate_reinflate_after = 3;
-  c.j_forget_s = 3000.0;
-  c.r_forget_s = 3000.0;
+  c.min_inertia_information = 1.0;
+  c.j_forget_s = 0.0;
+  c.r_forget_s = 0.0;
   c.j_confident_rel = 0.01;
   c.r_confident = 0.05;
   c.k_confident = 0.02;

@@ -201,6 +201,9 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   if (!finite_non_negative(c.min_torque_impulse)) return bad("min_torque_impulse", "must be >= 0");
   if (!finite_non_negative(c.min_force_impulse)) return bad("min_force_impulse", "must be >= 0");
   if (!finite_non_negative(c.min_snr)) return bad("min_snr", "must be >= 0");
+  if (!finite_non_negative(c.min_inertia_information)) {
+    return bad("min_inertia_information", "must be >= 0 (0: off)");
+  }
   if (!finite_non_negative(c.min_thruster_impulse)) {
     return bad("min_thruster_impulse", "must be >= 0");
   }
@@ -613,10 +616,25 @@ void Identifier::joint_gain() {
   h.middleCols<3>(kIdB) = -g;
   h.middleCols<3>(kIdD) = -latched_.weight * Mat3::Identity();
 
+  // (I26) What the window would teach J, against what J already knows: tr(R^-1 H_a P_a H_a').
+  // Below min_inertia_information, J is a consider parameter in this window (no gain, no
+  // forgetting, its covariance carried).
+  exc_.inertia_informative = true;
+  exc_.inertia_information = 0.0;
+  joint_.inertia_held = false;
+  if (c_.min_inertia_information > 0.0) {
+    const Mat36 ha = h.leftCols<6>();
+    const Mat3 m = ha * p_all_.topLeftCorner<6, 6>() * ha.transpose();
+    const Eigen::LDLT<Mat3> r_ldlt(latched_r_);
+    exc_.inertia_information = r_ldlt.info() == Eigen::Success ? r_ldlt.solve(m).trace() : 0.0;
+    exc_.inertia_informative = exc_.inertia_information >= c_.min_inertia_information;
+    joint_.inertia_held = !exc_.inertia_informative;
+  }
+
   // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
   VecId& d = joint_.d;
   d.setOnes();
-  if (exc_.inertia_scale && c_.j_forget_s > 0.0) {
+  if (exc_.inertia_scale && exc_.inertia_informative && c_.j_forget_s > 0.0) {
     d.head<6>().setConstant(std::exp(0.5 * c_.window_s / c_.j_forget_s));
   }
   if (exc_.offset && c_.r_forget_s > 0.0) {
@@ -670,6 +688,7 @@ bool Identifier::joint_gain_rows() {
   }
   gated_in_row_ = 0;
   joint_.k = joint_.p_ht.lazyProduct(s_inv);
+  if (joint_.inertia_held) joint_.k.topRows<6>().setZero();  // (I26)
   // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
   if (!exc_.offset) joint_.k.middleRows<3>(kIdR).setZero();
   // (I17) b as a consider parameter: no gain, its covariance kept (Schmidt).
@@ -764,7 +783,8 @@ void Identifier::joint_covariance_rows(int first, int n) {
   for (int i = first; i < first + n; ++i) {
     Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
     row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
-    if (!exc_.offset || !c_.gyro_bias_estimated) {  // a gain with zeroed rows: the full form
+    if (!exc_.offset || !c_.gyro_bias_estimated || joint_.inertia_held) {
+      // a gain with zeroed rows: the full form
       row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
       row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();
     }

@@ -128,6 +128,13 @@ struct IdentifierConfig {
   // times the window's noise sigma (I16): in a closed loop, windows where the commands only
   // answer the disturbance bias the estimate.
   double min_snr{10.0};
+  // (I26) A window updates J only when its information on J is at least this share of what J
+  // already knows, tr(R^-1 H_a P_a H_a') (0: off). The window's noise correlated with its own
+  // regressor (the gyro's noise in A_J; in a closed loop, the disturbance the commands answer)
+  // biases J by about the same amount in every window, whatever its torque, while what a window
+  // teaches falls with the despin's torque: without the gate the late windows pulled J by
+  // percents (estimation README §I.8). J does not forget in a window it does not use.
+  double min_inertia_information{0.0};
   double min_thruster_impulse{5.0};
   // Guards: a J update that leaves J not positive definite or violating the triangle inequality
   // of the principal moments is refused; r must stay within r_max_offset of r0 (else refused);
@@ -169,6 +176,8 @@ struct IdentifierInput {
 struct IdentifierExcitation {
   bool inertia_motion{false};               // the window carried rotation (inertia ratios)
   bool inertia_scale{false};                // ... and enough commanded torque (inertia scale)
+  bool inertia_informative{true};           // (I26) ... and adds enough to what J already knows
+  double inertia_information{0.0};          // (I26) tr(R^-1 H_a P_a H_a'), 0 when not computed
   bool offset{false};                       // enough net force (r, normal to it)
   std::array<bool, kThrusters> thruster{};  // thruster i fired enough
 };
@@ -436,6 +445,7 @@ class Identifier {
     Eigen::Matrix<double, 3, kIdParams> h{Eigen::Matrix<double, 3, kIdParams>::Zero()};
     Eigen::Matrix<double, kIdParams, 3> dht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
     bool any_thruster{false};
+    bool inertia_held{false};  // (I26) J's gain is zero in this window: the full covariance form
     VecId d{VecId::Ones()};
     Vec3 e0{Vec3::Zero()};
     Mat3 s{Mat3::Identity()};

@@ -146,7 +146,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
                   : fs.params.estimator.kind == gnc::EstimatorKind::kFilter ? "filter"
                                                                             : "passthrough";
   est.identifying = fs.params.identification.enabled;
-  const double marks[] = {60.0, 300.0, 600.0, 1000.0, 3000.0};
+  const double marks[] = {60.0, 300.0, 600.0, 1000.0, 3000.0, 10000.0, 30000.0};
   std::size_t next_mark = 0;
   if (est.identifying) {
     for (double m : marks) est.marks.push_back(IdentificationMark{m});
