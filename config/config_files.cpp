@@ -204,6 +204,9 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("min_inertia_information")) {
       ic.min_inertia_information = r.non_negative("min_inertia_information");
     }
+    if (r.has("min_offset_information")) {
+      ic.min_offset_information = r.non_negative("min_offset_information");
+    }
     ic.j_forget_s = r.non_negative("inertia_forget_s");
     ic.r_forget_s = r.non_negative("offset_forget_s");
     ic.j_confident_rel = r.positive("inertia_confident_rel");

@@ -204,6 +204,9 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   if (!finite_non_negative(c.min_inertia_information)) {
     return bad("min_inertia_information", "must be >= 0 (0: off)");
   }
+  if (!finite_non_negative(c.min_offset_information)) {
+    return bad("min_offset_information", "must be >= 0 (0: off)");
+  }
   if (!finite_non_negative(c.min_thruster_impulse)) {
     return bad("min_thruster_impulse", "must be >= 0");
   }
@@ -224,11 +227,11 @@ void Identifier::configure(const IdentifierConfig& c) {
   c_ = c;
   n_ = static_cast<int>(std::lround(c.window_s / c.dt));
   dist_factor_ = held_disturbance_factor(c.window_s, c.disturbance_corr_s);
-  // Ticks of one joint step: linearisation, the second-order term (3), gain rows, gain, a gate
-  // re-inflation (4), apply, covariance rows, finish, strengths and report. Smallest blocks that
-  // let the step end well before the next window closes.
+  // Ticks of one joint step: linearisation, the second-order term (3), the information gate
+  // (I26), gain rows, gain, a gate re-inflation (4), apply, covariance rows, finish, strengths
+  // and report. Smallest blocks that let the step end well before the next window closes.
   const auto ticks_for = [](int g, int r) {
-    return 1 + 3 + (kIdParams + g - 1) / g + 1 + 4 + 1 + (kIdParams + r - 1) / r +
+    return 1 + 3 + 1 + (kIdParams + g - 1) / g + 1 + 4 + 1 + (kIdParams + r - 1) / r +
            (kIdParams + kSymmetriseRowsPerTick - 1) / kSymmetriseRowsPerTick + 1 + 1 +
            (kIdParams + kAnchorRowsPerTick - 1) / kAnchorRowsPerTick + 1 +
            (kThrusters + kFaultJetsPerTick - 1) / kFaultJetsPerTick +
@@ -616,25 +619,18 @@ void Identifier::joint_gain() {
   h.middleCols<3>(kIdB) = -g;
   h.middleCols<3>(kIdD) = -latched_.weight * Mat3::Identity();
 
-  // (I26) What the window would teach J, against what J already knows: tr(R^-1 H_a P_a H_a').
-  // Below min_inertia_information, J is a consider parameter in this window (no gain, no
-  // forgetting, its covariance carried).
+  // (I26) decided on the first block of gain rows (information_gate), a tick of its own.
   exc_.inertia_informative = true;
   exc_.inertia_information = 0.0;
+  exc_.offset_informative = true;
   joint_.inertia_held = false;
-  if (c_.min_inertia_information > 0.0) {
-    const Mat36 ha = h.leftCols<6>();
-    const Mat3 m = ha * p_all_.topLeftCorner<6, 6>() * ha.transpose();
-    const Eigen::LDLT<Mat3> r_ldlt(latched_r_);
-    exc_.inertia_information = r_ldlt.info() == Eigen::Success ? r_ldlt.solve(m).trace() : 0.0;
-    exc_.inertia_informative = exc_.inertia_information >= c_.min_inertia_information;
-    joint_.inertia_held = !exc_.inertia_informative;
-  }
+  joint_.offset_held = false;
+  joint_.gated = false;
 
   // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
   VecId& d = joint_.d;
   d.setOnes();
-  if (exc_.inertia_scale && exc_.inertia_informative && c_.j_forget_s > 0.0) {
+  if (exc_.inertia_scale && c_.j_forget_s > 0.0) {
     d.head<6>().setConstant(std::exp(0.5 * c_.window_s / c_.j_forget_s));
   }
   if (exc_.offset && c_.r_forget_s > 0.0) {
@@ -653,8 +649,45 @@ void Identifier::joint_gain() {
   joint_.started = true;
 }
 
+bool Identifier::information_gate() {
+  // (I26) What the window would teach J, against what J already knows:
+  //   nu_J = tr(R^-1 H_a P_a H_a'),  nu_r = tr(R^-1 S(F) P_r S(F)'),
+  // R the window's noise (I19). Below min_*_information the group is a consider parameter in
+  // this window: no gain (joint_gain_rows), no forgetting (its rows of D and D H' put back to
+  // one here, before any row of P H' is formed), its covariance carried (the full form).
+  joint_.gated = true;
+  if (!(c_.min_inertia_information > 0.0) && !(c_.min_offset_information > 0.0)) return false;
+  const Eigen::LDLT<Mat3> r_ldlt(latched_r_);
+  if (r_ldlt.info() != Eigen::Success) return true;
+  const Mat3 r_inv = r_ldlt.solve(Mat3::Identity());
+  if (c_.min_inertia_information > 0.0) {
+    const Mat36 ha = joint_.h.leftCols<6>();
+    const Mat3 m = ha * p_all_.topLeftCorner<6, 6>() * ha.transpose();
+    exc_.inertia_information = r_inv.cwiseProduct(m).sum();  // tr(R^-1 M), both symmetric
+    exc_.inertia_informative = exc_.inertia_information >= c_.min_inertia_information;
+    joint_.inertia_held = !exc_.inertia_informative;
+    if (joint_.inertia_held) {
+      joint_.d.head<6>().setOnes();
+      joint_.dht.topRows<6>() = ha.transpose();
+    }
+  }
+  if (c_.min_offset_information > 0.0 && exc_.offset) {
+    const Mat3 sf = joint_.h.middleCols<3>(kIdR);  // S(F_hat)
+    const Mat3 m = sf * p_all_.block<3, 3>(kIdR, kIdR) * sf.transpose();
+    exc_.offset_informative = r_inv.cwiseProduct(m).sum() >= c_.min_offset_information;
+    joint_.offset_held = !exc_.offset_informative;
+    if (joint_.offset_held) {
+      joint_.d.segment<3>(kIdR).setOnes();
+      joint_.dht.middleRows<3>(kIdR) = sf.transpose();
+    }
+  }
+  return true;
+}
+
 bool Identifier::joint_gain_rows() {
   if (!joint_.started) return true;
+  // (I26) on a tick of its own before the first row block (none when both gates are off).
+  if (!joint_.gated && information_gate()) return false;
   const int first = joint_.gain_rows;
   if (first < kIdParams) {
     const int n = std::min(gain_rows_per_tick_, kIdParams - first);
@@ -690,7 +723,7 @@ bool Identifier::joint_gain_rows() {
   joint_.k = joint_.p_ht.lazyProduct(s_inv);
   if (joint_.inertia_held) joint_.k.topRows<6>().setZero();  // (I26)
   // Without a net force r is not estimated (I10): it stays a consider parameter, gain zero.
-  if (!exc_.offset) joint_.k.middleRows<3>(kIdR).setZero();
+  if (!exc_.offset || joint_.offset_held) joint_.k.middleRows<3>(kIdR).setZero();
   // (I17) b as a consider parameter: no gain, its covariance kept (Schmidt).
   if (!c_.gyro_bias_estimated) joint_.k.middleRows<3>(kIdB).setZero();
   joint_.pending = true;
@@ -772,7 +805,7 @@ void Identifier::joint_apply() {
   }
   window_fitted_ = true;
   ++counters_.inertia_updates;
-  if (exc_.offset) ++counters_.offset_updates;
+  if (exc_.offset && !joint_.offset_held) ++counters_.offset_updates;
   if (joint_.any_thruster) ++counters_.strength_updates;
 }
 
@@ -783,7 +816,7 @@ void Identifier::joint_covariance_rows(int first, int n) {
   for (int i = first; i < first + n; ++i) {
     Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
     row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
-    if (!exc_.offset || !c_.gyro_bias_estimated || joint_.inertia_held) {
+    if (!exc_.offset || !c_.gyro_bias_estimated || joint_.inertia_held || joint_.offset_held) {
       // a gain with zeroed rows: the full form
       row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
       row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();

@@ -135,6 +135,8 @@ struct IdentifierConfig {
   // teaches falls with the despin's torque: without the gate the late windows pulled J by
   // percents (estimation README §I.8). J does not forget in a window it does not use.
   double min_inertia_information{0.0};
+  // ... and r only when its information tr(R^-1 S(F) P_r S(F)') is at least this share (0: off).
+  double min_offset_information{0.0};
   double min_thruster_impulse{5.0};
   // Guards: a J update that leaves J not positive definite or violating the triangle inequality
   // of the principal moments is refused; r must stay within r_max_offset of r0 (else refused);
@@ -178,6 +180,7 @@ struct IdentifierExcitation {
   bool inertia_scale{false};                // ... and enough commanded torque (inertia scale)
   bool inertia_informative{true};           // (I26) ... and adds enough to what J already knows
   double inertia_information{0.0};          // (I26) tr(R^-1 H_a P_a H_a'), 0 when not computed
+  bool offset_informative{true};            // (I26) the same test for r
   bool offset{false};                       // enough net force (r, normal to it)
   std::array<bool, kThrusters> thruster{};  // thruster i fired enough
 };
@@ -355,7 +358,8 @@ class Identifier {
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
   double sample_weight(int i) const;  // w(t_i)
   double window_noise() const;        // row variance of the latched window (I5)
-  Mat3 window_noise_matrix() const;   // covariance of the latched window's equation (I19)
+  Mat3 window_noise_matrix() const;
+  bool information_gate();  // (I26) before the first block of gain rows; false: both gates off   // covariance of the latched window's equation (I19)
   bool gate_reinflate();                    // (I18) a re-inflation the gate asked for, a part per block
   int gate_reinflation_due_{0};             // ... its next part, 1-4 (0: none)
   double torque_threshold() const;    // (I16)
@@ -446,6 +450,8 @@ class Identifier {
     Eigen::Matrix<double, kIdParams, 3> dht{Eigen::Matrix<double, kIdParams, 3>::Zero()};
     bool any_thruster{false};
     bool inertia_held{false};  // (I26) J's gain is zero in this window: the full covariance form
+    bool offset_held{false};   // (I26) ... r's
+    bool gated{false};         // (I26) the information gate has been decided for this step
     VecId d{VecId::Ones()};
     Vec3 e0{Vec3::Zero()};
     Mat3 s{Mat3::Identity()};

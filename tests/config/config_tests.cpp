@@ -190,6 +190,7 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
     EXPECT_EQ(f.config.gate_chi2, y.config.gate_chi2);
     EXPECT_EQ(f.config.gate_reinflate_after, y.config.gate_reinflate_after);
     EXPECT_EQ(f.config.min_inertia_information, y.config.min_inertia_information);
+    EXPECT_EQ(f.config.min_offset_information, y.config.min_offset_information);
     EXPECT_EQ(f.config.j_forget_s, y.config.j_forget_s);
     EXPECT_EQ(f.config.r_forget_s, y.config.r_forget_s);
     EXPECT_EQ(f.config.j_confident_rel, y.config.j_confident_rel);

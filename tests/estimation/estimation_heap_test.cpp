@@ -88,6 +88,7 @@ TEST(EstimationHeap, IdentifierWithBiasGateSecondOrderTermAndFaultTorqueAllocate
       c.gate_chi2 = gate;
       c.fault_torque_sigma = 2000.0;  // (I22)-(I23): the fault torque and its per-window scores
       c.min_inertia_information = 1.0;  // (I26) the information gate
+      c.min_offset_information = 1.0;
       Identifier id;
       id.configure(c);
       IdentifierInput in;

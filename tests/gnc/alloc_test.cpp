@@ -111,6 +111,7 @@ TEST(ZeroAllocation, NoHeapWithMekfIdentificationFaultDetectionAndL1) {
   id.config.min_force_impulse = 0.02;
   id.config.min_thruster_impulse = 0.005;
   id.config.min_inertia_information = 1.0;  // (I26) the information gate, as gnc.yaml
+  id.config.min_offset_information = 1.0;
   p.fdi.enabled = true;  // and fault detection, with ground declarations and a valve closure
   p.fdi.degraded_min_loss = 0.1;
   ASSERT_TRUE(loop->gnc.init(p).ok);
