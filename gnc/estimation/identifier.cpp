@@ -804,7 +804,7 @@ void Identifier::joint_apply() {
     }
   }
   window_fitted_ = true;
-  ++counters_.inertia_updates;
+  if (!joint_.inertia_held) ++counters_.inertia_updates;  // (I26) a held J was not updated
   if (exc_.offset && !joint_.offset_held) ++counters_.offset_updates;
   if (joint_.any_thruster) ++counters_.strength_updates;
 }
