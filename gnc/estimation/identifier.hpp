@@ -358,8 +358,8 @@ class Identifier {
   double sample_alpha(int i) const;   // coefficient of L(omega_i), (I4)
   double sample_weight(int i) const;  // w(t_i)
   double window_noise() const;        // row variance of the latched window (I5)
-  Mat3 window_noise_matrix() const;
-  bool information_gate();  // (I26) before the first block of gain rows; false: both gates off   // covariance of the latched window's equation (I19)
+  Mat3 window_noise_matrix() const;  // covariance of the latched window's equation (I19)
+  bool information_gate();  // (I26) before the first block of gain rows; false: both gates off
   bool gate_reinflate();                    // (I18) a re-inflation the gate asked for, a part per block
   int gate_reinflation_due_{0};             // ... its next part, 1-4 (0: none)
   double torque_threshold() const;    // (I16)
