@@ -1189,12 +1189,7 @@ void FaultDetector::update_check() {
     }
     const double e = std::fmax(score_[k + static_cast<std::size_t>(kThrusters)], deg_cusum_[k]);
     if (e < evidence) continue;
-    // The model's relative 1 sigma of the jet's signature (F18's eps).
-    const double arm = (pos_[k] + m_.r).cross(dir_[k]).norm();
-    const double kk = std::fabs(m_.k(i));
-    const double eps = (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma +
-                       (arm > 0.0 ? r_sigma_ / arm : 1.0);
-    if (eps <= p_.check_max_model_error) {
+    if (signature_rel_error(i) <= p_.check_max_model_error) {
       evidence = e;
       jet = i;
     }
@@ -1206,6 +1201,15 @@ void FaultDetector::update_check() {
   if (last_check_[kj] != 0 && check_backoff_[kj] < 2) ++check_backoff_[kj];
   last_check_[kj] = st_.windows + 1;
   ++st_.checks;
+}
+
+double FaultDetector::signature_rel_error(int i) const {
+  // (F18, F19) The model's relative 1 sigma of thruster i's signature b_i = J^-1 k_i (p_i + r) x e_i:
+  // strength, inertia, and the centre of mass against the jet's arm.
+  const auto k = static_cast<std::size_t>(i);
+  const double arm = (pos_[k] + m_.r).cross(dir_[k]).norm();
+  const double kk = std::fabs(m_.k(i));
+  return (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma + (arm > 0.0 ? r_sigma_ / arm : 1.0);
 }
 
 double FaultDetector::degraded_llr(int g) const {
@@ -1230,9 +1234,15 @@ int FaultDetector::degraded_candidate(double& loss) const {
   //     alone does not make a loss,
   //   Gamma_g - (SR_g - E_g / 2) > margin_llr: a partial loss, not a total one (a = 1, the
   //     stuck-off that (F6)/(F13) decide),
-  //   Gamma_g leads every other jet's Gamma and every stuck-on / stuck-off score by margin_llr.
+  //   Gamma_g leads every other jet's Gamma and every stuck-on / stuck-off score by margin_llr,
+  //   the runner-up h's fit is further from the data than the model's error can turn the two
+  //   signatures: arccos sqrt(Gamma_h / Gamma_g) > model_sigmas (eps_g + eps_h). Twin jets
+  //   (opposite pods, the same direction) have nearly parallel signatures, and a model a few
+  //   percent off orders them either way; a check (F19) of either, which fires it alone, moves
+  //   them apart. (model_sigmas = 0 takes the model as exact, as in F8.)
   const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);
   int g = -1;
+  int runner = -1;
   double gamma_g = 0.0;
   double second = 0.0;
   for (int i = 0; i < kThrusters; ++i) {
@@ -1240,20 +1250,26 @@ int FaultDetector::degraded_candidate(double& loss) const {
     const double gi = degraded_llr(i);
     if (gi > gamma_g) {
       second = gamma_g;
+      runner = g;
       gamma_g = gi;
       g = i;
     } else if (gi > second) {
       second = gi;
+      runner = i;
     }
   }
   if (g < 0 || gamma_g <= p_.confirm_llr || gamma_g - second <= p_.margin_llr) return -1;
   const auto kg = static_cast<std::size_t>(g);
   const double a = deg_sr_[kg] / deg_e_[kg];
-  const double arm = (pos_[kg] + m_.r).cross(dir_[kg]).norm();
-  const double kk = std::fabs(m_.k(g));
-  const double eps = (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma +
-                     (arm > 0.0 ? r_sigma_ / arm : 1.0);
+  const double eps = signature_rel_error(g);
   if (a >= 1.0 || a < p_.degraded_min_loss + p_.model_sigmas * eps) return -1;
+  // Twin jets: the runner-up explains the data to cos^2 theta = Gamma_h / Gamma_g of what g
+  // does. Each signature's direction is known to its relative error, so the model's error can
+  // turn either one by up to model_sigmas eps: g is decided only when theta exceeds both turns.
+  if (runner >= 0 && second > 0.0 && p_.model_sigmas > 0.0) {
+    const double turn = p_.model_sigmas * (eps + signature_rel_error(runner));
+    if (turn >= 1.5707963267948966 || std::sqrt(second / gamma_g) >= std::cos(turn)) return -1;
+  }
   if (gamma_g - (deg_sr_[kg] - 0.5 * deg_e_[kg]) <= p_.margin_llr) return -1;
   for (int h = 0; h < kHypotheses; ++h) {
     if (gamma_g - score_[static_cast<std::size_t>(h)] <= p_.margin_llr) return -1;

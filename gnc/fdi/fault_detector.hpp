@@ -257,6 +257,8 @@ class FaultDetector {
   int partial_loss_alternative(int h) const;
   // (F13) The episode's LLR of hypothesis g (16..31) as a partial loss of thrust, fitted in (0, 1].
   double partial_loss_llr(int g) const;
+  // (F18, F19) The model's relative 1 sigma of thruster i's signature b_i.
+  double signature_rel_error(int i) const;
   // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
   double degraded_llr(int g) const;
   // (F18) The jet to confirm degraded now (and its fitted loss), or -1.
