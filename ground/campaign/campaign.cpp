@@ -224,9 +224,18 @@ void write_results_markdown(const std::string& path, const std::vector<RunResult
 
 void write_timeseries_csv(const std::string& path, const RunResult& r) {
   std::ofstream out = open_out(path);
+  // Identification and fault-detection columns only for runs that fly those modules.
+  const bool id = r.estimation.identifying;
+  const bool fdi = r.fdi.enabled;
   out << "t_s,omega_x,omega_y,omega_z,omega_hat_x,omega_hat_y,omega_hat_z,q_x,q_y,q_z,"
          "q_hat_x,q_hat_y,q_hat_z,torque_cmd_x,torque_cmd_y,torque_cmd_z,"
-         "u0,u1,u2,u3,u4,u5,u6,u7,fuel_kg,fuel_hat_kg,mode\n";
+         "u0,u1,u2,u3,u4,u5,u6,u7,fuel_kg,fuel_hat_kg,mode";
+  if (id) {
+    out << ",id_j_rel,id_r_err_m,id_k_max_err,id_j_nees,id_r_nees,id_r_sigma_max_m,"
+           "id_windows_gated,id_gate_reinflations";
+  }
+  if (fdi) out << ",fdi_chi2,fdi_best,fdi_best_llr,fdi_confirmed,fdi_check_jet";
+  out << "\n";
   char buf[64];
   auto put = [&](double v) {
     std::snprintf(buf, sizeof buf, "%.9g", v);
@@ -242,7 +251,21 @@ void write_timeseries_csv(const std::string& path, const RunResult& r) {
     for (int i = 0; i < 8; ++i) put(row.force(i));
     put(row.fuel_kg);
     put(row.fuel_hat_kg);
-    out << gnc::to_string(row.mode) << "\n";
+    out << gnc::to_string(row.mode);
+    if (id) {
+      for (double v : {row.j_rel, row.r_err_m, row.k_max_err, row.j_nees, row.r_nees,
+                       row.r_sigma_max_m}) {
+        std::snprintf(buf, sizeof buf, ",%.9g", v);
+        out << buf;
+      }
+      out << "," << row.windows_gated << "," << row.gate_reinflations;
+    }
+    if (fdi) {
+      std::snprintf(buf, sizeof buf, ",%.9g,%d,%.9g,%u,%d", row.fdi_chi2, row.fdi_best,
+                    row.fdi_best_llr, static_cast<unsigned>(row.fdi_confirmed), row.fdi_check_jet);
+      out << buf;
+    }
+    out << "\n";
   }
 }
 

@@ -115,6 +115,24 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     r.series.reserve(static_cast<std::size_t>(n_ticks / log_every + 2));
   }
 
+  // The identifier's errors against the truth, with its reported 1 sigma (diagonal NEES, 6 and
+  // 3 dof): the marks and the time series.
+  const Eigen::Matrix3d j_true = plant.inertia();
+  const Eigen::Vector3d r_true = setup.truth.mass.r_so_bcm;
+  const gnc::Vec16 k_true = setup.truth.thruster_strength;
+  struct IdentificationErrors {
+    double j_rel, r_err_m, k_max_err, j_nees, r_nees;
+  };
+  auto identification_errors = [&](const gnc::EstimationTelemetry& e) {
+    const Eigen::Matrix3d j_hat = gnc::inertia_matrix(e.j);
+    const gnc::Vec6 da = gnc::inertia_params(j_hat) - gnc::inertia_params(j_true);
+    return IdentificationErrors{
+        (j_hat - j_true).norm() / j_true.norm(), (e.r - r_true).norm(),
+        (e.k - k_true).cwiseAbs().maxCoeff(),
+        da.cwiseQuotient(e.j_sigma.cwiseMax(1e-300)).squaredNorm(),
+        (e.r - r_true).cwiseQuotient(e.r_sigma.cwiseMax(1e-300)).squaredNorm()};
+  };
+
   ConvergenceTracker omega_conv(setup.omega_tol_rad_s);
   ConvergenceTracker q_conv(setup.q_tol);
   auto record = [&](const gnc::GncOutput& o) {
@@ -131,6 +149,27 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     row.fuel_kg = plant.fuel_kg();
     row.fuel_hat_kg = o.telemetry.fuel_kg;
     row.mode = o.telemetry.mode;
+    if (o.telemetry.est.identifying) {
+      const gnc::EstimationTelemetry& e = o.telemetry.est;
+      const IdentificationErrors ie = identification_errors(e);
+      row.j_rel = ie.j_rel;
+      row.r_err_m = ie.r_err_m;
+      row.k_max_err = ie.k_max_err;
+      row.j_nees = ie.j_nees;
+      row.r_nees = ie.r_nees;
+      row.r_sigma_max_m = e.r_sigma.maxCoeff();
+      row.windows_gated = e.windows_gated;
+      row.gate_reinflations = e.gate_reinflations;
+    }
+    if (o.telemetry.fdi.enabled) {
+      const gnc::FdiTelemetry& f = o.telemetry.fdi;
+      row.fdi_chi2 = f.chi2;
+      row.fdi_best = f.best;
+      row.fdi_best_llr = f.best_llr;
+      row.fdi_confirmed =
+          static_cast<std::uint16_t>(f.confirmed_on | f.confirmed_off | f.confirmed_degraded);
+      row.fdi_check_jet = f.check_jet;
+    }
     r.series.push_back(row);
   };
 
@@ -152,9 +191,6 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     for (double m : marks) est.marks.push_back(IdentificationMark{m});
     est.strengths.resize(16);
   }
-  const Eigen::Matrix3d j_true = plant.inertia();
-  const Eigen::Vector3d r_true = setup.truth.mass.r_so_bcm;
-  const gnc::Vec16 k_true = setup.truth.thruster_strength;
   double sq_att = 0.0;
   double sq_rate = 0.0;
   std::uint64_t n_est = 0;
@@ -175,14 +211,13 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     if (next_mark < est.marks.size() && t >= marks[next_mark] - 1e-9) {
       const gnc::EstimationTelemetry& e = o.telemetry.est;
       IdentificationMark& m = est.marks[next_mark++];
-      const Eigen::Matrix3d j_hat = gnc::inertia_matrix(e.j);
+      const IdentificationErrors ie = identification_errors(e);
       m.reached = true;
-      m.j_rel = (j_hat - j_true).norm() / j_true.norm();
-      m.r_err_m = (e.r - r_true).norm();
-      m.k_max_err = (e.k - k_true).cwiseAbs().maxCoeff();
-      const gnc::Vec6 da = gnc::inertia_params(j_hat) - gnc::inertia_params(j_true);
-      m.j_nees = da.cwiseQuotient(e.j_sigma.cwiseMax(1e-300)).squaredNorm();
-      m.r_nees = (e.r - r_true).cwiseQuotient(e.r_sigma.cwiseMax(1e-300)).squaredNorm();
+      m.j_rel = ie.j_rel;
+      m.r_err_m = ie.r_err_m;
+      m.k_max_err = ie.k_max_err;
+      m.j_nees = ie.j_nees;
+      m.r_nees = ie.r_nees;
       m.inertia_confident = e.inertia_confident;
       m.offset_confident = e.offset_confident;
       m.offset_unobservable = e.offset_unobservable;

@@ -33,6 +33,24 @@ struct TimeRow {
   double fuel_kg{0.0};                                  // true, cumulative
   double fuel_hat_kg{0.0};                              // flight software's estimate
   gnc::Mode mode{gnc::Mode::kIdle};
+  // Identification against the truth (written when the identifier runs): as IdentificationMark,
+  // and the innovation gate's counters (estimation README I18).
+  double j_rel{0.0};
+  double r_err_m{0.0};
+  double k_max_err{0.0};
+  double j_nees{0.0};
+  double r_nees{0.0};
+  double r_sigma_max_m{0.0};  // largest reported 1 sigma of r
+  std::uint32_t windows_gated{0};
+  std::uint32_t gate_reinflations{0};
+  // Fault detection (written when the detector runs): the last window's no-fault chi-square, the
+  // leading hypothesis (0..15 stuck on, 16..31 stuck off, -1 none) and its LLR, the confirmed
+  // jets (on | off | degraded) and the jet under a check (-1 none).
+  double fdi_chi2{0.0};
+  int fdi_best{-1};
+  double fdi_best_llr{0.0};
+  std::uint16_t fdi_confirmed{0};
+  int fdi_check_jet{-1};
 };
 
 // Identification against the truth at one instant (the marks: 60, 300, 600, 1000, 3000 s).

@@ -1,8 +1,11 @@
 // Campaign outputs: results.csv header and NC fields, the Markdown table layout, time series, plots.
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -105,6 +108,75 @@ TEST(CampaignOutputs, SmallCampaignWritesTablesSeriesAndPlots) {
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
   EXPECT_EQ(rep.results[1].status, RunStatus::kNoReference);
   EXPECT_TRUE(rep.results[1].timeseries_path.empty());
+  fs::remove_all(dir);
+}
+
+// A run that identifies and detects faults carries the identifier's errors against the truth and
+// the detector's state in its time series; at the marks (60, 300 s) the columns are the marks'
+// numbers. A run without those modules has none of the columns.
+TEST(CampaignOutputs, TimeSeriesCarriesIdentificationAndFaultDetectionWhenFlown) {
+  CampaignSpec spec;
+  spec.mission_file = kConfigs + "/mission.yaml";
+  spec.gnc_file = kConfigs + "/gnc.yaml";
+  spec.case_files = {kConfigs + "/cases/case2.yaml"};
+  spec.strategies = {*parse_strategy("ntcl+dpd_ref:id:fdi"), *parse_strategy("ntcl+dpd_ref")};
+  const fs::path dir = fs::temp_directory_path() / "rocksteady_outputs_id_series";
+  fs::remove_all(dir);
+  spec.out_dir = dir.string();
+  spec.duration_s = 400.0;
+  spec.log_interval_s = 20.0;
+  spec.write_plots = false;
+  spec.progress = ProgressMode::kOff;
+  NoTrajectorySource none;
+  std::ostringstream log;
+  const CampaignReport rep = run_campaign(spec, none, log);
+  ASSERT_EQ(rep.results.size(), 2u);
+  const RunResult& id = rep.results[0];
+  ASSERT_EQ(id.status, RunStatus::kOk) << id.note;
+  const auto ts = lines(slurp(id.timeseries_path));
+  ASSERT_GE(ts.size(), 2u);
+  const std::string tail =
+      ",mode,id_j_rel,id_r_err_m,id_k_max_err,id_j_nees,id_r_nees,id_r_sigma_max_m,"
+      "id_windows_gated,id_gate_reinflations,fdi_chi2,fdi_best,fdi_best_llr,fdi_confirmed,"
+      "fdi_check_jet";
+  ASSERT_GE(ts[0].size(), tail.size());
+  EXPECT_EQ(ts[0].substr(ts[0].size() - tail.size()), tail);
+  auto fields = [](const std::string& line) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    std::string x;
+    while (std::getline(ss, x, ',')) f.push_back(x);
+    return f;
+  };
+  const std::vector<std::string> head = fields(ts[0]);
+  auto col = [&](const char* name) {
+    const auto it = std::find(head.begin(), head.end(), name);
+    return static_cast<std::size_t>(it - head.begin());
+  };
+  int at_marks = 0;
+  for (std::size_t i = 1; i < ts.size(); ++i) {
+    const std::vector<std::string> f = fields(ts[i]);
+    ASSERT_EQ(f.size(), head.size()) << "row " << i;
+    const double t = std::stod(f[0]);
+    for (const IdentificationMark& m : id.estimation.marks) {
+      if (!m.reached || std::fabs(t - m.t_s) > 1e-6) continue;
+      ++at_marks;
+      EXPECT_NEAR(std::stod(f[col("id_j_rel")]), m.j_rel, 1e-6 * m.j_rel + 1e-12) << t;
+      EXPECT_NEAR(std::stod(f[col("id_r_err_m")]), m.r_err_m, 1e-6 * m.r_err_m + 1e-12) << t;
+      EXPECT_NEAR(std::stod(f[col("id_j_nees")]), m.j_nees, 1e-6 * m.j_nees + 1e-12) << t;
+      EXPECT_NEAR(std::stod(f[col("id_r_nees")]), m.r_nees, 1e-6 * m.r_nees + 1e-12) << t;
+    }
+    EXPECT_EQ(f[col("fdi_confirmed")], "0") << t;  // a healthy run
+    EXPECT_EQ(f[col("fdi_check_jet")], "-1") << t;
+  }
+  EXPECT_EQ(at_marks, 2) << "the 60 s and 300 s marks fall on logged rows";
+  // Without the modules: the series ends with the mode.
+  const auto plain = lines(slurp(rep.results[1].timeseries_path));
+  ASSERT_GE(plain.size(), 1u);
+  ASSERT_GE(plain[0].size(), 5u);
+  EXPECT_EQ(plain[0].substr(plain[0].size() - 5), ",mode");
+  EXPECT_EQ(plain[0].find("id_j_rel"), std::string::npos);
+  EXPECT_EQ(plain[0].find("fdi_chi2"), std::string::npos);
   fs::remove_all(dir);
 }
 
