@@ -362,14 +362,18 @@ TEST(ClosedLoop, TheFaultyJetsCommandedFiringIsMeasuredFromOnsetToTheConfirmatio
   f.onset_s = 3000.0;
   s.truth.faults.push_back(f);
   const double dt = s.flight.dt;
-  const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", dt, 3600.0);
+  const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", dt, 5000.0);
   ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
   ASSERT_FALSE(r.fdi.valve_closed_s.has_value()) << "a valve closed: the recount below assumes open";
   const double end =
       r.fdi.first_confirmation_s ? *r.fdi.first_confirmation_s : r.series.back().t + 1.0;
   std::optional<double> first;
   double seconds = 0.0, impulse = 0.0;
-  for (const TimeRow& row : r.series) {
+  // Every tick flown has a row; the series' last row is the final state after the last tick
+  // (its command is the last tick's, already counted), so it is not a tick of its own.
+  ASSERT_GE(r.series.size(), 2u);
+  for (std::size_t i = 0; i + 1 < r.series.size(); ++i) {
+    const TimeRow& row = r.series[i];
     const double half = std::max(row.force(2), 0.0);
     if (row.t < f.onset_s - 1e-9 || !(half > 0.0)) continue;
     if (!first) first = row.t;
