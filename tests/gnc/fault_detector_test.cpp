@@ -506,14 +506,14 @@ struct AmbiguousRun {
   std::vector<int> probe_pods;  // the pod of each test
 };
 
-AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
-  Truth t;
+// The trap's truth r and the detector flying against its mirror: the model's r has its xy part
+// mirrored, an error of 0.72 m at 2 sigma of what the model states.
+void mirror_trap(Truth& t, FaultDetectorParams p, FaultDetector& d) {
   t.r = V3(-0.3, 0.2, 3.5456);
   p.enabled = true;
   p.window_ticks = 10;
   p.gyro_sigma = t.gyro_sigma;
   p.disturbance_sigma = 0.0;
-  FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
   FaultModel m;
   m.j = t.body.j;
@@ -522,6 +522,12 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
   m.r_cov = Mat3::Identity() * 0.13;  // 1 sigma 0.36 m: the 0.72 m error is at 2 sigma
   m.k_sigma = 1e-3;
   d.set_model(m);
+}
+
+AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
+  Truth t;
+  FaultDetector d;
+  mirror_trap(t, p, d);
   std::mt19937_64 rng(5);
   Vec16 prev = Vec16::Zero();
   std::array<bool, 4> prev_valve = t.valve;
@@ -1091,24 +1097,12 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
 // is never confirmed.
 FaultEvents fly_twin(const FaultDetectorParams& base, int ticks, int& confirmations) {
   Truth t;
-  t.r = V3(-0.3, 0.2, 3.5456);
   t.degraded = 2;
   t.degraded_factor = 0.3;
   FaultDetectorParams p = base;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = t.gyro_sigma;
-  p.disturbance_sigma = 0.0;
   p.degraded_min_loss = 0.1;
   FaultDetector d;
-  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  FaultModel m;
-  m.j = t.body.j;
-  m.r = V3(-t.r.x(), -t.r.y(), t.r.z());
-  m.j_rel_sigma = 1e-4;
-  m.r_cov = Mat3::Identity() * 0.13;  // 1 sigma 0.36 m: the 0.72 m error is at 2 sigma
-  m.k_sigma = 1e-3;
-  d.set_model(m);
+  mirror_trap(t, p, d);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   Vec16 prev = Vec16::Zero();
