@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "heap_counter.hpp"
+#include "eigen_no_malloc.hpp"
 
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/estimation/mekf.hpp"
@@ -14,8 +15,8 @@ namespace rocksteady::gnc {
 namespace {
 
 struct Armed {
-  Armed() { Eigen::internal::set_is_malloc_allowed(false); }
-  ~Armed() { Eigen::internal::set_is_malloc_allowed(true); }
+  Armed() { rocksteady::test::eigen_malloc_allowed(false); }
+  ~Armed() { rocksteady::test::eigen_malloc_allowed(true); }
   rocksteady::test::HeapArmed heap;
 };
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "heap_counter.hpp"
+#include "eigen_no_malloc.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -21,8 +22,8 @@ namespace {
 
 // Counts heap use and makes Eigen assert on any allocation of its own.
 struct Armed {
-  Armed() { Eigen::internal::set_is_malloc_allowed(false); }
-  ~Armed() { Eigen::internal::set_is_malloc_allowed(true); }
+  Armed() { rocksteady::test::eigen_malloc_allowed(false); }
+  ~Armed() { rocksteady::test::eigen_malloc_allowed(true); }
   rocksteady::test::HeapArmed heap;
 };
 
@@ -31,7 +32,7 @@ TEST(ZeroAllocation, CountingHookSeesAnAllocation) {
   long counted = 0;
   {
     Armed armed;
-    Eigen::internal::set_is_malloc_allowed(true);
+    rocksteady::test::eigen_malloc_allowed(true);
     int* volatile p = new int(3);
     counted = rocksteady::test::heap_allocations();
     delete p;
