@@ -244,6 +244,7 @@ GncConfig load_gnc(const std::string& path) {
     fd.model_sigmas = r.non_negative("model_sigmas");
     fd.probe_after_windows = r.integer("probe_after_windows");
     fd.probe_windows = r.integer("probe_windows");
+    if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
     if (r.has("identified_zero_chi2")) fd.identified_zero_chi2 = r.positive("identified_zero_chi2");

@@ -207,6 +207,7 @@ int firmware_main() {
     g_params.fdi.check_max_model_error = 0.5;  // ... against the model's stated 1 sigma, as flown
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
     g_params.fdi.probe_windows = 2;            // isolation tests of two windows, as flown
+    g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the
     // second-order term (I20), the gate (I18), the noise correction (I25), the gyro bias (I17).
     gnc::apply_flight_identification_settings(g_params, g_params.mekf.gyro_arw / std::sqrt(g_params.dt));

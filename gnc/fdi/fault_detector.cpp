@@ -122,6 +122,7 @@ void FaultDetector::cancel_evaluation() {
 
 void FaultDetector::reset() {
   have_start_ = false;
+  last_suspicious_ = false;
   n_ = 0;
   cancel_evaluation();
   reset_scores();
@@ -559,6 +560,14 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   const Vec3 slope = stt > 0.0 ? Vec3(str / stt) : Vec3::Zero();
   st_.residual = slope * n;  // rate change over the window that the model does not explain
   st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
+  // (F21) A fault that starts inside a window is in it for part of its samples only, whereas every
+  // signature (F4) spans the whole window: a jet whose signature matches the truncated ramp (a
+  // weaker one of another pod, nearly parallel) can fit it better than the faulty jet and carry
+  // that lead into the next windows. So the first window that shows a fault is not scored.
+  const bool suspicious = st_.chi2 > p_.suspect_chi2;
+  eval_onset_ = p_.skip_onset_window && suspicious && !last_suspicious_ && probe_left_ == 0 &&
+                !verdict_pending_ && !sweeping() && w.check_jet < 0;
+  last_suspicious_ = suspicious;
   // (F19) A window flown with a jet check: its unexplained rate change must lie along the checked
   // jet's signature b_i (a jet that produced less than commanded: -a b_i f); the part normal to
   // b_i is a model error the check exposed, not the jet.
@@ -596,7 +605,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
   const double n = static_cast<double>(w.n);
   const double var = eval_var_;
   const Vec3 r_mean = w.sum_r / n;
-  if (eval_unfit_) {  // (F19) a check that exposed a model error: the window is not scored
+  if (eval_unfit_ || eval_onset_) {  // (F19) a check that exposed a model error; (F21) an onset
     for (int h = first; h < last; ++h) {
       const auto k = static_cast<std::size_t>(h);
       window_llr_[k] = 0.0;
@@ -682,7 +691,7 @@ void FaultDetector::rank_hypotheses() {
 void FaultDetector::evaluate_cross(const WindowSums& w) {
   // The episode's mean-centred cross sums of the basis ramps, weighted by the window's 1 / var.
   // A ramp that stayed zero (its row not live) adds nothing: its sums are zero.
-  if (eval_unfit_) return;  // (F19) not scored
+  if (eval_unfit_ || eval_onset_) return;  // (F19), (F21) not scored
   const double n = static_cast<double>(w.n);
   std::array<double, kBasis> sx{};
   for (int i = 0; i < kThrusters; ++i) {

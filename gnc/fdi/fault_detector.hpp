@@ -45,6 +45,9 @@ struct FaultDetectorParams {
   double min_signature{4.0};
   // true: a confirmed stuck-on closes its pod's latch valve (automatic isolation).
   bool auto_isolate{true};
+  // (F21) The window a fault starts in is not scored: the first window whose no-fault chi-square
+  // exceeds suspect_chi2 after one that did not (outside isolation tests, sweeps and jet checks).
+  bool skip_onset_window{false};
   // (F8) The lead over each alternative must also exceed what an error of the model could have
   // produced: this many 1 sigma of the signature's model uncertainty.
   double model_sigmas{3.0};
@@ -274,6 +277,8 @@ class FaultDetector {
   int check_left_{0};
   int check_prev_{-1};      // the jet checked on the previous update (its thrust is this one's)
   bool eval_unfit_{false};  // the evaluated window's check showed a model error: not scored
+  bool eval_onset_{false};  // (F21) the evaluated window is the one a fault started in: not scored
+  bool last_suspicious_{false};  // (F21) the window before it exceeded suspect_chi2
   std::array<std::uint32_t, kThrusters> last_check_{};  // window count at each jet's last check, +1
   std::array<std::uint8_t, kThrusters> check_backoff_{};  // doublings of each jet's interval (0..2)
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust

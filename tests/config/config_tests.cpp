@@ -203,6 +203,18 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
   EXPECT_GT(load_run(kMission, kGnc, case_file(6)).flight.identification.config.gyro_sigma, 0.0);
 }
 
+TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
+  // (F21) gnc.yaml names it (off); a file without the key keeps the detector's default (off).
+  EXPECT_FALSE(load_run(kMission, kGnc, case_file(1)).flight.fdi.skip_onset_window);
+  TempFile on("gnc.yaml", replaced(read(kGnc), "skip_onset_window: false", "skip_onset_window: true"));
+  EXPECT_TRUE(load_run(kMission, on.path(), case_file(1)).flight.fdi.skip_onset_window);
+  EXPECT_TRUE(load_run(kMission, on.path(), case_file(6)).flight.fdi.skip_onset_window);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), "  skip_onset_window: false", "  #"));
+  EXPECT_FALSE(load_run(kMission, absent.path(), case_file(1)).flight.fdi.skip_onset_window);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), "skip_onset_window: false", "skip_onset_window: 3"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.skip_onset_window", "");
+}
+
 TEST(ConfigErrors, UnreadableFile) {
   const std::string missing = kConfigs + "/cases/no_such_case.yaml";
   expect_error([&] { load_case(missing); }, missing, "", "cannot read file");

@@ -400,6 +400,7 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
   p.fdi.check_force_n = 0.5;  // the small vehicle's channels reach 2 N
   p.fdi.check_max_model_error = 1e3;  // (the guard is tested with the detector)
   p.fdi.check_interval_s = 10.0;
+  p.fdi.skip_onset_window = true;  // (F21)
   p.fdi_table_rel_sigma = 1e-4;
   auto* loop = new test::SmallLoop(p);
   ASSERT_TRUE(loop->gnc.init(p).ok);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -224,6 +225,77 @@ RunResult fly_weak(Truth& t, FaultDetector& d, int ticks, int onset, int fault_o
     prev = cmd;
   }
   return r;
+}
+
+// (F21) A jet stuck on from inside a window: every jet, every onset phase of a 5-tick window,
+// under the few-newton firing of HOLD (WeakFiring) and a quiet gyro. The window the fault starts
+// in carries it for part of its ticks only, while every signature (F4) spans the whole window.
+// Scored, that window makes some confirmations name a jet of another pod; not scored, every jet
+// is confirmed to itself, one window later at most.
+RunResult fly_onset_inside_window(int jet, int phase, bool skip_onset_window) {
+  Truth t;
+  t.gyro_sigma = 1e-7;  // the noise-free cases' floor (config: at least 1e-7 rad/s per sample)
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 5;
+  p.gyro_sigma = t.gyro_sigma;
+  p.disturbance_sigma = 0.0;
+  p.skip_onset_window = skip_onset_window;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 1e-6;
+  m.k_sigma = 1e-3;
+  d.set_model(m);
+  WeakFiring firing(31);
+  Vec16 prev = Vec16::Zero();
+  RunResult r;
+  const int onset = 500 + phase;
+  for (int k = 0; k < onset + 100; ++k) {
+    if (k == onset) t.stuck_on = jet;
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    const FaultEvents e = d.update(in);
+    if (e.confirmed && r.confirmed_at < 0) {
+      r.confirmed_at = k - onset;
+      r.thruster = e.thruster;
+      r.kind = e.kind;
+    }
+    const Vec16 cmd = firing.next(k);
+    t.advance(cmd);
+    prev = cmd;
+  }
+  return r;
+}
+
+TEST(FaultDetector, TheWindowAFaultStartsInIsNotScoredAndNoJetOfAnotherPodIsConfirmed) {
+  int wrong_scored = 0;
+  double latency_scored = 0.0;
+  double latency_skipped = 0.0;
+  for (int jet = 0; jet < 16; ++jet) {
+    for (int phase = 0; phase < 5; ++phase) {
+      const RunResult scored = fly_onset_inside_window(jet, phase, false);
+      ASSERT_GE(scored.confirmed_at, 0) << "jet " << jet << " phase " << phase;
+      if (scored.thruster != jet) ++wrong_scored;
+      latency_scored += scored.confirmed_at;
+      const RunResult skipped = fly_onset_inside_window(jet, phase, true);
+      ASSERT_GE(skipped.confirmed_at, 0) << "jet " << jet << " phase " << phase;
+      EXPECT_EQ(skipped.thruster, jet) << "phase " << phase;
+      EXPECT_EQ(skipped.kind, FaultKind::kStuckOn) << "jet " << jet << " phase " << phase;
+      EXPECT_LE(skipped.confirmed_at, 30) << "jet " << jet << " phase " << phase;  // 3 s
+      latency_skipped += skipped.confirmed_at;
+    }
+  }
+  EXPECT_GT(wrong_scored, 0);  // the trap is there without (F21)
+  // One window (5 ticks) later at most, on average over the 80 runs.
+  EXPECT_LE(latency_skipped, latency_scored + 5.0 * 80.0);
+  std::printf("onset inside a window: %d of 80 wrong when scored; mean latency %.1f -> %.1f ticks\n",
+              wrong_scored, latency_scored / 80.0, latency_skipped / 80.0);
 }
 
 TEST(FaultDetector, AStuckOffJetCommandedAtAFewPercentIsIsolatedFromPooledWindows) {
