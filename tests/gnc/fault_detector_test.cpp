@@ -73,6 +73,17 @@ struct Truth {
   }
 };
 
+// The truth's J and r as an identified model gives them (case 1 reaches ~3e-5 in J by 300 s).
+FaultModel identified_model(const Truth& t) {
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 1e-6;  // 1 mm
+  m.k_sigma = 1e-3;
+  return m;
+}
+
 FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_min_loss = 0.0,
                             double check_llr = 0.0) {
   FaultDetectorParams p;
@@ -84,13 +95,7 @@ FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_m
   p.disturbance_sigma = 0.0;
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  FaultModel m;
-  m.j = t.body.j;
-  m.r = t.r;
-  m.j_rel_sigma = 1e-4;  // an identified model (case 1 reaches ~3e-5 by 300 s)
-  m.r_cov = Mat3::Identity() * 1e-6;  // 1 mm
-  m.k_sigma = 1e-3;
-  d.set_model(m);
+  d.set_model(identified_model(t));
   return d;
 }
 
@@ -243,13 +248,7 @@ RunResult fly_onset_inside_window(int jet, int phase, bool skip_onset_window) {
   p.skip_onset_window = skip_onset_window;
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  FaultModel m;
-  m.j = t.body.j;
-  m.r = t.r;
-  m.j_rel_sigma = 1e-4;
-  m.r_cov = Mat3::Identity() * 1e-6;
-  m.k_sigma = 1e-3;
-  d.set_model(m);
+  d.set_model(identified_model(t));
   WeakFiring firing(31);
   Vec16 prev = Vec16::Zero();
   RunResult r;
@@ -436,12 +435,7 @@ TEST(FaultDetector, AModelGivenDuringTheEvaluationIsTakenWithFiveTickWindowsAndP
     p.degraded_min_loss = 0.1;
     FaultDetector d;
     d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-    FaultModel right;
-    right.j = t.body.j;
-    right.r = t.r;
-    right.j_rel_sigma = 1e-4;
-    right.r_cov = Mat3::Identity() * 1e-6;
-    right.k_sigma = 1e-3;
+    const FaultModel right = identified_model(t);
     FaultModel wrong = right;  // an unidentified model, honestly uncertain
     wrong.j *= 1.3;
     wrong.j_rel_sigma = 0.3;
@@ -872,12 +866,7 @@ TEST(FaultDetector, AClosedWindowIsScoredOverTheNextTicksWithTheModelItWasPredic
   p.gyro_sigma = t.gyro_sigma;
   p.disturbance_sigma = 0.0;
   p.confirm_llr = 1e30;  // never confirm: compare the scores
-  FaultModel m;
-  m.j = t.body.j;
-  m.r = t.r;
-  m.j_rel_sigma = 1e-4;
-  m.r_cov = Mat3::Identity() * 1e-6;
-  m.k_sigma = 1e-3;
+  const FaultModel m = identified_model(t);
   FaultModel other = m;
   other.r += V3(0.05, -0.02, 0.03);
   other.k(6) = 0.9;
