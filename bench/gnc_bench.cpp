@@ -95,14 +95,20 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   double t = 0.0;
   gnc.step(study_sample(t), c, out);
   c = GncCommands{};
-  std::vector<double> tick_ns;
-  tick_ns.reserve(static_cast<std::size_t>(state.max_iterations));
-  long k = 0;
-  for (auto _ : state) {
+  // The samples are made before the timed loop: the loop times Gnc::step and the clock reads
+  // around it, not the test's own sample synthesis.
+  const auto n = static_cast<std::size_t>(state.max_iterations);
+  std::vector<SensorSample> samples(n);
+  for (std::size_t k = 0; k < n; ++k) {
     t += p.dt;
-    SensorSample s = study_sample(t);
-    s.gyro_rate *= 1.0 - 1e-5 * static_cast<double>(k % 10000);
-    ++k;
+    samples[k] = study_sample(t);
+    samples[k].gyro_rate *= 1.0 - 1e-5 * static_cast<double>(k % 10000);
+  }
+  std::vector<double> tick_ns;
+  tick_ns.reserve(n);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const SensorSample& s = samples[k++ % n];
     const auto t0 = std::chrono::steady_clock::now();
     gnc.step(s, c, out);
     const auto t1 = std::chrono::steady_clock::now();
@@ -114,6 +120,10 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   // also holds whatever preemption the machine did, so it is reported but not the figure to quote.
   std::sort(tick_ns.begin(), tick_ns.end());
   if (!tick_ns.empty()) {
+    double sum = 0.0;
+    for (double v : tick_ns) sum += v;
+    // The mean of the timed steps alone (one clock read's cost included), beside the loop's.
+    state.counters["mean_tick_us"] = sum / static_cast<double>(tick_ns.size()) * 1e-3;
     state.counters["p50_tick_us"] = tick_ns[tick_ns.size() / 2] * 1e-3;
     state.counters["p999_tick_us"] = tick_ns[tick_ns.size() * 999 / 1000] * 1e-3;
     state.counters["max_tick_us"] = tick_ns.back() * 1e-3;
@@ -121,10 +131,21 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   state.counters["id_windows"] = gnc.identifier().counters().windows;
   state.SetLabel(to_string(gnc.mode()));
 }
-BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_fdi_l1, true, AllocatorKind::kL1)->Iterations(200000);
+// Ten runs of 5000 s each (83 identification windows), each from the same start. A shared
+// machine's speed wanders between runs (on the 2-core VM of 2026-11-27, by up to a factor of two
+// within a minute), so besides the mean and median over the runs the bench reports the minimum:
+// the run least disturbed by the machine's other work.
+double min_of(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+void all_modules_runs(benchmark::internal::Benchmark* b) {
+  b->Iterations(50000)->Repetitions(10)->ReportAggregatesOnly(true)->ComputeStatistics("min",
+                                                                                       min_of);
+}
+BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_fdi_l1, true, AllocatorKind::kL1)
+    ->Apply(all_modules_runs);
 BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_fdi_pinv, true, AllocatorKind::kPseudoInverse)
-    ->Iterations(200000);
-BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_l1, false, AllocatorKind::kL1)->Iterations(200000);
+    ->Apply(all_modules_runs);
+BENCHMARK_CAPTURE(BM_GncTickAllModules, mekf_id_l1, false, AllocatorKind::kL1)
+    ->Apply(all_modules_runs);
 
 void BM_LawAlone(benchmark::State& state, LawId law) {
   const GncParams p = study_gnc_params(200.0);

@@ -35,6 +35,12 @@ struct Lp {
   int phase{1};
   int iterations{0};
   bool bland_only{false};
+  // The basis solution of the current basis and nonbasic bounds (basic_solution), kept until a
+  // pivot, a bound flip or a reload changes them: one solve computes it once per basis, not once
+  // per caller. The torque is the same for the whole solve.
+  bool solved{false};
+  Mat3 binv;
+  Vec3 xb;
 
   Vec3 column(int j) const {
     if (j < kChannels) return a->col(j);
@@ -50,21 +56,39 @@ struct Lp {
   }
 };
 
-// Basis inverse and the basic variables' values for the current nonbasic bounds.
-bool basic_solution(const Lp& lp, const Vec3& tau, Mat3& binv, Vec3& xb) {
-  Mat3 bb;
-  for (int r = 0; r < 3; ++r) bb.col(r) = lp.column(lp.basis[static_cast<std::size_t>(r)]);
-  bool invertible = false;
-  double det = 0.0;
-  bb.computeInverseAndDetWithCheck(binv, det, invertible, kDetTol);
-  if (!invertible) return false;
-  Vec3 rhs = tau;
-  for (int j = 0; j < kStructural; ++j) {
-    const auto k = static_cast<std::size_t>(j);
-    if (!lp.basic[k] && lp.upper[k]) rhs -= lp.ub[k] * lp.column(j);
+// Basis inverse and the basic variables' values for the current nonbasic bounds. The u- columns
+// are the u+ columns negated, so their terms are added (the same numbers as subtracting -a_j).
+bool basic_solution(Lp& lp, const Vec3& tau, Mat3& binv, Vec3& xb) {
+  if (!lp.solved) {
+    Mat3 bb;
+    for (int r = 0; r < 3; ++r) bb.col(r) = lp.column(lp.basis[static_cast<std::size_t>(r)]);
+    bool invertible = false;
+    double det = 0.0;
+    bb.computeInverseAndDetWithCheck(lp.binv, det, invertible, kDetTol);
+    if (!invertible) return false;
+    Vec3 rhs = tau;
+    for (int j = 0; j < kChannels; ++j) {
+      const auto k = static_cast<std::size_t>(j);
+      if (!lp.basic[k] && lp.upper[k]) rhs -= lp.ub[k] * lp.a->col(j);
+    }
+    for (int j = 0; j < kChannels; ++j) {
+      const auto k = static_cast<std::size_t>(j + kChannels);
+      if (!lp.basic[k] && lp.upper[k]) rhs += lp.ub[k] * lp.a->col(j);
+    }
+    lp.xb = lp.binv * rhs;
+    lp.solved = true;
   }
-  xb = binv * rhs;
+  binv = lp.binv;
+  xb = lp.xb;
   return xb.allFinite();
+}
+
+// v . a_i for the eight u+ columns; a u- column's product is the negative (v . (-a) is -(v . a)
+// to the bit: the same products, negated, summed in the same order).
+Vec8 column_products(const Lp& lp, const Vec3& v) {
+  Vec8 p;
+  for (int i = 0; i < kChannels; ++i) p(i) = v.dot(Vec3(lp.a->col(i)));
+  return p;
 }
 
 // One simplex phase to optimality. False: iteration cap, singular basis or no bounded step.
@@ -84,12 +108,13 @@ bool run_phase(Lp& lp, const Vec3& tau) {
     // between runs and Bland's rule cannot cycle within one, so the method terminates.
     // Artificials never re-enter.
     const bool bland = lp.bland_only || degenerate_run >= kDegenerateBeforeBland;
+    const Vec8 ya = column_products(lp, y);
     int enter = -1;
     double violation = 0.0;
     for (int j = 0; j < kStructural; ++j) {
       const auto k = static_cast<std::size_t>(j);
       if (lp.basic[k] || !(lp.ub[k] > 0.0)) continue;  // a variable fixed at zero never enters
-      const double d = lp.cost(j) - y.dot(lp.column(j));
+      const double d = lp.cost(j) - (j < kChannels ? ya(j) : -ya(j - kChannels));
       const double v = lp.upper[k] ? d : -d;  // > 0: moving off the bound lowers the cost
       if (v > kCostTol && v > violation) {
         enter = j;
@@ -136,6 +161,7 @@ bool run_phase(Lp& lp, const Vec3& tau) {
     if (flip <= best + kTieTol) {
       if (!(flip < kInf)) return false;  // unbounded step (not reachable: all columns bounded)
       lp.upper[ke] = !lp.upper[ke];
+      lp.solved = false;
       continue;
     }
     if (leave_row < 0) return false;
@@ -146,6 +172,7 @@ bool run_phase(Lp& lp, const Vec3& tau) {
     lp.basis[kr] = enter;
     lp.basic[ke] = true;
     lp.upper[ke] = false;
+    lp.solved = false;
   }
 }
 
@@ -184,18 +211,21 @@ bool run_dual(Lp& lp, const Vec3& tau, int max_steps) {
     for (int i = 0; i < 3; ++i) cb(i) = lp.cost(lp.basis[static_cast<std::size_t>(i)]);
     const Vec3 y = binv.transpose() * cb;
     const Vec3 row = binv.row(r).transpose();
+    const Vec8 ra = column_products(lp, row);
+    const Vec8 ya = column_products(lp, y);
     int enter = -1;
     double best = kInf;
     for (int j = 0; j < kStructural; ++j) {
       const auto k = static_cast<std::size_t>(j);
       if (lp.basic[k] || !(lp.ub[k] > 0.0)) continue;
-      const Vec3 a = lp.column(j);
-      const double alpha = row.dot(a);
+      const bool plus = j < kChannels;
+      const int c = plus ? j : j - kChannels;
+      const double alpha = plus ? ra(c) : -ra(c);
       const double dir = lp.upper[k] ? -1.0 : 1.0;
       // x_r moves by -dir theta alpha: up (towards 0) when it is negative, down when above ub.
       const double move = -dir * alpha;
       if (!(to_upper ? move < -kPivotTol : move > kPivotTol)) continue;
-      const double d = std::fabs(lp.cost(j) - y.dot(a));
+      const double d = std::fabs(lp.cost(j) - (plus ? ya(c) : -ya(c)));
       const double ratio = d / std::fabs(alpha);
       if (ratio < best - kTieTol) {
         best = ratio;
@@ -210,6 +240,7 @@ bool run_dual(Lp& lp, const Vec3& tau, int max_steps) {
     lp.basis[kr] = enter;
     lp.basic[ke] = true;
     lp.upper[ke] = false;
+    lp.solved = false;
   }
 }
 
@@ -217,9 +248,11 @@ bool run_dual(Lp& lp, const Vec3& tau, int max_steps) {
 // whichever path (cold or warm) reached the basis, so both give the same numbers.
 void sort_basis(Lp& lp) {
   auto& b = lp.basis;
+  const auto before = b;
   if (b[0] > b[1]) std::swap(b[0], b[1]);
   if (b[1] > b[2]) std::swap(b[1], b[2]);
   if (b[0] > b[1]) std::swap(b[0], b[1]);
+  if (b != before) lp.solved = false;  // the same basis in another column order
 }
 
 // The index of variable j in the problem for -tau: u+ and u- swap (their columns are each
@@ -269,6 +302,7 @@ L1Solution L1Allocation::solve(const Vec3& tau, const Vec8& lo, const Vec8& hi) 
   bool warm = false;
   if (warm_start_ && hint_.valid) {
     auto load = [&](bool mirror) {
+      lp.solved = false;
       for (int j = 0; j < kVars; ++j) {
         const auto k = static_cast<std::size_t>(j);
         lp.basic[k] = false;
@@ -303,6 +337,7 @@ L1Solution L1Allocation::solve(const Vec3& tau, const Vec8& lo, const Vec8& hi) 
   }
 
   if (!warm) {
+    lp.solved = false;
     for (int i = 0; i < 3; ++i) lp.art_sign(i) = tau_s(i) < 0.0 ? -1.0 : 1.0;
     for (int j = 0; j < kVars; ++j) {
       const auto k = static_cast<std::size_t>(j);

@@ -406,35 +406,37 @@ void FaultDetector::accumulate(WindowSums& w, const FaultDetectorInput& in, cons
     w.sum_tr += t * r;
   }
   // (F4) signatures: stuck-on adds (u_max - f) of its thrust, stuck-off removes f; both only
-  // while the pod's valve is open (a closed pod produces nothing under any hypothesis).
+  // while the pod's valve is open (a closed pod produces nothing under any hypothesis). The
+  // increments first, then the sums over all hypotheses in loops of one array each (the compiler
+  // runs them two hypotheses at a time; every sum is the same number as one hypothesis at a time).
+  std::array<double, kHypotheses> step{};
   for (int i = 0; i < kThrusters; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const auto h = k + static_cast<std::size_t>(kThrusters);
-    double on = 0.0;
-    double off = 0.0;
     if (in.valve_open[static_cast<std::size_t>(pod_[k])]) {
       const double f = in.thrust(i);
-      on = (u_max_ - f) * dt_;
-      off = -f * dt_;
+      step[k] = (u_max_ - f) * dt_;
+      step[k + static_cast<std::size_t>(kThrusters)] = -f * dt_;
     }
-    if (kFirst) {
-      w.c[k] = on;
-      w.c[h] = off;
-      w.sum_c[k] = on;
-      w.sum_c[h] = off;
-      w.sum_cc[k] = on * on;
-      w.sum_cc[h] = off * off;
-      w.sum_cr[k] = on * r;
-      w.sum_cr[h] = off * r;
-    } else {
-      const double ck = (w.c[k] += on);
-      const double ch = (w.c[h] += off);
-      w.sum_c[k] += ck;
-      w.sum_c[h] += ch;
-      w.sum_cc[k] += ck * ck;
-      w.sum_cc[h] += ch * ch;
-      w.sum_cr[k] += ck * r;
-      w.sum_cr[h] += ch * r;
+  }
+  const double rx = r.x(), ry = r.y(), rz = r.z();
+  if (kFirst) {
+    for (std::size_t h = 0; h < step.size(); ++h) {
+      const double c = step[h];
+      w.c[h] = c;
+      w.sum_c[h] = c;
+      w.sum_cc[h] = c * c;
+      w.sum_crx[h] = c * rx;
+      w.sum_cry[h] = c * ry;
+      w.sum_crz[h] = c * rz;
+    }
+  } else {
+    for (std::size_t h = 0; h < step.size(); ++h) {
+      const double c = (w.c[h] += step[h]);
+      w.sum_c[h] += c;
+      w.sum_cc[h] += c * c;
+      w.sum_crx[h] += c * rx;
+      w.sum_cry[h] += c * ry;
+      w.sum_crz[h] += c * rz;
     }
   }
   // (F8) cross sums of the basis ramps (the hypotheses' pairs follow from them).
@@ -629,7 +631,8 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     sig_[k] = b * w.c[k];
     // Mean-centred sums: sum S~ r~ = b.(sum c r) - (b.r_mean) sum c; sum |S~|^2 = |b|^2 (sum c^2 -
     // (sum c)^2 / n).
-    const double sr = b.dot(w.sum_cr[k]) - b.dot(r_mean) * w.sum_c[k];
+    const Vec3 sum_cr(w.sum_crx[k], w.sum_cry[k], w.sum_crz[k]);
+    const double sr = b.dot(sum_cr) - b.dot(r_mean) * w.sum_c[k];
     const double cc = w.sum_cc[k] - w.sum_c[k] * w.sum_c[k] / n;
     const double ss = b.squaredNorm() * cc;
     const double llr = (sr - 0.5 * ss) / var;

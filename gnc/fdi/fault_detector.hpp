@@ -334,7 +334,9 @@ class FaultDetector {
     std::array<double, kHypotheses> c{};
     std::array<double, kHypotheses> sum_c{};
     std::array<double, kHypotheses> sum_cc{};
-    std::array<Vec3, kHypotheses> sum_cr{};
+    std::array<double, kHypotheses> sum_crx{};  // sum of c_h(j) r_j, by component
+    std::array<double, kHypotheses> sum_cry{};
+    std::array<double, kHypotheses> sum_crz{};
     std::array<double, kPods> tp{};      // open time of each pod since the window's start
     std::array<double, kPods> sum_tp{};  // its sum over the window's samples
     // sum_j x_a x_b; row a is written only once ramp a is non-zero (bit a of `live`): a ramp
