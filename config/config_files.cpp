@@ -236,6 +236,9 @@ GncConfig load_gnc(const std::string& path) {
     fd.window_ticks = r.integer("window_ticks");
     g.fdi_window_noisy_ticks = r.integer("window_noisy_ticks");
     fd.model_rel_floor = r.non_negative("model_rel_floor");
+    if (r.has("model_floor_gyroscopic")) {  // (F22), optional (the floor on both terms when absent)
+      fd.model_floor_gyroscopic = r.boolean("model_floor_gyroscopic");
+    }
     fd.disturbance_sigma = r.non_negative("disturbance_sigma_nm");
     fd.confirm_llr = r.positive("confirm_llr");
     fd.margin_llr = r.non_negative("margin_llr");

@@ -545,7 +545,11 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   // and the model's relative uncertainty times the motion it predicts.
   const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
   const double dist = p_.disturbance_sigma * j_inv_.norm() * n * dt_;
-  const double model = rel * w.motion;
+  // (F22) With the floor on the thrust's term only: rel of the thrust's motion, the identifier's
+  // own 1 sigma of the gyroscopic term's bound (the rest of the motion).
+  const double model = p_.model_floor_gyroscopic
+                           ? rel * w.motion
+                           : rel * w.thrust_motion + m_.j_rel_sigma * (w.motion - w.thrust_motion);
   // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
   // r_sigma times the jets' force, and k_sigma times their torque.
   const double offset = r_sigma_ * j_inv_.norm() * w.force_impulse;

@@ -34,6 +34,10 @@ struct FaultDetectorParams {
   double gyro_sigma{1e-6};
   double disturbance_sigma{0.57735026918962576};
   double model_rel_floor{0.0};
+  // (F22) Whether the floor also applies to the gyroscopic term of the model's error, whose bound
+  // (F5: 2 ||J^-1|| ||J|| |w|^2) already carries the margin of a norm bound; false: the floor
+  // applies to the commanded thrust's term only, the gyroscopic one takes the identifier's 1 sigma.
+  bool model_floor_gyroscopic{true};
   // Sequential test (F6): a hypothesis is confirmed when its cumulative log-likelihood ratio
   // exceeds confirm_llr and leads the runner-up by margin_llr; a window whose no-fault chi-square
   // (3 dof) exceeds suspect_chi2 raises a suspicion. Calibrated on healthy runs (README §F.4).

@@ -203,6 +203,18 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
   EXPECT_GT(load_run(kMission, kGnc, case_file(6)).flight.identification.config.gyro_sigma, 0.0);
 }
 
+TEST(ConfigShipped, TheGyroscopicFloorSwitchIsReadAndOptional) {
+  // (F22) gnc.yaml names it (false: the floor on the thrust's term only); a file without the key
+  // keeps the detector's default (the floor on both terms).
+  EXPECT_FALSE(load_run(kMission, kGnc, case_file(1)).flight.fdi.model_floor_gyroscopic);
+  EXPECT_FALSE(load_run(kMission, kGnc, case_file(6)).flight.fdi.model_floor_gyroscopic);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), "  model_floor_gyroscopic: false", "  #"));
+  EXPECT_TRUE(load_run(kMission, absent.path(), case_file(1)).flight.fdi.model_floor_gyroscopic);
+  TempFile bad("gnc.yaml",
+               replaced(read(kGnc), "model_floor_gyroscopic: false", "model_floor_gyroscopic: 2"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.model_floor_gyroscopic", "");
+}
+
 TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
   // (F21) gnc.yaml names it (off); a file without the key keeps the detector's default (off).
   EXPECT_FALSE(load_run(kMission, kGnc, case_file(1)).flight.fdi.skip_onset_window);

@@ -4,6 +4,8 @@
 // noisy gyro. Every thruster and kind is isolated to the right one; healthy runs never confirm.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -555,6 +557,82 @@ TEST(FaultDetector, ScoresAreTheLikelihoodRatioOfTheSignatures) {
   EXPECT_GT(d.status().chi2, p.suspect_chi2);
 }
 
+
+// (F22) The model's error in the detector's noise (F5): rel ||J^-1 B u|| for the commanded thrust
+// and rel 2 ||J^-1|| ||J|| |w|^2 for the gyroscopic term, rel = max(model_rel_floor, the model's J
+// 1 sigma). With model_floor_gyroscopic false the floor applies to the thrust's term only: a
+// torque-free window has the identifier's 1 sigma, a window of thrust at rest the floor, as before.
+double window_sigma(bool floor_gyroscopic, bool thrust, double* expected) {
+  Truth t;
+  if (thrust) t.body.omega = V3::Zero();
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = 1e-7;
+  p.disturbance_sigma = 0.0;
+  p.model_rel_floor = 0.01;
+  p.model_floor_gyroscopic = floor_gyroscopic;
+  p.confirm_llr = 1e30;  // never confirm: look at the noise
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Zero();
+  m.k_sigma = 0.0;
+  d.set_model(m);
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(t.body.j);
+  const double j_norm = es.eigenvalues().maxCoeff();
+  const double j_inv_norm = 1.0 / es.eigenvalues().minCoeff();
+  const Mat3 j_inv = t.body.j.inverse();
+  Vec16 cmd = Vec16::Zero();
+  if (thrust) cmd << 150, 0, 0, 80, 0, 0, 60, 0, 0, 120, 0, 40, 0, 0, 0, 90;
+  double gyro_motion = 0.0;    // sum of 2 ||J^-1|| ||J|| |w_mid|^2 dt
+  double thrust_motion = 0.0;  // sum of |J^-1 sum (p_i + r) x f_i d_i| dt
+  V3 prev = t.body.omega;
+  for (int k = 0; k < 11 + FaultDetector::kEvaluationSteps; ++k) {
+    FaultDetectorInput in;
+    in.omega = t.body.omega;
+    in.omega_valid = true;
+    in.thrust = k == 0 ? Vec16::Zero() : cmd;
+    in.valve_open = t.valve;
+    d.update(in);
+    if (k >= 1 && k <= 10) {
+      const V3 w = 0.5 * (prev + t.body.omega);
+      gyro_motion += 2.0 * j_inv_norm * j_norm * w.squaredNorm() * kDt;
+      V3 tau = V3::Zero();
+      for (int i = 0; i < 16; ++i) {
+        tau += (t.pos[static_cast<std::size_t>(i)] + t.r)
+                   .cross(cmd(i) * t.dir[static_cast<std::size_t>(i)]);
+      }
+      thrust_motion += (j_inv * tau).norm() * kDt;
+    }
+    prev = t.body.omega;
+    t.advance(cmd);
+  }
+  const double model = floor_gyroscopic ? 0.01 * (thrust_motion + gyro_motion)
+                                        : 0.01 * thrust_motion + 1e-4 * gyro_motion;
+  *expected = std::sqrt(2.0 * p.gyro_sigma * p.gyro_sigma + model * model + 1e-30);
+  EXPECT_EQ(d.status().windows, 1u);
+  return d.status().noise_sigma;
+}
+
+TEST(FaultDetector, TheFloorOnTheThrustTermOnlyLeavesTheGyroscopicTermToTheModelsSigma) {
+  double e_on = 0.0, e_off = 0.0;
+  const double tumbling_on = window_sigma(true, false, &e_on);
+  const double tumbling_off = window_sigma(false, false, &e_off);
+  EXPECT_NEAR(tumbling_on, e_on, 1e-9 * e_on);
+  EXPECT_NEAR(tumbling_off, e_off, 1e-9 * e_off);
+  EXPECT_GT(tumbling_on, 50.0 * tumbling_off);  // the floor (0.01) against the model's 1e-4
+  const double firing_on = window_sigma(true, true, &e_on);
+  const double firing_off = window_sigma(false, true, &e_off);
+  EXPECT_NEAR(firing_on, e_on, 1e-6 * e_on);
+  EXPECT_NEAR(firing_off, e_off, 1e-6 * e_off);
+  // From rest the window's gyroscopic term is only the firing's own spin-up (1e-4 of the thrust's
+  // term here): both settings floor the thrust's term alike.
+  EXPECT_NEAR(firing_off, firing_on, 1e-3 * firing_on);
+}
 
 // Two axial jets of opposite pods (thruster 2: pod 0 +z; thruster 11: pod 2 -z) push the body the
 // same way up to the centre of mass's xy offset r_xy: their signatures differ by 2 |r_xy| over
