@@ -206,7 +206,7 @@ int firmware_main() {
     g_params.fdi.check_llr = 5.0;              // (F19) jet checks, as flown
     g_params.fdi.check_max_model_error = 0.5;  // ... against the model's stated 1 sigma, as flown
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
-    g_params.fdi.model_floor_gyroscopic = false;  // (F22) ... on the thrust's term only, as flown
+    g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
     g_params.fdi.probe_windows = 2;            // isolation tests of two windows, as flown
     g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the

@@ -204,14 +204,16 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
 }
 
 TEST(ConfigShipped, TheGyroscopicFloorSwitchIsReadAndOptional) {
-  // (F22) gnc.yaml names it (false: the floor on the thrust's term only); a file without the key
-  // keeps the detector's default (the floor on both terms).
-  EXPECT_FALSE(load_run(kMission, kGnc, case_file(1)).flight.fdi.model_floor_gyroscopic);
-  EXPECT_FALSE(load_run(kMission, kGnc, case_file(6)).flight.fdi.model_floor_gyroscopic);
-  TempFile absent("gnc.yaml", replaced(read(kGnc), "  model_floor_gyroscopic: false", "  #"));
+  // (F22) gnc.yaml names it (true: the floor on both terms); false is read; a file without the
+  // key keeps the detector's default (both terms).
+  EXPECT_TRUE(load_run(kMission, kGnc, case_file(1)).flight.fdi.model_floor_gyroscopic);
+  TempFile off("gnc.yaml", replaced(read(kGnc), "model_floor_gyroscopic: true", "model_floor_gyroscopic: false"));
+  EXPECT_FALSE(load_run(kMission, off.path(), case_file(1)).flight.fdi.model_floor_gyroscopic);
+  EXPECT_FALSE(load_run(kMission, off.path(), case_file(6)).flight.fdi.model_floor_gyroscopic);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), "  model_floor_gyroscopic: true", "  #"));
   EXPECT_TRUE(load_run(kMission, absent.path(), case_file(1)).flight.fdi.model_floor_gyroscopic);
   TempFile bad("gnc.yaml",
-               replaced(read(kGnc), "model_floor_gyroscopic: false", "model_floor_gyroscopic: 2"));
+               replaced(read(kGnc), "model_floor_gyroscopic: true", "model_floor_gyroscopic: 2"));
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.model_floor_gyroscopic", "");
 }
 
