@@ -203,30 +203,33 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
   EXPECT_GT(load_run(kMission, kGnc, case_file(6)).flight.identification.config.gyro_sigma, 0.0);
 }
 
+// An optional switch of the detector's section: gnc.yaml names it with `shipped`, which is also
+// the detector's default; the other value is read in a quiet case (1) and a noisy one (6); a
+// file without the key keeps the default; a value that is not a boolean names the file and key.
+void expect_optional_fdi_switch(const std::string& key, bool shipped,
+                                bool gnc::FaultDetectorParams::*member) {
+  const std::string as_shipped = key + ": " + (shipped ? "true" : "false");
+  const std::string flipped = key + ": " + (shipped ? "false" : "true");
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.*member, shipped) << key;
+  TempFile other("gnc.yaml", replaced(read(kGnc), as_shipped, flipped));
+  EXPECT_EQ(load_run(kMission, other.path(), case_file(1)).flight.fdi.*member, !shipped) << key;
+  EXPECT_EQ(load_run(kMission, other.path(), case_file(6)).flight.fdi.*member, !shipped) << key;
+  TempFile absent("gnc.yaml", replaced(read(kGnc), "  " + as_shipped, "  #"));
+  EXPECT_EQ(load_run(kMission, absent.path(), case_file(1)).flight.fdi.*member, shipped) << key;
+  TempFile bad("gnc.yaml", replaced(read(kGnc), as_shipped, key + ": 3"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi." + key, "");
+}
+
 TEST(ConfigShipped, TheGyroscopicFloorSwitchIsReadAndOptional) {
-  // (F22) gnc.yaml names it (true: the floor on both terms); false is read; a file without the
-  // key keeps the detector's default (both terms).
-  EXPECT_TRUE(load_run(kMission, kGnc, case_file(1)).flight.fdi.model_floor_gyroscopic);
-  TempFile off("gnc.yaml", replaced(read(kGnc), "model_floor_gyroscopic: true", "model_floor_gyroscopic: false"));
-  EXPECT_FALSE(load_run(kMission, off.path(), case_file(1)).flight.fdi.model_floor_gyroscopic);
-  EXPECT_FALSE(load_run(kMission, off.path(), case_file(6)).flight.fdi.model_floor_gyroscopic);
-  TempFile absent("gnc.yaml", replaced(read(kGnc), "  model_floor_gyroscopic: true", "  #"));
-  EXPECT_TRUE(load_run(kMission, absent.path(), case_file(1)).flight.fdi.model_floor_gyroscopic);
-  TempFile bad("gnc.yaml",
-               replaced(read(kGnc), "model_floor_gyroscopic: true", "model_floor_gyroscopic: 2"));
-  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.model_floor_gyroscopic", "");
+  // (F22): true, the floor on both terms of the model's error.
+  expect_optional_fdi_switch("model_floor_gyroscopic", true,
+                             &gnc::FaultDetectorParams::model_floor_gyroscopic);
 }
 
 TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
-  // (F21) gnc.yaml names it (off); a file without the key keeps the detector's default (off).
-  EXPECT_FALSE(load_run(kMission, kGnc, case_file(1)).flight.fdi.skip_onset_window);
-  TempFile on("gnc.yaml", replaced(read(kGnc), "skip_onset_window: false", "skip_onset_window: true"));
-  EXPECT_TRUE(load_run(kMission, on.path(), case_file(1)).flight.fdi.skip_onset_window);
-  EXPECT_TRUE(load_run(kMission, on.path(), case_file(6)).flight.fdi.skip_onset_window);
-  TempFile absent("gnc.yaml", replaced(read(kGnc), "  skip_onset_window: false", "  #"));
-  EXPECT_FALSE(load_run(kMission, absent.path(), case_file(1)).flight.fdi.skip_onset_window);
-  TempFile bad("gnc.yaml", replaced(read(kGnc), "skip_onset_window: false", "skip_onset_window: 3"));
-  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.skip_onset_window", "");
+  // (F21): false, the onset window scored.
+  expect_optional_fdi_switch("skip_onset_window", false,
+                             &gnc::FaultDetectorParams::skip_onset_window);
 }
 
 TEST(ConfigErrors, UnreadableFile) {

@@ -211,12 +211,15 @@ struct WeakFiring {
 };
 
 RunResult fly_weak(Truth& t, FaultDetector& d, int ticks, int onset, int fault_off,
-                   std::uint64_t seed) {
+                   std::uint64_t seed, int fault_on = -1) {
   WeakFiring firing(seed);
   Vec16 prev = Vec16::Zero();
   RunResult r;
   for (int k = 0; k < ticks; ++k) {
-    if (k == onset) t.stuck_off = fault_off;
+    if (k == onset) {
+      t.stuck_off = fault_off;
+      t.stuck_on = fault_on;
+    }
     FaultDetectorInput in;
     in.omega = t.gyro();
     in.omega_valid = true;
@@ -251,26 +254,9 @@ RunResult fly_onset_inside_window(int jet, int phase, bool skip_onset_window) {
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
   d.set_model(identified_model(t));
-  WeakFiring firing(31);
-  Vec16 prev = Vec16::Zero();
-  RunResult r;
   const int onset = 500 + phase;
-  for (int k = 0; k < onset + 100; ++k) {
-    if (k == onset) t.stuck_on = jet;
-    FaultDetectorInput in;
-    in.omega = t.gyro();
-    in.omega_valid = true;
-    in.thrust = prev;
-    const FaultEvents e = d.update(in);
-    if (e.confirmed && r.confirmed_at < 0) {
-      r.confirmed_at = k - onset;
-      r.thruster = e.thruster;
-      r.kind = e.kind;
-    }
-    const Vec16 cmd = firing.next(k);
-    t.advance(cmd);
-    prev = cmd;
-  }
+  RunResult r = fly_weak(t, d, onset + 100, onset, -1, 31, jet);
+  if (r.confirmed_at >= 0) r.confirmed_at -= onset;  // ticks after onset
   return r;
 }
 
