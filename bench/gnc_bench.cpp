@@ -80,6 +80,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.degraded_min_loss = fdi ? 0.1 : 0.0;  // (F18) partial losses of thrust, as flown
   p.fdi.check_llr = fdi ? 5.0 : 0.0;          // (F19) jet checks, as flown
   p.fdi.check_max_model_error = 0.5;          // ... against the model's stated 1 sigma, as flown
+  p.fdi.check_min_llr = 5.0;                  // (F24) ... when the check can move the evidence
   p.fdi.model_rel_floor = 0.005;              // the model's relative error floor, as flown
   p.fdi.model_floor_gyroscopic = true;        // (F22) ... on both terms, as flown
   p.fdi.probe_windows = 2;                    // isolation tests of two windows, as flown

@@ -58,6 +58,9 @@ Check validate(const FaultDetectorParams& p) {
   if (!finite_positive(p.check_max_model_error)) {
     return bad("fdi.check_max_model_error", "must be positive");
   }
+  if (!(p.check_min_llr >= 0.0) || !std::isfinite(p.check_min_llr)) {
+    return bad("fdi.check_min_llr", "must not be negative");
+  }
   return Check{};
 }
 
@@ -139,6 +142,7 @@ void FaultDetector::reset() {
   last_check_.fill(0);
   check_backoff_.fill(0);
   check_prev_ = -1;
+  quiet_var_ = 0.0;
   eval_unfit_ = false;
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
@@ -557,6 +561,7 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   const double var = 2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model +
                      offset * offset + strength * strength + 1e-30;
   eval_var_ = var;
+  if (w.check_jet < 0) quiet_var_ = var;  // (F24) the noise of a window without a check
   st_.noise_sigma = std::sqrt(var);
   // The unknown offset (the start sample's own noise) is removed: mean-centred sums.
   const Vec3 r_mean = w.sum_r / n;
@@ -1093,12 +1098,40 @@ double FaultDetector::cross(int h, int g) const {
   return ah * ag * at(ph, pg) + ah * at(ph, ig) + ag * at(ih, pg) + at(ih, ig);
 }
 
+double FaultDetector::partial_loss_energy(int g) const {
+  const auto k = static_cast<std::size_t>(g);
+  return b_[k % static_cast<std::size_t>(kThrusters)].squaredNorm() * info_[k];
+}
+
+double FaultDetector::total_loss_floor(int i) const {
+  // (F23) A jet that produces nothing leaves the residual of its whole signature b_i c, known to
+  // the model's relative error eps_i only (strength, inertia, centre of mass): the fitted loss of
+  // a dead jet scatters below 1 by up to model_sigmas eps_i, and under a long firing (HOLD's
+  // steady command, E in the 1e5s) even a few percent gains far more than margin_llr over the
+  // total loss. A fitted loss at or above this floor is a total loss. The gap is capped at
+  // kMaxTotalLossGap, so that a half-strength jet (the dispersions' degraded 0.5) stays a partial
+  // loss whatever the model's error.
+  const double gap = std::fmin(p_.model_sigmas * signature_rel_error(i), kMaxTotalLossGap);
+  return 1.0 - std::fmax(gap, 0.0);
+}
+
+bool FaultDetector::partial_not_total(int i, double sr, double e) const {
+  // (F13, F18, F23) The episode's or segment's sums SR, E of thruster i's partial-loss fit say a
+  // partial loss, not a total one, when the fitted loss a = SR / E lies below the total-loss
+  // floor and the fit gains more than margin_llr over a loss at the floor:
+  // (a SR - a^2 E / 2) - (f SR - f^2 E / 2) = E (f - a)^2 / 2.
+  if (!(e > 0.0)) return false;
+  const double a = sr / e;
+  const double floor = total_loss_floor(i);
+  return a < floor && 0.5 * e * (floor - a) * (floor - a) > p_.margin_llr;
+}
+
 double FaultDetector::partial_loss_llr(int g) const {
   // (F13) The episode's LLR of "thruster g lost a fraction a of its thrust", a in (0, 1] fitted:
   // with SR = sum S~.r~ / var = Lambda + E / 2 and E = sum |S~|^2 / var = |b|^2 A, the maximum
   // over a of a SR - a^2 E / 2 is SR^2 / (2 E) for SR < E, and Lambda (a = 1) beyond.
   const auto k = static_cast<std::size_t>(g);
-  const double e = b_[k % static_cast<std::size_t>(kThrusters)].squaredNorm() * info_[k];
+  const double e = partial_loss_energy(g);
   const double sr = lambda_[k] + 0.5 * e;
   if (sr <= 0.0 || e <= 0.0) return 0.0;
   return sr >= e ? lambda_[k] : sr * sr / (2.0 * e);
@@ -1108,9 +1141,11 @@ int FaultDetector::partial_loss_alternative(int h) const {
   // (F13) A stuck-off leader must beat, by margin_llr, a partial loss of thrust of every other
   // jet (a degraded jet explains its residual exactly with its own a < 1, and only that much of
   // a smaller, nearly parallel signature of another jet), and its own amplitude must be that of
-  // a jet that produces nothing: its fitted a < 1 may not gain margin_llr over a = 1.
+  // a jet that produces nothing: its fitted a may not gain margin_llr over a loss at the (F23)
+  // total-loss floor (1 when model_sigmas is 0).
   const double lh = lambda_[static_cast<std::size_t>(h)];
-  if (partial_loss_llr(h) - lh > p_.margin_llr) return h;
+  const double eh = partial_loss_energy(h);
+  if (partial_not_total(h % kThrusters, lh + 0.5 * eh, eh)) return h;
   for (int g = kThrusters; g < kHypotheses; ++g) {
     if (g == h) continue;
     if ((((st_.confirmed_on | st_.confirmed_off) >> (g - kThrusters)) & 1u) != 0) continue;
@@ -1205,7 +1240,8 @@ void FaultDetector::update_check() {
     }
     const double e = std::fmax(score_[k + static_cast<std::size_t>(kThrusters)], deg_cusum_[k]);
     if (e < evidence) continue;
-    if (signature_rel_error(i) <= p_.check_max_model_error) {
+    if (signature_rel_error(i) <= p_.check_max_model_error &&
+        (!(p_.check_min_llr > 0.0) || expected_check_llr(i) >= p_.check_min_llr)) {
       evidence = e;
       jet = i;
     }
@@ -1226,6 +1262,44 @@ double FaultDetector::signature_rel_error(int i) const {
   const double arm = (pos_[k] + m_.r).cross(dir_[k]).norm();
   const double kk = std::fabs(m_.k(i));
   return (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma + (arm > 0.0 ? r_sigma_ / arm : 1.0);
+}
+
+double FaultDetector::expected_check_llr(int i) const {
+  // (F24) A check fires thruster i at f = check_force_n, compensated in the null space of the
+  // channels' torque matrix B (Gnc::apply_jet_check: du = e_c - B^T (B B^T)^-1 B e_c, scaled to
+  // move channel c by f), so every channel fires: the check's force is f_tot = f sum |du| / |du_c|.
+  // Under "i stuck off" the residual ramps as b_i f t over each window of n samples, whose
+  // mean-centred energy is |b_i f dt|^2 n (n^2 - 1) / 12 / var (F6: a healthy jet's check loses
+  // half of it from that hypothesis), with var the window's (F5) noise: that of the last window
+  // flown without a check, plus the centre of mass against the check's force,
+  // (r_sigma ||J^-1|| f_tot T)^2. (The check adds nothing to the thrust term: B du = 0.)
+  const auto k = static_cast<std::size_t>(i);
+  const int c = i / 2;
+  Mat3 g = Mat3::Zero();
+  std::array<Vec3, kChannels> col{};
+  for (int q = 0; q < kChannels; ++q) {
+    const auto kq = static_cast<std::size_t>(2 * q);
+    col[static_cast<std::size_t>(q)] = (pos_[kq] + m_.r).cross(dir_[kq]);
+    g += col[static_cast<std::size_t>(q)] * col[static_cast<std::size_t>(q)].transpose();
+  }
+  const Eigen::LDLT<Mat3> ldlt(g);
+  if (ldlt.info() != Eigen::Success) return 0.0;
+  const Vec3 y = ldlt.solve(col[static_cast<std::size_t>(c)]);
+  double sum = 0.0;
+  double own = 0.0;
+  for (int q = 0; q < kChannels; ++q) {
+    const double du = (q == c ? 1.0 : 0.0) - col[static_cast<std::size_t>(q)].dot(y);
+    sum += std::fabs(du);
+    if (q == c) own = du;
+  }
+  if (!(own > 1e-6)) return 0.0;  // channel c has no null-space move: no check is flown
+  const double n = static_cast<double>(p_.window_ticks);
+  const double f = p_.check_force_n;
+  const double offset = r_sigma_ * j_inv_.norm() * f * (sum / own) * n * dt_;
+  const double var = quiet_var_ + offset * offset + 1e-30;
+  const double step = b_[k].norm() * f * dt_;
+  const double e = step * step * n * (n * n - 1.0) / 12.0 / var;
+  return 0.5 * e * static_cast<double>(p_.check_windows);
 }
 
 double FaultDetector::degraded_llr(int g) const {
@@ -1286,7 +1360,7 @@ int FaultDetector::degraded_candidate(double& loss) const {
     const double turn = p_.model_sigmas * (eps + signature_rel_error(runner));
     if (turn >= 1.5707963267948966 || std::sqrt(second / gamma_g) >= std::cos(turn)) return -1;
   }
-  if (gamma_g - (deg_sr_[kg] - 0.5 * deg_e_[kg]) <= p_.margin_llr) return -1;
+  if (!partial_not_total(g, deg_sr_[kg], deg_e_[kg])) return -1;
   for (int h = 0; h < kHypotheses; ++h) {
     if (gamma_g - score_[static_cast<std::size_t>(h)] <= p_.margin_llr) return -1;
   }

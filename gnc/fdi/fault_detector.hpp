@@ -102,6 +102,12 @@ struct FaultDetectorParams {
   // an earlier fault while the identifier was far from the truth makes a firm firing look like
   // a loss of thrust of another jet.
   double check_max_model_error{0.05};
+  // (F24) A jet is checked only when the check can move its evidence by at least this much: the
+  // stuck-off LLR a healthy jet's check is expected to lose (E / 2 over check_windows windows),
+  // with what the check adds to the noise (the centre of mass's 1 sigma against the force of the
+  // check and of the jets that compensate it). A check that cannot even undo the evidence that
+  // started it only kicks the vehicle. 0: off.
+  double check_min_llr{0.0};
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -264,8 +270,19 @@ class FaultDetector {
   int partial_loss_alternative(int h) const;
   // (F13) The episode's LLR of hypothesis g (16..31) as a partial loss of thrust, fitted in (0, 1].
   double partial_loss_llr(int g) const;
+  // (F13) The episode's signature energy E_g = |b_g|^2 A_g of hypothesis g (16..31).
+  double partial_loss_energy(int g) const;
+  // (F23) The fitted loss at and above which thruster i's loss is total (stuck off): 1 less
+  // model_sigmas of its signature's relative error, the gap at most kMaxTotalLossGap.
+  static constexpr double kMaxTotalLossGap = 0.25;
+  double total_loss_floor(int i) const;
+  // (F13, F18, F23) Whether sums SR, E of thruster i's partial-loss fit say a partial loss: the
+  // fitted loss below the floor, and the fit margin_llr better than a loss at the floor.
+  bool partial_not_total(int i, double sr, double e) const;
   // (F18, F19) The model's relative 1 sigma of thruster i's signature b_i.
   double signature_rel_error(int i) const;
+  // (F24) The stuck-off LLR a check of thruster i is expected to move, E / 2 over its windows.
+  double expected_check_llr(int i) const;
   // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
   double degraded_llr(int g) const;
   // (F18) The jet to confirm degraded now (and its fitted loss), or -1.
@@ -279,6 +296,7 @@ class FaultDetector {
     check_left_ = 0;
   }
   int check_left_{0};
+  double quiet_var_{0.0};   // (F24) the residual variance of the last window flown without a check
   int check_prev_{-1};      // the jet checked on the previous update (its thrust is this one's)
   bool eval_unfit_{false};  // the evaluated window's check showed a model error: not scored
   bool eval_onset_{false};  // (F21) the evaluated window is the one a fault started in: not scored

@@ -138,6 +138,7 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
             const StrategyOutcome& o = d.runs[k];
             ++g.runs;
             g.successes += o.success ? 1 : 0;
+            g.goals_met += o.t_omega_conv_s && o.t_q_conv_s ? 1 : 0;
             const campaign::FdiReport& f = o.fdi;
             if (!f.fault_first_commanded_s) ++g.not_commanded;
             if (f.confirmations == 0) {
@@ -525,6 +526,7 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                       {"onset_s", g.onset_s},
                       {"case", g.case_number},
                       {"runs", g.runs},
+                      {"goals_met", g.goals_met},
                       {"successes", g.successes},
                       {"isolated", g.isolated},
                       {"wrong", g.wrong},
@@ -742,24 +744,43 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
   }
   if (!s.faults.empty()) {
     md << "\n## Thruster faults\n\nPer strategy, fault kind and onset, over the study cases: "
-          "runs, success (both SPEC §7 goals), the fault isolated (exactly one confirmation, "
+          "runs, both SPEC §7 goals met (t_ω,conv and t_q,conv reached), success (the goals and "
+          "‖ω‖ ≤ ε_trans throughout), the fault isolated (exactly one confirmation, "
           "naming the draw's thruster and kind), a wrong confirmation (another thruster or kind, "
           "or more than one), none; the latency from onset to the confirmation over the isolated "
           "runs (for stuck-off and degraded faults it includes the time before the jet is next "
           "commanded); the fuel penalty against the same case flown by the same strategy without "
           "the fault";
     if (s.references.empty()) md << " (no fault-free reference: the plan has no study cases)";
-    md << ".\n\n| strategy | fault | onset (s) | runs | success | isolated | wrong | none | "
-          "latency p50 / p95 / max (s) | fuel penalty p50 / p95 / max (kg) |\n"
-          "|---|---|---:|---:|---:|---:|---:|---:|---|---|\n";
+    md << ".\n\n| strategy | fault | onset (s) | runs | SPEC §7 goals | success | isolated | wrong | "
+          "none | latency p50 / p95 / max (s) | fuel penalty p50 / p95 / max (kg) |\n"
+          "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
     for (const FaultGroupStats& g : s.faults) {
       if (g.case_number != 0) continue;
       md << "| `" << g.strategy << "` | " << g.kind << " | " << fmt("%.0f", g.onset_s) << " | "
-         << g.runs << " | " << g.successes << " | " << g.isolated << " | " << g.wrong << " | "
+         << g.runs << " | " << g.goals_met << " | " << g.successes << " | " << g.isolated << " | "
+         << g.wrong << " | "
          << g.none << " | " << nc(g.latency_s.p50, "%.1f") << " / " << nc(g.latency_s.p95, "%.1f")
          << " / " << nc(g.latency_max_s, "%.1f") << " | " << nc(g.penalty_kg.p50, "%.2f")
          << " / " << nc(g.penalty_kg.p95, "%.2f") << " / " << nc(g.penalty_max_kg, "%.2f")
          << " |\n";
+    }
+    md << "\nOver every fault kind and onset:\n\n";
+    for (const campaign::Strategy& st : spec.strategies) {
+      int runs = 0, goals = 0, ok = 0, isolated = 0, wrong = 0;
+      for (const FaultGroupStats& g : s.faults) {
+        if (g.case_number != 0 || g.strategy != st.name) continue;
+        runs += g.runs;
+        goals += g.goals_met;
+        ok += g.successes;
+        isolated += g.isolated;
+        wrong += g.wrong;
+      }
+      if (runs == 0) continue;
+      md << "- `" << st.name << "`: both SPEC §7 goals in " << goals << " / " << runs << " ("
+         << fmt("%.1f", 100.0 * goals / runs) << " %), success in " << ok << " / " << runs << " ("
+         << fmt("%.1f", 100.0 * ok / runs) << " %); isolated " << isolated << ", wrong " << wrong
+         << ".\n";
     }
     bool unforced = false;
     for (const FaultGroupStats& g : s.faults) unforced = unforced || g.kind != "stuck_on";
@@ -783,7 +804,8 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
       }
     }
     if (!spec.faults.case_numbers.empty()) {
-      md << "\nPer case: isolated / runs (latency p50 s), and successes.\n\n| strategy | fault | "
+      md << "\nPer case: isolated / runs (latency p50 s), the runs that met both goals, and the "
+            "successes.\n\n| strategy | fault | "
             "onset (s) |";
       for (int c : spec.faults.case_numbers) md << " case " << c << " |";
       md << "\n|---|---|---:|";
@@ -804,7 +826,7 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
             md << " — |";
           } else {
             md << " " << x->isolated << "/" << x->runs << " (" << nc(x->latency_s.p50, "%.1f")
-               << "), " << x->successes << " ok |";
+               << "), " << x->goals_met << " goals, " << x->successes << " ok |";
           }
         }
         md << "\n";

@@ -107,6 +107,7 @@ struct FaultGroupStats {
   double onset_s{0.0};
   int case_number{0};  // 0: every case
   int runs{0};         // flown (status ok)
+  int goals_met{0};    // both SPEC §7 goals (t_omega,conv and t_q,conv reached in the run)
   int successes{0};    // both SPEC §7 goals and |omega| <= eps_trans throughout
   int isolated{0};     // exactly one confirmation, naming the draw's thruster and kind
   int wrong{0};        // some confirmation, not that one

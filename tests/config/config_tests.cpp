@@ -232,6 +232,19 @@ TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
                              &gnc::FaultDetectorParams::skip_onset_window);
 }
 
+// (F24) The jet checks' information gate: gnc.yaml's value, off (0) when the key is absent, and a
+// negative value names the file and key.
+TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
+  const std::string line = "  check_min_llr: 5.0";
+  ASSERT_NE(read(kGnc).find(line), std::string::npos);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.check_min_llr, 5.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.check_min_llr, 5.0);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), line, ""));
+  EXPECT_EQ(load_run(kMission, absent.path(), case_file(1)).flight.fdi.check_min_llr, 0.0);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  check_min_llr: -1.0"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.check_min_llr", "must not be negative");
+}
+
 TEST(ConfigErrors, UnreadableFile) {
   const std::string missing = kConfigs + "/cases/no_such_case.yaml";
   expect_error([&] { load_case(missing); }, missing, "", "cannot read file");

@@ -171,6 +171,7 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
       {1, plant::FaultKind::kStuckOn, 3, 3, "stuck-on", 1, 62.0, 110.0, true},    // isolated, 2 s
       {1, plant::FaultKind::kStuckOn, 4, 5, "stuck-on", 1, 61.0, 120.0, true},    // wrong thruster
       {5, plant::FaultKind::kStuckOn, 6, 6, "stuck-on", 1, 70.0, 130.0, false},   // isolated, 10 s
+                                                                                  // (goals met)
       {5, plant::FaultKind::kStuckOn, 7, 7, "stuck-on", 2, 64.0, 140.0, true},    // and another
       {1, plant::FaultKind::kStuckOff, 0, 0, "stuck-on", 1, 90.0, 101.0, true},   // wrong kind
       {5, plant::FaultKind::kStuckOff, 1, -1, "", 0, 0.0, 95.0, true},            // none
@@ -186,6 +187,8 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
     d.sampled.fault.thruster = r.thruster;
     d.sampled.fault.onset_s = 60.0;
     StrategyOutcome o = ok("ntcl+dpd_ref", r.fuel, r.success);
+    // Draw 2 met both SPEC §7 goals but left eps_trans on the way: a goal met, not a success.
+    if (d.index == 2) o.t_q_conv_s = 3000.0;
     o.fdi.enabled = true;
     o.fdi.confirmations = r.confirmations;
     o.fdi.thruster = r.confirmed_thruster;
@@ -211,6 +214,7 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
   ASSERT_NE(on, nullptr);
   EXPECT_EQ(on->runs, 4);
   EXPECT_EQ(on->successes, 3);
+  EXPECT_EQ(on->goals_met, 4);
   EXPECT_EQ(on->isolated, 2);
   EXPECT_EQ(on->wrong, 2);
   EXPECT_EQ(on->none, 0);
@@ -229,6 +233,8 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
   EXPECT_EQ(off->isolated, 0);
   EXPECT_EQ(off->wrong, 1);
   EXPECT_EQ(off->none, 1);
+  EXPECT_EQ(off->goals_met, 2);
+  EXPECT_EQ(off->successes, 2);
   EXPECT_FALSE(off->latency_s.p50.has_value());
   EXPECT_NEAR(*off->penalty_kg.p50, 3.0, 1e-12);  // 1 and 5
   // Without references there is no penalty, and the counts are unchanged.

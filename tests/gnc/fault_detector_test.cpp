@@ -406,6 +406,69 @@ TEST(FaultDetector, APartialLossOfThrustIsConfirmedDegradedWithItsFactor) {
   }
 }
 
+// (F23) A jet that produces nothing leaves the residual of its whole signature, which the model
+// knows to its relative error eps only; so the fitted loss of a dead jet scatters below 1 by up to
+// model_sigmas eps. Under a long, firm firing (E of the order of 1e8 here: a quiet gyro, as in
+// HOLD's hours) a fitted loss a few percent below 1 gains far more than margin_llr over a total
+// loss, and without (F23) such a jet was held as a partial loss for the rest of the flight (case 1,
+// a jet stuck off in HOLD, held by another alternative until its LLR was past 1e5, then never
+// isolated). Here the confirmation level is 2e4, so that the decision is taken under that much
+// evidence. The truth's jet gives 3 % of its thrust (a jet that failed shut and leaks, or a model
+// whose strength is a few percent off). With a model whose strength 1 sigma is 1.5 % (3 sigma:
+// 4.6 % of the signature) that is a total loss: confirmed stuck off (without F23: degraded, at
+// 3 %). With a model certain to 0.1 % the same data are a partial loss: confirmed degraded
+// with its fitted factor. The floor follows the model's stated error.
+FaultEvents fly_leaking(int i, double k_sigma) {
+  Truth t;
+  t.gyro_sigma = 1e-8;
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.degraded_min_loss = 0.1;
+  p.confirm_llr = 2e4;
+  p.window_ticks = 10;
+  p.gyro_sigma = t.gyro_sigma;
+  p.disturbance_sigma = 0.0;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  m.k_sigma = k_sigma;
+  d.set_model(m);
+  std::mt19937_64 cmd_rng(11);
+  Vec16 prev = Vec16::Zero();
+  for (int k = 0; k < 200000; ++k) {
+    if (k == 50) {
+      t.degraded = i;
+      t.degraded_factor = 0.03;
+    }
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    const FaultEvents e = d.update(in);
+    if (e.confirmed) return e;
+    const Vec16 cmd = random_firing(cmd_rng);
+    t.advance(cmd);
+    prev = cmd;
+  }
+  return FaultEvents{};
+}
+
+TEST(FaultDetector, ALossOfThrustWithinTheModelsErrorOfTotalIsConfirmedStuckOff) {
+  for (int i : {0, 5, 10, 15}) {
+    const FaultEvents off = fly_leaking(i, 0.015);
+    ASSERT_TRUE(off.confirmed) << "thruster " << i << " (model 1 sigma 1.5 %): never confirmed";
+    EXPECT_EQ(off.thruster, i);
+    EXPECT_EQ(off.kind, FaultKind::kStuckOff)
+        << "thruster " << i << " (model 1 sigma 1.5 %): confirmed " << to_string(off.kind);
+    const FaultEvents partial = fly_leaking(i, 0.001);
+    ASSERT_TRUE(partial.confirmed) << "thruster " << i << " (model 1 sigma 0.1 %): never confirmed";
+    EXPECT_EQ(partial.thruster, i);
+    EXPECT_EQ(partial.kind, FaultKind::kDegraded)
+        << "thruster " << i << " (model 1 sigma 0.1 %): confirmed " << to_string(partial.kind);
+    EXPECT_NEAR(partial.factor, 0.03, 3.0 * partial.factor_sigma + 0.01) << "thruster " << i;
+  }
+}
+
 // (F18) With 5-tick windows (the study table's) the four evaluation steps and the partial-loss
 // step leave no update free of an evaluation step inside a window: a model given during an
 // evaluation must still be taken (at the update after the decision, before the partial-loss step
@@ -1137,6 +1200,53 @@ TEST(FaultDetector, JetChecksOfHealthyJetsConfirmNothingAndRespectTheInterval) {
 
 // A check is only as good as the model it is flown against: with the inertia known to 10 %
 // (the table's, before identification) no jet is checked, whatever the evidence.
+// (F24) A check is flown only when it can move the evidence: a model whose centre of mass is
+// known to 0.3 m makes the check's own torque (its force against that offset) about as uncertain
+// as the signature it fires, and the expected LLR of a check falls below check_llr. The guard of
+// F19 on the signature's error is opened wide here, so only (F24) decides. A tangential jet
+// stuck off under the weak firing: without (F24) it is checked against the 0.3 m model; with it,
+// not; with the centre of mass known to 1 mm it is checked and confirmed stuck off to itself.
+CheckRun fly_check_gated(Truth& t, double r_sigma, double check_min_llr, FaultDetector& d) {
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.degraded_min_loss = 0.1;
+  p.check_llr = 5.0;
+  p.check_max_model_error = 1.0;
+  p.check_min_llr = check_min_llr;
+  p.window_ticks = 10;
+  p.gyro_sigma = t.gyro_sigma;
+  p.disturbance_sigma = 0.0;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  m.r_cov = Mat3::Identity() * r_sigma * r_sigma;
+  d.set_model(m);
+  return fly_checked(t, d, 20000, 141);
+}
+
+TEST(FaultDetector, ACheckThatCannotMoveTheEvidenceIsNotFlown) {
+  Truth loose;
+  loose.stuck_off = 4;
+  FaultDetector ungated;
+  const CheckRun a = fly_check_gated(loose, 0.6, 0.0, ungated);
+  EXPECT_FALSE(a.checked.empty()) << "no check without (F24): the case below tests nothing";
+  Truth loose2;
+  loose2.stuck_off = 4;
+  FaultDetector gated;
+  const CheckRun b = fly_check_gated(loose2, 0.6, 5.0, gated);
+  EXPECT_TRUE(b.checked.empty()) << b.checked.size() << " checks, the first of thruster "
+                                 << (b.checked.empty() ? -1 : b.checked.front());
+  EXPECT_EQ(gated.status().checks, 0u);
+  Truth known;
+  known.stuck_off = 4;
+  FaultDetector d;
+  const CheckRun c = fly_check_gated(known, 1e-3, 5.0, d);
+  const auto own = std::find(c.checked.begin(), c.checked.end(), 4);
+  ASSERT_NE(own, c.checked.end()) << "the jet was never checked with the centre of mass known";
+  ASSERT_GE(c.r.confirmed_at, 0);
+  EXPECT_EQ(c.r.thruster, 4);
+  EXPECT_EQ(c.r.kind, FaultKind::kStuckOff);
+}
+
 TEST(FaultDetector, NoJetCheckWithAModelThatDoesNotKnowTheJetsSignature) {
   Truth t;
   t.stuck_off = 13;
@@ -1210,6 +1320,9 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
   p = FaultDetectorParams{};
   p.check_max_model_error = -0.1;
   EXPECT_STREQ(validate(p).field, "fdi.check_max_model_error");
+  p.check_max_model_error = 0.05;
+  p.check_min_llr = -1.0;  // (F24)
+  EXPECT_STREQ(validate(p).field, "fdi.check_min_llr");
   EXPECT_TRUE(validate(FaultDetectorParams{}).ok);
 }
 
