@@ -8,9 +8,23 @@
 
 namespace rocksteady::dispersion::test {
 
+// This process's scratch directory, removed with everything in it when the process exits (one
+// per process: ctest runs each test in a process of its own).
+inline const std::filesystem::path& temp_dir() {
+  struct Scratch {
+    std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                ("rs_dispersion_tests_" + std::to_string(::getpid()));
+    ~Scratch() {
+      std::error_code ec;
+      std::filesystem::remove_all(dir, ec);
+    }
+  };
+  static const Scratch scratch;
+  return scratch.dir;
+}
+
 inline std::string write_temp(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("rs_dispersion_tests_" + std::to_string(::getpid()));
+  const std::filesystem::path& dir = temp_dir();
   std::filesystem::create_directories(dir);
   const std::string path = (dir / name).string();
   std::ofstream(path) << text;

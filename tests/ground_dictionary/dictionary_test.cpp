@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -195,9 +196,13 @@ std::pair<int, std::string> dictgen_with(const std::string& from, const std::str
   const std::string cmd = std::string(ROCKSTEADY_DICTGEN_EXE) + " " + dir + "/d.yaml " + dir + " " +
                           ROCKSTEADY_LCM_DIR + "/*.lcm 2> " + dir + "/err";
   const int rc = std::system(cmd.c_str());
-  std::ifstream err(dir + "/err");
   std::stringstream es;
-  es << err.rdbuf();
+  {
+    std::ifstream err(dir + "/err");
+    es << err.rdbuf();
+  }
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);  // the copy, the generated files and the log
   return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, es.str()};
 }
 
