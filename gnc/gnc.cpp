@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "gnc/fdi/jet_check.hpp"
 #include "gnc/math/rotation.hpp"
 
 namespace rocksteady::gnc {
@@ -304,13 +305,8 @@ void Gnc::apply_jet_check(const AllocatorLimits& lim, Vec8& u) {
   const int c = i / 2;
   const double s = (i % 2 == 0) ? 1.0 : -1.0;
   if ((s > 0.0 && !(lim.hi(c) > 0.0)) || (s < 0.0 && !(lim.lo(c) < 0.0))) return;
-  const Mat38& b = alloc_.b_hat();
-  const Mat3 g = b * b.transpose();
-  const Eigen::LDLT<Mat3> ldlt(g);
-  if (ldlt.info() != Eigen::Success) return;
-  Vec8 du = -(b.transpose() * ldlt.solve(Vec3(b.col(c))));
-  du(c) += 1.0;
-  if (!(du(c) > 1e-6) || !du.allFinite()) return;
+  Vec8 du;
+  if (!jet_check_move(alloc_.b_hat(), c, du)) return;
   du *= s * fdi_.check_force() / du(c);
   double gamma = 1.0;
   for (int j = 0; j < kChannels; ++j) {

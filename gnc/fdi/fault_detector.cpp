@@ -1,4 +1,5 @@
 #include "gnc/fdi/fault_detector.hpp"
+#include "gnc/fdi/jet_check.hpp"
 
 #include <cmath>
 
@@ -1275,24 +1276,15 @@ double FaultDetector::expected_check_llr(int i) const {
   // (r_sigma ||J^-1|| f_tot T)^2. (The check adds nothing to the thrust term: B du = 0.)
   const auto k = static_cast<std::size_t>(i);
   const int c = i / 2;
-  Mat3 g = Mat3::Zero();
-  std::array<Vec3, kChannels> col{};
+  Mat38 b = Mat38::Zero();
   for (int q = 0; q < kChannels; ++q) {
     const auto kq = static_cast<std::size_t>(2 * q);
-    col[static_cast<std::size_t>(q)] = (pos_[kq] + m_.r).cross(dir_[kq]);
-    g += col[static_cast<std::size_t>(q)] * col[static_cast<std::size_t>(q)].transpose();
+    b.col(q) = (pos_[kq] + m_.r).cross(dir_[kq]);
   }
-  const Eigen::LDLT<Mat3> ldlt(g);
-  if (ldlt.info() != Eigen::Success) return 0.0;
-  const Vec3 y = ldlt.solve(col[static_cast<std::size_t>(c)]);
-  double sum = 0.0;
-  double own = 0.0;
-  for (int q = 0; q < kChannels; ++q) {
-    const double du = (q == c ? 1.0 : 0.0) - col[static_cast<std::size_t>(q)].dot(y);
-    sum += std::fabs(du);
-    if (q == c) own = du;
-  }
-  if (!(own > 1e-6)) return 0.0;  // channel c has no null-space move: no check is flown
+  Vec8 du;
+  if (!jet_check_move(b, c, du)) return 0.0;  // channel c has no null-space move: no check
+  const double sum = du.cwiseAbs().sum();
+  const double own = du(c);
   const double n = static_cast<double>(p_.window_ticks);
   const double f = p_.check_force_n;
   const double offset = r_sigma_ * j_inv_.norm() * f * (sum / own) * n * dt_;
