@@ -85,6 +85,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.model_floor_gyroscopic = true;        // (F22) ... on both terms, as flown
   p.fdi.probe_windows = 2;                    // isolation tests of two windows, as flown
   p.fdi.skip_onset_window = true;             // (F21) the onset window not scored: 5-tick windows
+  p.fdi.episode_restart = true;               // (F25) the episode since the fault showed, as flown
   p.mode.auto_hold = false;
   Gnc gnc;
   if (!gnc.init(p).ok) {

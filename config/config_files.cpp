@@ -245,6 +245,7 @@ GncConfig load_gnc(const std::string& path) {
     fd.suspect_chi2 = r.positive("suspect_chi2");
     fd.auto_isolate = r.boolean("auto_isolate");
     fd.model_sigmas = r.non_negative("model_sigmas");
+    if (r.has("episode_restart")) fd.episode_restart = r.boolean("episode_restart");  // (F25), optional
     fd.probe_after_windows = r.integer("probe_after_windows");
     fd.probe_windows = r.integer("probe_windows");
     if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)

@@ -210,6 +210,7 @@ int firmware_main() {
     g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
     g_params.fdi.probe_windows = 2;            // isolation tests of two windows, as flown
     g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows
+    g_params.fdi.episode_restart = true;       // (F25) the episode since the fault showed, as flown
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the
     // second-order term (I20), the gate (I18), the noise correction (I25), the gyro bias (I17).
     gnc::apply_flight_identification_settings(g_params, g_params.mekf.gyro_arw / std::sqrt(g_params.dt));

@@ -108,11 +108,25 @@ void FaultDetector::reset_scores() {
 }
 
 void FaultDetector::reset_episode() {
-  lambda_.fill(0.0);
-  info_.fill(0.0);
-  cross_xx_.fill(0.0);
+  // The sums are not cleared (about 3 kB: 1.3 k Cortex-M7 instructions, every window with F25):
+  // a new epoch makes every entry stale; a stale entry reads as zero, and its first window of the
+  // episode writes it afresh. (A 32-bit epoch per window of 0.5 s wraps after 68 years.)
+  ++episode_epoch_;
   ambiguous_windows_ = 0;
   st_.ambiguous_with = -1;
+}
+
+void FaultDetector::restart_episode_with_window() {
+  // (F25) A new episode of the window being evaluated alone: its scores (steps 1 and 2) are
+  // already in the old episode's sums, so the new one takes them from the window's own values;
+  // its cross sums come next (evaluate_cross), on the new epoch's fresh rows.
+  reset_episode();
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kHypotheses); ++k) {
+    hyp_epoch_[k] = episode_epoch_;
+    lambda_[k] = window_llr_[k];
+    info_[k] = window_info_[k];
+  }
+  ++st_.episode_restarts;
 }
 
 void FaultDetector::cancel_evaluation() {
@@ -512,9 +526,19 @@ void FaultDetector::evaluate_step() {
       evaluate_scores(w, 0, kThrusters);
       eval_phase_ = 2;
       break;
-    case 2:
+    case 2: {
       evaluate_scores(w, kThrusters, kHypotheses);
+      const int was_best = st_.best;
+      const bool was_suspecting = suspecting_;
       rank_hypotheses();
+      // (F25) A suspicion that starts with a new leader starts a new episode with this window:
+      // (F8)'s sums then hold the windows since the fault showed, not hours of healthy flight
+      // (in HOLD an idle jet's stuck-off score can stay above zero for the rest of the flight,
+      // and the episode used to restart only with every score at zero). A leader that was
+      // already leading keeps the evidence it gathered below the suspicion level.
+      if (p_.episode_restart && suspecting_ && !was_suspecting && st_.best != was_best) {
+        restart_episode_with_window();
+      }
       evaluate_cross(w);
       // (F10) A leader past the confirmation level is checked against every alternative (F8)
       // before the decision, the scan split over this step and the next (the Cortex-M7 tick
@@ -529,6 +553,7 @@ void FaultDetector::evaluate_step() {
       }
       eval_phase_ = 3;
       break;
+    }
     case 3:
       if (block_scan_.h >= 0) blocking_scan(block_scan_.h, kScanSplit, kHypotheses, block_scan_);
       eval_phase_ = 4;
@@ -621,6 +646,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     for (int h = first; h < last; ++h) {
       const auto k = static_cast<std::size_t>(h);
       window_llr_[k] = 0.0;
+      window_info_[k] = 0.0;
       if (h >= kThrusters) window_energy_[k - static_cast<std::size_t>(kThrusters)] = 0.0;
     }
     return;
@@ -634,6 +660,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
       pool_llr_[k] = 0.0;
       pool_energy_[k] = 0.0;
       window_llr_[k] = 0.0;
+      window_info_[k] = 0.0;
       if (h >= kThrusters) window_energy_[k - static_cast<std::size_t>(kThrusters)] = 0.0;
       continue;
     }
@@ -647,8 +674,14 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
     const double ss = b.squaredNorm() * cc;
     const double llr = (sr - 0.5 * ss) / var;
     window_llr_[k] = llr;
+    window_info_[k] = cc / var;
+    if (hyp_epoch_[k] != episode_epoch_) {  // the hypothesis's first window of the episode
+      hyp_epoch_[k] = episode_epoch_;
+      lambda_[k] = 0.0;
+      info_[k] = 0.0;
+    }
     lambda_[k] += llr;
-    info_[k] += cc / var;
+    info_[k] += window_info_[k];
     const double energy = ss / var;
     if (h >= kThrusters) window_energy_[k - static_cast<std::size_t>(kThrusters)] = energy;  // (F18)
     if (energy >= p_.min_signature) {  // observable in this window alone
@@ -721,8 +754,11 @@ void FaultDetector::evaluate_cross(const WindowSums& w) {
       continue;
     }
     const double sa = sx[a] / n;
+    const bool fresh = row_epoch_[a] != episode_epoch_;  // the row's first window of the episode
+    row_epoch_[a] = episode_epoch_;
     for (std::size_t b = a; b < sx.size(); ++b, ++idx) {
-      cross_xx_[idx] += (w.sum_xx[idx] - sa * sx[b]) * inv_var;
+      const double v = (w.sum_xx[idx] - sa * sx[b]) * inv_var;
+      cross_xx_[idx] = fresh ? v : cross_xx_[idx] + v;
     }
   }
 }
@@ -787,6 +823,7 @@ void FaultDetector::decide() {
     }
   }
   if (blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
+  if (blocking < 0 && best < kThrusters && p_.episode_restart) blocking = partial_loss_rival(best);
   if (blocking < 0) {
     const int thruster = best % kThrusters;
     const FaultKind kind = best < kThrusters ? FaultKind::kStuckOn : FaultKind::kStuckOff;
@@ -1088,6 +1125,8 @@ int FaultDetector::probe_verdict() const {
 double FaultDetector::cross(int h, int g) const {
   // c_h = alpha_h x_{16+pod} + x_i, alpha = u_max for stuck-on and 0 for stuck-off (F4).
   const auto at = [this](int a, int b) {
+    const int row = a <= b ? a : b;
+    if (row_epoch_[static_cast<std::size_t>(row)] != episode_epoch_) return 0.0;  // stale
     return cross_xx_[static_cast<std::size_t>(a <= b ? basis_index(a, b) : basis_index(b, a))];
   };
   const int ih = h % kThrusters;
@@ -1101,7 +1140,7 @@ double FaultDetector::cross(int h, int g) const {
 
 double FaultDetector::partial_loss_energy(int g) const {
   const auto k = static_cast<std::size_t>(g);
-  return b_[k % static_cast<std::size_t>(kThrusters)].squaredNorm() * info_[k];
+  return b_[k % static_cast<std::size_t>(kThrusters)].squaredNorm() * info(k);
 }
 
 double FaultDetector::total_loss_floor(int i) const {
@@ -1133,9 +1172,9 @@ double FaultDetector::partial_loss_llr(int g) const {
   // over a of a SR - a^2 E / 2 is SR^2 / (2 E) for SR < E, and Lambda (a = 1) beyond.
   const auto k = static_cast<std::size_t>(g);
   const double e = partial_loss_energy(g);
-  const double sr = lambda_[k] + 0.5 * e;
+  const double sr = lambda(k) + 0.5 * e;
   if (sr <= 0.0 || e <= 0.0) return 0.0;
-  return sr >= e ? lambda_[k] : sr * sr / (2.0 * e);
+  return sr >= e ? lambda(k) : sr * sr / (2.0 * e);
 }
 
 int FaultDetector::partial_loss_alternative(int h) const {
@@ -1144,11 +1183,26 @@ int FaultDetector::partial_loss_alternative(int h) const {
   // a smaller, nearly parallel signature of another jet), and its own amplitude must be that of
   // a jet that produces nothing: its fitted a may not gain margin_llr over a loss at the (F23)
   // total-loss floor (1 when model_sigmas is 0).
-  const double lh = lambda_[static_cast<std::size_t>(h)];
+  const double lh = lambda(static_cast<std::size_t>(h));
   const double eh = partial_loss_energy(h);
   if (partial_not_total(h % kThrusters, lh + 0.5 * eh, eh)) return h;
   for (int g = kThrusters; g < kHypotheses; ++g) {
     if (g == h) continue;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> (g - kThrusters)) & 1u) != 0) continue;
+    if (lh - partial_loss_llr(g) <= p_.margin_llr) return g;
+  }
+  return -1;
+}
+
+int FaultDetector::partial_loss_rival(int h) const {
+  // (F25) A stuck-on leader must also beat, by margin_llr, a partial loss of thrust of every jet.
+  // A jet at half strength leaves half its stuck-off signature: no hypothesis of the bank
+  // explains it at full amplitude, and a stuck-on jet whose signature is nearly anti-parallel
+  // (another pod, a similar ramp under the despin's steady firing) can lead the bank. Over the
+  // episode since the fault showed, the partial loss explains it exactly (under the former,
+  // hours-long episode the stuck-on leader carried the healthy flight's evidence against it).
+  const double lh = lambda(static_cast<std::size_t>(h));
+  for (int g = kThrusters; g < kHypotheses; ++g) {
     if ((((st_.confirmed_on | st_.confirmed_off) >> (g - kThrusters)) & 1u) != 0) continue;
     if (lh - partial_loss_llr(g) <= p_.margin_llr) return g;
   }
@@ -1378,13 +1432,13 @@ void FaultDetector::blocking_scan(int h, int g_begin, int g_end, BlockingScan& s
     if ((((st_.confirmed_on | st_.confirmed_off) >> tg) & 1u) != 0) continue;
     const Vec3& bg = b_[kg % static_cast<std::size_t>(kThrusters)];
     const double c = cross(h, g);
-    const Vec3 v = bh * info_[kh] - bg * c;
+    const Vec3 v = bh * info(kh) - bg * c;
     const Vec3 w = j_inv_.transpose() * v;
     const Vec3 wxe = kk * w.cross(dir_[ih]);
     const double vk = rel_k * v.dot(bh);
     const double vj = dj * w.norm();
     const double sd = std::sqrt(vk * vk + wxe.dot(m_.r_cov * wxe) + vj * vj);
-    const double lead = lambda_[kh] - lambda_[kg] - p_.model_sigmas * sd;
+    const double lead = lambda(kh) - lambda(kg) - p_.model_sigmas * sd;
     if (lead <= p_.margin_llr && (scan.worst < 0 || lead < scan.worst_lead)) {
       scan.worst = g;
       scan.worst_lead = lead;

@@ -55,6 +55,11 @@ struct FaultDetectorParams {
   // (F8) The lead over each alternative must also exceed what an error of the model could have
   // produced: this many 1 sigma of the signature's model uncertainty.
   double model_sigmas{3.0};
+  // (F25) The episode of (F8) restarts with the window in which a suspicion starts with a new
+  // leader (false: only when every score is zero, which a stale stuck-off score of an idle jet
+  // can put off for the rest of the flight); a stuck-on leader must also beat every jet's partial
+  // loss of thrust.
+  bool episode_restart{false};
   // (F9) Isolation test: when the leader stays ambiguous against a hypothesis on another pod for
   // this many windows, its pod's valve is closed for probe_windows windows (0: never).
   int probe_after_windows{1};
@@ -165,6 +170,7 @@ struct FaultDetectorStatus {
   std::uint32_t models_held{0};  // model refreshes not applied while a hypothesis was suspected
   int probe_pod{-1};              // (F9) pod whose valve the detector asks closed for a test, -1 none
   std::uint32_t probes{0};        // isolation tests started
+  std::uint32_t episode_restarts{0};  // (F25) episodes restarted with a new suspected leader
   int ambiguous_with{-1};         // the alternative the leader could not be told from, -1 none
   // (F14) The identifier's evidence: the thruster whose stuck-on torque it matches best (-1 none)
   // and how many fitted windows in a row it has passed the isolation test.
@@ -264,6 +270,7 @@ class FaultDetector {
     double worst_lead{0.0};
   };
   void blocking_scan(int h, int g_begin, int g_end, BlockingScan& scan) const;
+  int partial_loss_rival(int h) const;  // (F25) a stuck-on leader against every jet's partial loss
   BlockingScan block_scan_{};
   // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
   // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.
@@ -410,6 +417,15 @@ class FaultDetector {
   std::array<double, kHypotheses> info_{};
   double cross(int h, int g) const;
   std::array<double, kBasisPairs> cross_xx_{};  // per episode: sum_w (sum x~_a x~_b) / var
+  // The episode's epoch and each hypothesis's and each basis row's: an entry whose epoch is not
+  // the episode's is stale, read as zero and written afresh (reset_episode clears nothing).
+  std::uint32_t episode_epoch_{1};
+  std::array<std::uint32_t, kHypotheses> hyp_epoch_{};
+  std::array<std::uint32_t, kBasis> row_epoch_{};
+  std::array<double, kHypotheses> window_info_{};  // the evaluated window's |c~_h|^2 / var
+  void restart_episode_with_window();  // (F25)
+  double lambda(std::size_t k) const { return hyp_epoch_[k] == episode_epoch_ ? lambda_[k] : 0.0; }
+  double info(std::size_t k) const { return hyp_epoch_[k] == episode_epoch_ ? info_[k] : 0.0; }
   int ambiguous_windows_{0};
   int probe_left_{0};
   // (F15) The isolation test's outcome: the tested pod, how many windows were flown with it closed

@@ -245,6 +245,19 @@ TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.check_min_llr", "must not be negative");
 }
 
+// (F25) The episode restart: gnc.yaml true, the former episode (false) when the key is absent,
+// and a value that is not a boolean names the file and key.
+TEST(ConfigShipped, TheEpisodeRestartIsReadAndOptional) {
+  const std::string line = "  episode_restart: true";
+  ASSERT_NE(read(kGnc).find(line), std::string::npos);
+  EXPECT_TRUE(load_run(kMission, kGnc, case_file(1)).flight.fdi.episode_restart);
+  EXPECT_TRUE(load_run(kMission, kGnc, case_file(6)).flight.fdi.episode_restart);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), line, "  #"));
+  EXPECT_FALSE(load_run(kMission, absent.path(), case_file(1)).flight.fdi.episode_restart);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  episode_restart: 3"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.episode_restart", "");
+}
+
 TEST(ConfigErrors, UnreadableFile) {
   const std::string missing = kConfigs + "/cases/no_such_case.yaml";
   expect_error([&] { load_case(missing); }, missing, "", "cannot read file");

@@ -1379,3 +1379,224 @@ TEST(FaultDetector, ATwinJetWhoseSignatureTheModelsErrorMatchesIsNotConfirmedDeg
 
 }  // namespace
 }  // namespace rocksteady::gnc
+
+namespace rocksteady::gnc {
+namespace {
+
+// (F25) A HOLD-like flight with the model identified (the centre of mass to 1 mm), a quiet gyro,
+// channel 4 (thrusters 8 and 9) never commanded and the others at a few newtons, and thruster 9
+// stuck on from tick `onset`. If `stale`, thruster 8 (the same pod and channel) is commanded at
+// 0.5 N for 30 s from tick 400 while the truth gives nothing (its windows pooled, F11), and is
+// idle after: its stuck-off score is left above zero, below the suspicion level, for the rest of
+// the flight, as an idle jet's can be in HOLD.
+struct HeldRun {
+  RunResult r;
+  std::uint32_t probes{0};
+  std::uint32_t restarts{0};
+  FaultDetectorStatus before_onset;
+};
+
+HeldRun fly_held(bool episode_restart, int onset, bool stale,
+                 int probe_windows = FaultDetectorParams{}.probe_windows) {
+  Truth t;
+  t.gyro_sigma = 1e-7;  // cases 1-4: a perfect gyro (the detector's floor)
+  t.body.omega = V3(1e-4, -2e-4, 1e-4);  // HOLD
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = t.gyro_sigma;
+  p.disturbance_sigma = 0.0;
+  p.episode_restart = episode_restart;
+  p.probe_windows = probe_windows;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  d.set_model(identified_model(t));
+  std::mt19937_64 rng(23);
+  Vec16 prev = Vec16::Zero();
+  HeldRun out;
+  constexpr int kStaleFrom = 400;
+  constexpr int kStaleTo = 700;
+  for (int k = 0; k < onset + 600; ++k) {
+    if (k == onset) t.stuck_on = 9;
+    t.stuck_off = stale && k >= kStaleFrom && k < kStaleTo ? 8 : -1;
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    in.valve_open = t.valve;
+    const FaultEvents e = d.update(in);
+    if (e.confirmed && out.r.confirmed_at < 0) {
+      out.r.confirmed_at = k;
+      out.r.thruster = e.thruster;
+      out.r.kind = e.kind;
+    }
+    t.valve = {{true, true, true, true}};
+    for (int i = 0; i < 16; ++i) {
+      if ((d.confirmed_on() >> i) & 1u) t.valve[static_cast<std::size_t>(i / 4)] = false;
+    }
+    if (d.probe_pod() >= 0) t.valve[static_cast<std::size_t>(d.probe_pod())] = false;
+    Vec16 cmd = 0.05 * random_firing(rng);  // HOLD: a few newtons
+    cmd(8) = cmd(9) = 0.0;
+    if (stale && k >= kStaleFrom && k < kStaleTo) cmd(8) = 0.5;
+    if (k == onset - 1) out.before_onset = d.status();
+    t.advance(cmd);
+    prev = cmd;
+  }
+  out.probes = d.status().probes;
+  out.restarts = d.status().episode_restarts;
+  return out;
+}
+
+// (F8)'s pairwise sums run over the episode. It used to start only when every score was zero,
+// and thruster 8's stale score keeps it open: the stuck-on leader's unfloored sum then carries
+// 290 s of healthy flight in which its idle jet would have shown (about -1e7), and every
+// alternative leads it. Without isolation tests the leader is never confirmed; with them, only
+// after a test has closed its pod. With (F25) a suspicion that starts with a new leader restarts
+// the episode with its window, and the leader is confirmed in the windows that show it.
+TEST(FaultDetector, TheEpisodeStartsWhenTheFaultShowsNotWithAStaleScore) {
+  constexpr int kOnset = 3500;
+  const HeldRun untested = fly_held(false, kOnset, true, 0);
+  ASSERT_EQ(untested.before_onset.best, 16 + 8) << "no stale score: the case tests nothing";
+  EXPECT_GT(untested.before_onset.best_llr, 0.0);
+  EXPECT_LT(untested.before_onset.best_llr, 0.5 * FaultDetectorParams{}.confirm_llr);
+  EXPECT_LT(untested.r.confirmed_at, 0)
+      << "confirmed " << untested.r.thruster << " at tick " << untested.r.confirmed_at
+      << ": the former episode did not hold the leader";
+  const HeldRun tested = fly_held(false, kOnset, true);
+  EXPECT_GE(tested.probes, 1u) << "the former episode confirmed without an isolation test";
+
+  for (int probe_windows : {0, FaultDetectorParams{}.probe_windows}) {
+    const HeldRun fresh = fly_held(true, kOnset, false, probe_windows);
+    const HeldRun stale = fly_held(true, kOnset, true, probe_windows);
+    EXPECT_EQ(stale.before_onset.best, 16 + 8);
+    EXPECT_GE(stale.restarts, 1u) << "the suspicion of 9 did not restart the episode";
+    for (const HeldRun* run : {&fresh, &stale}) {
+      ASSERT_GE(run->r.confirmed_at, 0) << "not confirmed (isolation tests " << probe_windows << ")";
+      EXPECT_EQ(run->r.thruster, 9);
+      EXPECT_EQ(run->r.kind, FaultKind::kStuckOn);
+      EXPECT_LE(run->r.confirmed_at, kOnset + 30) << "more than 3 s after the onset";
+      EXPECT_EQ(run->probes, 0u);
+    }
+  }
+}
+
+// (F25) A half-strength jet under a steady firing is not a stuck-on jet of another pod. Thruster
+// 0 fires 200 N throughout and delivers 100 N; thruster j, the one of another pod whose torque is
+// the most nearly opposite to 0's, fires 180 N throughout, so "j stuck on" predicts only 20 N more
+// of it. Under a steady firing every ramp has the same shape, and the bank's "0 stuck off"
+// predicts twice the loss: a stuck-on hypothesis of another pod leads (thruster 6 here, as in the
+// flight's case 1 with jet 0 at half strength during the despin), is confirmed without a rival and
+// closes a healthy pod. A stuck-on leader must now beat every jet's partial loss as well.
+struct SteadyRun {
+  int rival{-1};
+  FaultEvents first;
+  int confirmations{0};
+};
+
+SteadyRun fly_steady_loss(bool episode_restart) {
+  Truth t;
+  t.gyro_sigma = 1e-7;
+  t.degraded = 0;
+  t.degraded_factor = 0.5;
+  SteadyRun out;
+  const M3 j_inv = t.body.j.inverse();
+  auto b = [&](int i) {
+    const auto k = static_cast<std::size_t>(i);
+    return V3(j_inv * (t.pos[k] + t.r).cross(t.dir[k]));
+  };
+  double most = 0.0;
+  for (int i = 4; i < 16; ++i) {
+    const double c = b(i).normalized().dot(b(0).normalized());
+    if (c < most) {
+      most = c;
+      out.rival = i;
+    }
+  }
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = t.gyro_sigma;
+  p.disturbance_sigma = 0.0;
+  p.probe_windows = 0;
+  p.degraded_min_loss = 0.1;  // (F18)
+  p.episode_restart = episode_restart;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  d.set_model(identified_model(t));
+  std::mt19937_64 rng(31);
+  Vec16 prev = Vec16::Zero();
+  for (int k = 0; k < 600; ++k) {
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    const FaultEvents e = d.update(in);
+    if (e.confirmed && out.confirmations++ == 0) out.first = e;
+    Vec16 cmd = 0.05 * random_firing(rng);
+    cmd(0) = kUmax;
+    cmd(1) = 0.0;
+    const int partner = out.rival ^ 1;
+    cmd(out.rival) = 0.9 * kUmax;
+    cmd(partner) = 0.0;
+    t.advance(cmd);
+    prev = cmd;
+  }
+  return out;
+}
+
+TEST(FaultDetector, AHalfStrengthJetUnderSteadyFiringIsNotAStuckOnJetOfAnotherPod) {
+  const SteadyRun trap = fly_steady_loss(false);
+  ASSERT_GE(trap.rival, 0);
+  ASSERT_GE(trap.confirmations, 1) << "the trap: nothing confirmed without the rival";
+  EXPECT_NE(trap.first.thruster, 0) << "the trap";
+  EXPECT_NE(trap.first.thruster / 4, 0) << "the trap: a jet of another pod";
+  EXPECT_EQ(trap.first.kind, FaultKind::kStuckOn) << "the trap";
+  const SteadyRun now = fly_steady_loss(true);
+  EXPECT_FALSE(now.confirmations > 0 && now.first.kind == FaultKind::kStuckOn)
+      << "thruster " << now.first.thruster << " confirmed stuck on";
+  ASSERT_GE(now.confirmations, 1) << "the partial loss was not confirmed";
+  EXPECT_EQ(now.confirmations, 1);
+  EXPECT_EQ(now.first.thruster, 0);
+  EXPECT_EQ(now.first.kind, FaultKind::kDegraded);
+  EXPECT_NEAR(now.first.factor, 0.5, 0.05);
+}
+
+// (F25) The mirror trap of (F8) with the episode restart: never the mirror jet without the
+// isolation test, thruster 2 with it.
+TEST(FaultDetector, TheEpisodeRestartNeverConfirmsTheMirrorJet) {
+  FaultDetectorParams no_test;
+  no_test.probe_windows = 0;
+  no_test.episode_restart = true;
+  const AmbiguousRun alone = fly_ambiguous(no_test);
+  EXPECT_NE(alone.r.thruster, 11);
+  FaultDetectorParams with_test;
+  with_test.episode_restart = true;
+  const AmbiguousRun tested = fly_ambiguous(with_test);
+  ASSERT_GE(tested.r.confirmed_at, 0) << "not isolated";
+  EXPECT_EQ(tested.r.thruster, 2);
+  EXPECT_EQ(tested.r.kind, FaultKind::kStuckOn);
+}
+
+TEST(FaultDetector, HealthyFiringNeverConfirmsAFaultWithTheEpisodeRestart) {
+  for (double sigma : {3.1623e-6, 3.1623e-5}) {
+    Truth t;
+    t.gyro_sigma = sigma;
+    FaultDetectorParams p;
+    p.enabled = true;
+    p.window_ticks = 10;
+    p.gyro_sigma = sigma;
+    p.disturbance_sigma = 0.0;
+    p.episode_restart = true;
+    p.degraded_min_loss = 0.1;  // (F18) on: the rival compares partial losses
+    FaultDetector d;
+    d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+    d.set_model(identified_model(t));
+    const RunResult r = fly(t, d, 20000, -1, -1, -1);
+    EXPECT_LT(r.confirmed_at, 0) << "false alarm: thruster " << r.thruster << " "
+                                 << to_string(r.kind) << " at tick " << r.confirmed_at;
+    EXPECT_GT(d.status().windows, 1900u);
+  }
+}
+
+}  // namespace
+}  // namespace rocksteady::gnc
