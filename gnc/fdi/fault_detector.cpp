@@ -108,9 +108,9 @@ void FaultDetector::reset_scores() {
 }
 
 void FaultDetector::reset_episode() {
-  // The sums are not cleared (about 3 kB: 1.3 k Cortex-M7 instructions, every window with F25):
-  // a new epoch makes every entry stale; a stale entry reads as zero, and its first window of the
-  // episode writes it afresh. (A 32-bit epoch per window of 0.5 s wraps after 68 years.)
+  // The sums are not cleared (about 3 kB: 1.3 k Cortex-M7 instructions): a new epoch makes every
+  // entry stale; a stale entry reads as zero, and its first window of the episode writes it
+  // afresh. (A 32-bit epoch, at most one restart per window of 0.5 s, wraps after 68 years.)
   ++episode_epoch_;
   ambiguous_windows_ = 0;
   st_.ambiguous_with = -1;
@@ -1186,23 +1186,19 @@ int FaultDetector::partial_loss_alternative(int h) const {
   const double lh = lambda(static_cast<std::size_t>(h));
   const double eh = partial_loss_energy(h);
   if (partial_not_total(h % kThrusters, lh + 0.5 * eh, eh)) return h;
-  for (int g = kThrusters; g < kHypotheses; ++g) {
-    if (g == h) continue;
-    if ((((st_.confirmed_on | st_.confirmed_off) >> (g - kThrusters)) & 1u) != 0) continue;
-    if (lh - partial_loss_llr(g) <= p_.margin_llr) return g;
-  }
-  return -1;
+  return partial_loss_rival(h);
 }
 
 int FaultDetector::partial_loss_rival(int h) const {
-  // (F25) A stuck-on leader must also beat, by margin_llr, a partial loss of thrust of every jet.
-  // A jet at half strength leaves half its stuck-off signature: no hypothesis of the bank
-  // explains it at full amplitude, and a stuck-on jet whose signature is nearly anti-parallel
-  // (another pod, a similar ramp under the despin's steady firing) can lead the bank. Over the
-  // episode since the fault showed, the partial loss explains it exactly (under the former,
-  // hours-long episode the stuck-on leader carried the healthy flight's evidence against it).
+  // (F13) The jet other than h's whose partial loss of thrust h does not beat by margin_llr, or
+  // -1. (F25) A stuck-on leader must pass it too: a jet at half strength leaves half its stuck-off
+  // signature, which no hypothesis of the bank explains at full amplitude, and a stuck-on jet
+  // whose signature is nearly anti-parallel (another pod, a similar ramp under the despin's
+  // steady firing) can lead the bank; over the episode since the fault showed, the partial loss
+  // explains it exactly (the former, hours-long episode held the stuck-on leader by accident).
   const double lh = lambda(static_cast<std::size_t>(h));
   for (int g = kThrusters; g < kHypotheses; ++g) {
+    if (g == h) continue;
     if ((((st_.confirmed_on | st_.confirmed_off) >> (g - kThrusters)) & 1u) != 0) continue;
     if (lh - partial_loss_llr(g) <= p_.margin_llr) return g;
   }

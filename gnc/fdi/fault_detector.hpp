@@ -270,7 +270,7 @@ class FaultDetector {
     double worst_lead{0.0};
   };
   void blocking_scan(int h, int g_begin, int g_end, BlockingScan& scan) const;
-  int partial_loss_rival(int h) const;  // (F25) a stuck-on leader against every jet's partial loss
+  int partial_loss_rival(int h) const;  // (F13, F25) the other jet whose partial loss h does not beat
   BlockingScan block_scan_{};
   // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
   // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.

@@ -86,15 +86,22 @@ FaultModel identified_model(const Truth& t) {
   return m;
 }
 
-FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_min_loss = 0.0,
-                            double check_llr = 0.0) {
+// The detector as these tests fly it: on, windows of `window_ticks`, the truth's gyro noise and no
+// external disturbance; each test sets what it is about on top.
+FaultDetectorParams bank_params(double gyro_sigma, int window_ticks = 10) {
   FaultDetectorParams p;
   p.enabled = true;
-  p.degraded_min_loss = degraded_min_loss;
-  p.check_llr = check_llr;  // (F19) jet checks, off unless asked
-  p.window_ticks = 10;
+  p.window_ticks = window_ticks;
   p.gyro_sigma = gyro_sigma;
   p.disturbance_sigma = 0.0;
+  return p;
+}
+
+FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_min_loss = 0.0,
+                            double check_llr = 0.0) {
+  FaultDetectorParams p = bank_params(gyro_sigma);
+  p.degraded_min_loss = degraded_min_loss;
+  p.check_llr = check_llr;  // (F19) jet checks, off unless asked
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
   d.set_model(identified_model(t));
@@ -245,11 +252,7 @@ RunResult fly_weak(Truth& t, FaultDetector& d, int ticks, int onset, int fault_o
 RunResult fly_onset_inside_window(int jet, int phase, bool skip_onset_window) {
   Truth t;
   t.gyro_sigma = 1e-7;  // the noise-free cases' floor (config: at least 1e-7 rad/s per sample)
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 5;
-  p.gyro_sigma = t.gyro_sigma;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(t.gyro_sigma, 5);
   p.skip_onset_window = skip_onset_window;
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
@@ -478,11 +481,7 @@ TEST(FaultDetector, ALossOfThrustWithinTheModelsErrorOfTotalIsConfirmedStuckOff)
 TEST(FaultDetector, AModelGivenDuringTheEvaluationIsTakenWithFiveTickWindowsAndPartialLossesOn) {
   for (int i : {0, 6, 11}) {
     Truth t;
-    FaultDetectorParams p;
-    p.enabled = true;
-    p.window_ticks = 5;
-    p.gyro_sigma = t.gyro_sigma;
-    p.disturbance_sigma = 0.0;
+    FaultDetectorParams p = bank_params(t.gyro_sigma, 5);
     p.degraded_min_loss = 0.1;
     FaultDetector d;
     d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
@@ -582,11 +581,7 @@ TEST(FaultDetector, ScoresAreTheLikelihoodRatioOfTheSignatures) {
   // +||S~||^2 / (2 var) and every other hypothesis scores less.
   Truth t;
   t.gyro_sigma = 0.0;
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = 1e-6;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(1e-6);
   p.model_rel_floor = 0.0;
   p.confirm_llr = 1e30;  // never confirm: look at the scores
   FaultDetector d;
@@ -614,11 +609,7 @@ TEST(FaultDetector, ScoresAreTheLikelihoodRatioOfTheSignatures) {
 double window_sigma(bool floor_gyroscopic, bool thrust, double* expected) {
   Truth t;
   if (thrust) t.body.omega = V3::Zero();
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = 1e-7;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(1e-7);
   p.model_rel_floor = 0.01;
   p.model_floor_gyroscopic = floor_gyroscopic;
   p.confirm_llr = 1e30;  // never confirm: look at the noise
@@ -824,11 +815,7 @@ struct SweepRun {
 SweepRun fly_sweep(bool sweep, int stuck, std::uint64_t seed, int stuck_off = -1) {
   Truth t;
   t.rng.seed(seed);
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = t.gyro_sigma;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
   p.identified_isolation = true;
   p.identified_sweep = sweep;
   FaultDetector d;
@@ -987,11 +974,7 @@ TEST(FaultDetector, AClosedWindowIsScoredOverTheNextTicksWithTheModelItWasPredic
       prev = cmd;
     }
   }
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = t.gyro_sigma;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
   p.confirm_llr = 1e30;  // never confirm: compare the scores
   const FaultModel m = identified_model(t);
   FaultModel other = m;
@@ -1401,11 +1384,7 @@ HeldRun fly_held(bool episode_restart, int onset, bool stale,
   Truth t;
   t.gyro_sigma = 1e-7;  // cases 1-4: a perfect gyro (the detector's floor)
   t.body.omega = V3(1e-4, -2e-4, 1e-4);  // HOLD
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = t.gyro_sigma;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
   p.episode_restart = episode_restart;
   p.probe_windows = probe_windows;
   FaultDetector d;
@@ -1512,11 +1491,7 @@ SteadyRun fly_steady_loss(bool episode_restart) {
       out.rival = i;
     }
   }
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = t.gyro_sigma;
-  p.disturbance_sigma = 0.0;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
   p.probe_windows = 0;
   p.degraded_min_loss = 0.1;  // (F18)
   p.episode_restart = episode_restart;
@@ -1581,11 +1556,7 @@ TEST(FaultDetector, HealthyFiringNeverConfirmsAFaultWithTheEpisodeRestart) {
   for (double sigma : {3.1623e-6, 3.1623e-5}) {
     Truth t;
     t.gyro_sigma = sigma;
-    FaultDetectorParams p;
-    p.enabled = true;
-    p.window_ticks = 10;
-    p.gyro_sigma = sigma;
-    p.disturbance_sigma = 0.0;
+    FaultDetectorParams p = bank_params(sigma);
     p.episode_restart = true;
     p.degraded_min_loss = 0.1;  // (F18) on: the rival compares partial losses
     FaultDetector d;
