@@ -248,6 +248,9 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("episode_restart")) fd.episode_restart = r.boolean("episode_restart");  // (F25), optional
     fd.probe_after_windows = r.integer("probe_after_windows");
     fd.probe_windows = r.integer("probe_windows");
+    if (r.has("probe_aligned")) fd.probe_aligned = r.boolean("probe_aligned");  // (F27), optional
+    if (r.has("centred_gyro_noise")) fd.centred_gyro_noise = r.boolean("centred_gyro_noise");  // (F28), optional
+    if (r.has("probe_partial_rival")) fd.probe_partial_rival = r.boolean("probe_partial_rival");  // (F29), optional
     if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
@@ -415,7 +418,10 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
   // A gyro is never noise-free: the detector assumes at least 1e-7 rad/s per sample (a
   // navigation-grade gyro's resolution), so the noise-free cases do not trust rates to the bit.
-  p.fdi.gyro_sigma = std::fmax(std::sqrt(c.gyro_psd / m.sensor_period_s), 1e-7);
+  // That floor was measured with the start sample's noise counted in every sample (2 sigma^2,
+  // fdi README F28): with the centred noise its variance stays what was measured, 2 (1e-7)^2.
+  const double gyro_floor = g.params.fdi.centred_gyro_noise ? 1e-7 * std::sqrt(2.0) : 1e-7;
+  p.fdi.gyro_sigma = std::fmax(std::sqrt(c.gyro_psd / m.sensor_period_s), gyro_floor);
   if (noisy) p.fdi.window_ticks = g.fdi_window_noisy_ticks;
   const gnc::ParamCheck check = gnc::validate(p);
   if (!check.ok) {

@@ -208,7 +208,11 @@ int firmware_main() {
     g_params.fdi.check_min_llr = 5.0;          // (F24) ... when the check can move the evidence
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
     g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
-    g_params.fdi.probe_windows = 2;            // isolation tests of two windows, as flown
+    g_params.fdi.probe_windows = 1;            // isolation tests of one window ...
+    g_params.fdi.probe_aligned = true;         // (F27) ... flown closed throughout, as flown
+    g_params.fdi.probe_partial_rival = true;   // (F29) ... read against partial losses
+    g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
+    g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows
     g_params.fdi.episode_restart = true;       // (F25) the episode since the fault showed, as flown
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the

@@ -136,6 +136,7 @@ void FaultDetector::cancel_evaluation() {
   eval_phase_ = 0;
   partial_loss_pending_ = false;
   have_start_ = false;
+  restart_window_ = false;
 }
 
 void FaultDetector::reset() {
@@ -362,7 +363,10 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
     have_start_ = false;  // a gap breaks the window; the next valid sample starts another
     return pending_;
   }
-  if (!have_start_) {
+  if (!have_start_ || restart_window_) {
+    // (F27) At a pod's closure the window restarts on this sample: every interval of the new
+    // window is flown with the valve as the test set it.
+    restart_window_ = false;
     start_window(in.omega);
     return pending_;
   }
@@ -584,7 +588,8 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   // r_sigma times the jets' force, and k_sigma times their torque.
   const double offset = r_sigma_ * j_inv_.norm() * w.force_impulse;
   const double strength = m_.k_sigma * w.thrust_motion;
-  const double var = 2.0 * p_.gyro_sigma * p_.gyro_sigma + dist * dist + model * model +
+  const double gyro_var = (p_.centred_gyro_noise ? 1.0 : 2.0) * p_.gyro_sigma * p_.gyro_sigma;
+  const double var = gyro_var + dist * dist + model * model +
                      offset * offset + strength * strength + 1e-30;
   eval_var_ = var;
   if (w.check_jet < 0) quiet_var_ = var;  // (F24) the noise of a window without a check
@@ -782,6 +787,7 @@ void FaultDetector::decide() {
   if (probe_left_ > 0 || (verdict_pending_ && eval_open_fraction_ >= 0.5)) {
     // (F16) Every window of the test, and the reopened one that reads it, adds its LLRs.
     for (std::size_t h = 0; h < probe_llr_.size(); ++h) probe_llr_[h] += window_llr_[h];
+    for (std::size_t i = 0; i < probe_energy_.size(); ++i) probe_energy_[i] += window_energy_[i];
   }
   if (probe_left_ > 0) {
     // (F15) A window flown with the tested pod closed throughout.
@@ -865,10 +871,12 @@ void FaultDetector::decide() {
     st_.probe_pod = pod;
     if (pod != probe_llr_pod_) {  // (F16) a test of another pod starts its own sum
       probe_llr_.fill(0.0);
+      probe_energy_.fill(0.0);
       probe_llr_pod_ = pod;
     }
     probe_left_ = p_.probe_windows;
     ++st_.probes;
+    restart_window_ = p_.probe_aligned;  // (F27)
     ambiguous_windows_ = 0;
     end_probe_verdict();
     probe_tested_pod_ = pod;
@@ -943,6 +951,7 @@ bool FaultDetector::sweep_step() {
     sweep_left_ = p_.probe_windows > 0 ? p_.probe_windows : 1;
     sweep_reading_ = false;
     st_.probe_pod = sweep_pod_;
+    restart_window_ = p_.probe_aligned;  // (F27)
     ++st_.probes;
     return false;
   }
@@ -1119,6 +1128,22 @@ int FaultDetector::probe_verdict() const {
     return -1;
   }
   if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  if (p_.probe_partial_rival) {
+    // (F29) A jet that lost part of its thrust leaves that part of its stuck-off signature, which
+    // no hypothesis of the bank explains at full amplitude: over the test's windows its fitted
+    // loss, max over a in (0, 1] of a SR - a^2 E / 2 (F13, SR = LLR_off + E / 2), may explain the
+    // motion as well as the tested pod's stuck-on jet (a jet at half strength read as a stuck-on
+    // jet of another pod on a one-window test).
+    for (int i = 0; i < kThrusters; ++i) {
+      if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+      const auto k = static_cast<std::size_t>(i);
+      const double e = probe_energy_[k];
+      const double sr = probe_llr_[k + static_cast<std::size_t>(kThrusters)] + 0.5 * e;
+      if (!(e > 0.0) || !(sr > 0.0)) continue;
+      const double partial = sr >= e ? sr - 0.5 * e : sr * sr / (2.0 * e);
+      if (best_llr - partial <= p_.margin_llr) return -1;
+    }
+  }
   return best;
 }
 

@@ -64,6 +64,20 @@ struct FaultDetectorParams {
   // this many windows, its pod's valve is closed for probe_windows windows (0: never).
   int probe_after_windows{1};
   int probe_windows{3};
+  // (F27) The pod's closure (a test of F9, or a sweep's of F17) starts a new window, so the test's
+  // first window is flown closed throughout (the decision comes kEvaluationSteps updates into the
+  // window that follows the one it read: without this, that window is flown partly open and a
+  // test needs two windows for one closed throughout). The few samples of the window under way
+  // are dropped.
+  bool probe_aligned{false};
+  // (F28) The gyro's share of a residual sample's variance (F5) is sigma_g^2: the window's start
+  // sample enters every sample of the window alike, as an offset that the mean-centring (F6)
+  // removes. false: 2 sigma_g^2 (the start sample's noise counted in every sample), which halves
+  // every likelihood ratio where the gyro's noise dominates (cases 5-7).
+  bool centred_gyro_noise{false};
+  // (F29) A test's verdict (F15) names its stuck-on jet only when it also leads, over the test's
+  // windows, every jet's partial loss of thrust (F13's fit) by margin_llr.
+  bool probe_partial_rival{false};
   // (F14) Stuck-on isolation inside identification: the identifier's constant fault torque d
   // (estimation README I22) scored against each stuck-on column (I23). Thruster i is confirmed
   // stuck on when, in identified_windows fitted windows in a row, d-hat is at least
@@ -433,6 +447,7 @@ class FaultDetector {
   int probe_tested_pod_{-1};
   int probe_closed_{0};
   bool verdict_pending_{false};
+  bool restart_window_{false};  // (F27) the next sample starts a new window
   double eval_open_fraction_{1.0};           // the evaluated window's open time of the tested pod
   std::array<double, kHypotheses> window_llr_{};  // the evaluated window's LLR per hypothesis
   void end_probe_verdict() {
@@ -447,9 +462,12 @@ class FaultDetector {
   // adding up), and the pod (-1 none). A stuck-on jet of another pod loses ½E in each quiet closed
   // window; one of the tested pod loses nothing there.
   std::array<double, kHypotheses> probe_llr_{};
+  // (F29) ... and each jet's stuck-off energy over the same windows, for its partial loss.
+  std::array<double, kThrusters> probe_energy_{};
   int probe_llr_pod_{-1};
   void reset_probe_llr() {
     probe_llr_.fill(0.0);
+    probe_energy_.fill(0.0);
     probe_llr_pod_ = -1;
   }
   // (F17) Pod sweep on the identifier's fault torque: the pods in test order, the next one

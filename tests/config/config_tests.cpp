@@ -245,6 +245,24 @@ TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.check_min_llr", "must not be negative");
 }
 
+// (F27) aligned isolation tests and (F28) the centred gyro noise: gnc.yaml true, the former
+// behaviour (false) when a key is absent, and a value that is not a boolean names the file and key.
+TEST(ConfigShipped, TheAlignedTestAndTheCentredGyroNoiseAreReadAndOptional) {
+  for (const char* key : {"probe_aligned", "centred_gyro_noise"}) {
+    const std::string line = std::string("  ") + key + ": true";
+    ASSERT_NE(read(kGnc).find(line), std::string::npos) << key;
+    const auto get = [&](const auto& f) {
+      return std::string(key) == "probe_aligned" ? f.probe_aligned : f.centred_gyro_noise;
+    };
+    EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;
+    EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(6)).flight.fdi)) << key;
+    TempFile absent("gnc.yaml", replaced(read(kGnc), line, "  #"));
+    EXPECT_FALSE(get(load_run(kMission, absent.path(), case_file(1)).flight.fdi)) << key;
+    TempFile bad("gnc.yaml", replaced(read(kGnc), line, std::string("  ") + key + ": 3"));
+    expect_error([&] { load_gnc(bad.path()); }, bad.path(), std::string("fdi.") + key, "");
+  }
+}
+
 // (F25) The episode restart: gnc.yaml true, the former episode (false) when the key is absent,
 // and a value that is not a boolean names the file and key.
 TEST(ConfigShipped, TheEpisodeRestartIsReadAndOptional) {

@@ -17,7 +17,7 @@ setsid "$exe" dispersion "$work/d.yaml" --config-dir "$src/configs" --no-plots -
   > "$work/run1.log" 2>&1 &
 pid=$!
 n=0
-for _ in $(seq 600); do
+for _ in $(seq 3000); do  # up to 150 s: a loaded machine writes its first draws late
   n=$(ls "$work/run/draws" 2>/dev/null | grep -c '\.json$' || true)
   [ "$n" -ge 3 ] && break
   sleep 0.05

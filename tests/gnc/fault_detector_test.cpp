@@ -792,6 +792,51 @@ TEST(FaultDetector, TheIsolationTestIsReadOverAllItsWindows) {
                        << run.probe_ends.size() << " tests, not by a test's outcome";
 }
 
+// (F27) A test of one window. The decision that starts a test comes kEvaluationSteps updates into
+// the next window, so without the alignment that window is flown partly open, the test ends in its
+// decision with no window flown closed throughout (F15) and nothing to read. Aligned, the closure
+// starts a window: each test is closed for exactly one window and its evaluation, and the trap's
+// jet is confirmed by a test of its pod.
+TEST(FaultDetector, AnAlignedTestOfOneWindowIsFlownClosedThroughoutAndRead) {
+  FaultDetectorParams unaligned;
+  unaligned.probe_windows = 1;
+  const AmbiguousRun before = fly_ambiguous(unaligned);
+  EXPECT_GE(before.probes, 1u);
+  ASSERT_FALSE(before.probe_ends.empty());
+  for (std::size_t i = 0; i < before.probe_ends.size(); ++i) {
+    EXPECT_NE(before.r.confirmed_at, before.probe_ends[i] + 10 + FaultDetector::kEvaluationSteps)
+        << "an unaligned one-window test has no closed window to read";
+  }
+  EXPECT_NE(before.r.thruster, 11);
+
+  FaultDetectorParams aligned = unaligned;
+  aligned.probe_aligned = true;
+  const AmbiguousRun run = fly_ambiguous(aligned);
+  ASSERT_GE(run.r.confirmed_at, 0) << "not isolated";
+  EXPECT_EQ(run.r.thruster, 2);
+  EXPECT_EQ(run.r.kind, FaultKind::kStuckOn);
+  ASSERT_FALSE(run.probe_ends.empty());
+  // Each test: one window of 10 ticks from its closure, plus the evaluation that ends it.
+  const int per_test = 10 + FaultDetector::kEvaluationSteps;
+  EXPECT_EQ(run.probe_windows_closed, per_test * static_cast<int>(run.probe_ends.size()));
+  bool by_test = false;
+  for (std::size_t i = 0; i < run.probe_ends.size(); ++i) {
+    const int end = run.probe_ends[i];
+    if (run.probe_pods[i] == 0 && run.r.confirmed_at >= end &&
+        run.r.confirmed_at <= end + 10 + FaultDetector::kEvaluationSteps + 1) {
+      by_test = true;
+    }
+  }
+  EXPECT_TRUE(by_test) << "confirmed at tick " << run.r.confirmed_at << " after "
+                       << run.probe_ends.size() << " tests, not by a test's outcome";
+  // The first aligned test is read one window sooner than the first unaligned two-window test.
+  FaultDetectorParams two_windows;
+  two_windows.probe_windows = 2;
+  const AmbiguousRun two = fly_ambiguous(two_windows);
+  ASSERT_FALSE(two.probe_ends.empty());
+  EXPECT_LT(run.probe_ends.front(), two.probe_ends.front());
+}
+
 TEST(FaultDetector, WithoutTheIsolationTestAnAmbiguousPairIsNeverDecided) {
   FaultDetectorParams p;
   p.probe_windows = 0;  // (F8) alone: a later correct decision or none, never the wrong one
@@ -1468,11 +1513,16 @@ TEST(FaultDetector, TheEpisodeStartsWhenTheFaultShowsNotWithAStaleScore) {
 // closes a healthy pod. A stuck-on leader must now beat every jet's partial loss as well.
 struct SteadyRun {
   int rival{-1};
+  int tests{0};  // ticks flown with a pod closed for a test
   FaultEvents first;
   int confirmations{0};
 };
 
-SteadyRun fly_steady_loss(bool episode_restart) {
+// test: 0 no isolation test; 1 aligned one-window tests (F27) whose verdict knows only the bank's
+// hypotheses; 2 the same, the verdict also against every jet's partial loss (F29). With a test, the
+// flight's allocation follows the valve: with the rival's pod closed, jet 0 (which the steady
+// firing balances against the rival) is not commanded either.
+SteadyRun fly_steady_loss(bool episode_restart, int test = 0) {
   Truth t;
   t.gyro_sigma = 1e-7;
   t.degraded = 0;
@@ -1492,7 +1542,9 @@ SteadyRun fly_steady_loss(bool episode_restart) {
     }
   }
   FaultDetectorParams p = bank_params(t.gyro_sigma);
-  p.probe_windows = 0;
+  p.probe_windows = test == 0 ? 0 : 1;
+  p.probe_aligned = test != 0;
+  p.probe_partial_rival = test == 2;
   p.degraded_min_loss = 0.1;  // (F18)
   p.episode_restart = episode_restart;
   FaultDetector d;
@@ -1505,6 +1557,7 @@ SteadyRun fly_steady_loss(bool episode_restart) {
     in.omega = t.gyro();
     in.omega_valid = true;
     in.thrust = prev;
+    in.valve_open = t.valve;
     const FaultEvents e = d.update(in);
     if (e.confirmed && out.confirmations++ == 0) out.first = e;
     Vec16 cmd = 0.05 * random_firing(rng);
@@ -1513,6 +1566,12 @@ SteadyRun fly_steady_loss(bool episode_restart) {
     const int partner = out.rival ^ 1;
     cmd(out.rival) = 0.9 * kUmax;
     cmd(partner) = 0.0;
+    t.valve = {{true, true, true, true}};
+    if (d.probe_pod() >= 0) {
+      t.valve[static_cast<std::size_t>(d.probe_pod())] = false;
+      ++out.tests;
+      if (d.probe_pod() == out.rival / 4) cmd(0) = 0.0;
+    }
     t.advance(cmd);
     prev = cmd;
   }
@@ -1534,6 +1593,27 @@ TEST(FaultDetector, AHalfStrengthJetUnderSteadyFiringIsNotAStuckOnJetOfAnotherPo
   EXPECT_EQ(now.first.thruster, 0);
   EXPECT_EQ(now.first.kind, FaultKind::kDegraded);
   EXPECT_NEAR(now.first.factor, 0.5, 0.05);
+}
+
+// (F29) The same jet at half strength, flown with one-window isolation tests while the allocation
+// follows the valve. The episode's rival (F25) blocks the stuck-on leader, so its pod is tested:
+// with the rival's pod closed, jet 0 (which the rival balanced) is not commanded either. A verdict
+// that knows only the bank's hypotheses names a stuck-on jet of another pod (jet 6 here, as in
+// case 1's closed loop at 10 000 s); against jet 0's partial loss over the same windows it does not.
+TEST(FaultDetector, AnIsolationTestsVerdictBeatsEveryJetsPartialLoss) {
+  const SteadyRun trap = fly_steady_loss(true, 1);
+  ASSERT_GT(trap.tests, 0) << "no isolation test";
+  ASSERT_GE(trap.confirmations, 1) << "the trap: nothing confirmed";
+  EXPECT_NE(trap.first.thruster / 4, 0) << "the trap: a jet of another pod";
+  EXPECT_EQ(trap.first.kind, FaultKind::kStuckOn) << "the trap";
+  const SteadyRun now = fly_steady_loss(true, 2);
+  EXPECT_GT(now.tests, 0);
+  EXPECT_FALSE(now.confirmations > 0 && now.first.kind == FaultKind::kStuckOn)
+      << "thruster " << now.first.thruster << " confirmed stuck on";
+  if (now.confirmations > 0) {
+    EXPECT_EQ(now.first.thruster, 0);
+    EXPECT_EQ(now.first.kind, FaultKind::kDegraded);
+  }
 }
 
 // (F25) The mirror trap of (F8) with the episode restart: never the mirror jet without the
@@ -1567,6 +1647,57 @@ TEST(FaultDetector, HealthyFiringNeverConfirmsAFaultWithTheEpisodeRestart) {
                                  << to_string(r.kind) << " at tick " << r.confirmed_at;
     EXPECT_GT(d.status().windows, 1900u);
   }
+}
+
+// (F28) The window's no-fault statistic under white gyro noise alone (a held vehicle, the truth's
+// model, no floor, no disturbance): chi-square with 3 degrees of freedom, mean 3, when the gyro's
+// share of a sample's variance is sigma_g^2, since the start sample's noise is a common offset
+// that the centring removes; half of that when it is counted twice (2 sigma_g^2).
+double mean_quiet_chi2(bool centred, double* above) {
+  Truth t;
+  t.gyro_sigma = 3.1623e-5;  // case 6
+  t.body.omega = V3(1e-5, -1e-5, 2e-5);
+  FaultDetectorParams p = bank_params(t.gyro_sigma, 25);
+  p.centred_gyro_noise = centred;
+  p.model_rel_floor = 0.0;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  m.j_rel_sigma = 0.0;
+  m.r_cov = Mat3::Zero();
+  m.k_sigma = 0.0;
+  d.set_model(m);
+  double sum = 0.0;
+  int n = 0;
+  int over = 0;
+  std::uint32_t seen = 0;
+  for (int k = 0; k < 25 * 4000 + 10; ++k) {
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = Vec16::Zero();
+    d.update(in);
+    t.advance(Vec16::Zero());
+    if (d.status().windows != seen) {
+      seen = d.status().windows;
+      sum += d.status().chi2;
+      if (d.status().chi2 > 7.815) ++over;  // chi-square(3) at 0.95
+      ++n;
+    }
+  }
+  *above = static_cast<double>(over) / n;
+  return sum / n;
+}
+
+TEST(FaultDetector, TheNoFaultStatisticIsChiSquareThreeUnderWhiteGyroNoise) {
+  double above = 0.0;
+  const double centred = mean_quiet_chi2(true, &above);
+  // 4000 windows: the mean's 1 sigma is sqrt(6 / 4000) = 0.04; the tail's (5 %) 0.0034.
+  EXPECT_NEAR(centred, 3.0, 0.2);
+  EXPECT_NEAR(above, 0.05, 0.015);
+  const double doubled = mean_quiet_chi2(false, &above);
+  EXPECT_NEAR(doubled, 1.5, 0.1);
+  EXPECT_LT(above, 0.01);  // chi-square(3) > 15.6: 0.14 %
 }
 
 }  // namespace
