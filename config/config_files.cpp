@@ -235,6 +235,7 @@ GncConfig load_gnc(const std::string& path) {
     fd.enabled = r.boolean("enabled");
     fd.window_ticks = r.integer("window_ticks");
     g.fdi_window_noisy_ticks = r.integer("window_noisy_ticks");
+    if (r.has("window_snr")) g.fdi_window_snr = r.non_negative("window_snr");  // (F30), optional
     fd.model_rel_floor = r.non_negative("model_rel_floor");
     if (r.has("model_floor_gyroscopic")) {  // (F22), optional (the floor on both terms when absent)
       fd.model_floor_gyroscopic = r.boolean("model_floor_gyroscopic");
@@ -422,7 +423,13 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   // fdi README F28): with the centred noise its variance stays what was measured, 2 (1e-7)^2.
   const double gyro_floor = g.params.fdi.centred_gyro_noise ? 1e-7 * std::sqrt(2.0) : 1e-7;
   p.fdi.gyro_sigma = std::fmax(std::sqrt(c.gyro_psd / m.sensor_period_s), gyro_floor);
-  if (noisy) p.fdi.window_ticks = g.fdi_window_noisy_ticks;
+  if (noisy) {
+    p.fdi.window_ticks = g.fdi_window_snr > 0.0
+                             ? fdi_window_for_noise(p, std::sqrt(c.gyro_psd / m.sensor_period_s),
+                                                    g.fdi_window_snr, g.params.fdi.window_ticks,
+                                                    g.fdi_window_noisy_ticks)
+                             : g.fdi_window_noisy_ticks;
+  }
   const gnc::ParamCheck check = gnc::validate(p);
   if (!check.ok) {
     const std::string field = check.field;
@@ -430,6 +437,23 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
     throw ConfigError(model ? m.file + " + " + c.file : g.file, field, check.reason);
   }
   return p;
+}
+
+int fdi_window_for_noise(const gnc::GncParams& p, double gyro_sigma, double snr, int min_ticks,
+                         int max_ticks) {
+  if (!(gyro_sigma > 0.0) || max_ticks <= min_ticks) return min_ticks;
+  const gnc::Mat3 j_inv = gnc::total_inertia(p.mass_hat).inverse();
+  const gnc::Mat38 b = gnc::torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
+  double a_min = 1e300;
+  for (int c = 0; c < gnc::kChannels; ++c) {
+    a_min = std::fmin(a_min, (j_inv * b.col(c)).norm() * p.rcs.u_max);
+  }
+  const double sigma = (p.fdi.centred_gyro_noise ? 1.0 : std::sqrt(2.0)) * gyro_sigma;
+  for (int n = min_ticks; n < max_ticks; ++n) {
+    const double nn = static_cast<double>(n);
+    if (a_min * p.dt * std::sqrt(nn * (nn * nn - 1.0) / 12.0) / sigma >= snr) return n;
+  }
+  return max_ticks;
 }
 
 gnc::GncParams load_flight_params(const std::string& mission_path, const std::string& gnc_path,

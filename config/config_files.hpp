@@ -51,6 +51,10 @@ struct GncConfig {
   // Fault-detector residual window when the case's sensors are noisy (params.fdi.window_ticks is
   // the quiet-sensor one).
   int fdi_window_noisy_ticks{25};
+  // (F30) With noisy sensors the detector's window is the shortest of window_ticks ..
+  // window_noisy_ticks in which the weakest jet's stuck-on signature stands this many sigma of the
+  // case's gyro noise above it (0: window_noisy_ticks whenever the sensors are noisy).
+  double fdi_window_snr{0.0};
 };
 
 struct CaseConfig {
@@ -77,6 +81,14 @@ CaseConfig load_case(const std::string& path);
 // The flight software's parameters, Eq. (6): the estimates (true minus the case's errors), the
 // mission's RCS layout at the case's u_max, the gains of gnc.yaml, the estimator choice; validated.
 gnc::GncParams flight_params(const MissionConfig& mission, const GncConfig& gnc, const CaseConfig& c);
+// (F30) The detector's window for a gyro of per-sample noise gyro_sigma: the shortest n in
+// [min_ticks, max_ticks] whose least-squares slope of the weakest jet's stuck-on ramp (the smallest
+// |J^-1 B_c| u_max of the table's model) stands snr sigma above the gyro's noise:
+// a dt sqrt(n (n^2 - 1) / 12) / (c sigma) >= snr, c = 1 with the centred noise (F28), sqrt(2)
+// without. max_ticks when none does; min_ticks for a noise-free gyro.
+int fdi_window_for_noise(const gnc::GncParams& p, double gyro_sigma, double snr, int min_ticks,
+                         int max_ticks);
+
 gnc::GncParams load_flight_params(const std::string& mission_path, const std::string& gnc_path,
                                   const std::string& case_path);
 

@@ -234,32 +234,101 @@ TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
 
 // (F24) The jet checks' information gate: gnc.yaml's value, off (0) when the key is absent, and a
 // negative value names the file and key.
-TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
-  const std::string line = "  check_min_llr: 5.0";
-  ASSERT_NE(read(kGnc).find(line), std::string::npos);
-  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.check_min_llr, 5.0);
-  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.check_min_llr, 5.0);
-  TempFile absent("gnc.yaml", replaced(read(kGnc), line, ""));
-  EXPECT_EQ(load_run(kMission, absent.path(), case_file(1)).flight.fdi.check_min_llr, 0.0);
-  TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  check_min_llr: -1.0"));
-  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi.check_min_llr", "must not be negative");
+// An optional fdi key shipped in gnc.yaml as `line`: `absent` checks a run whose gnc.yaml lacks the
+// line, and `bad_line` in its place is refused, naming the file, fdi.<key> and the reason.
+template <class Absent>
+void expect_optional_fdi_key(const std::string& line, const std::string& key,
+                             const std::string& bad_line, const std::string& reason,
+                             Absent absent) {
+  ASSERT_NE(read(kGnc).find(line), std::string::npos) << key;
+  TempFile without("gnc.yaml", replaced(read(kGnc), line, "  #"));
+  absent(without.path());
+  TempFile bad("gnc.yaml", replaced(read(kGnc), line, bad_line));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi." + key, reason);
 }
 
-// (F27) aligned isolation tests and (F28) the centred gyro noise: gnc.yaml true, the former
-// behaviour (false) when a key is absent, and a value that is not a boolean names the file and key.
-TEST(ConfigShipped, TheAlignedTestAndTheCentredGyroNoiseAreReadAndOptional) {
-  for (const char* key : {"probe_aligned", "centred_gyro_noise"}) {
+TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.check_min_llr, 5.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.check_min_llr, 5.0);
+  expect_optional_fdi_key("  check_min_llr: 5.0", "check_min_llr", "  check_min_llr: -1.0",
+                          "must not be negative", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.check_min_llr,
+                                      0.0);
+                          });
+}
+
+// (F30) The window sized by the case's gyro noise, against a brute-force count: for each case, the
+// weakest jet's acceleration from the table's model, column by column, and the slope statistic's
+// sum of squared sample times written out; the window is the first n from window_ticks whose
+// stuck-on ramp stands window_snr sigma above the gyro. gnc.yaml's value, and the former switch
+// when the key is absent.
+TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
+  const std::string line = "  window_snr: 5.0";
+  ASSERT_NE(read(kGnc).find(line), std::string::npos);
+  const double snr = 5.0;
+  for (int c = 1; c <= 7; ++c) {
+    const auto run = load_run(kMission, kGnc, case_file(c));
+    const CaseConfig cs = load_case(case_file(c));
+    const gnc::GncParams& p = run.flight;
+    const double sigma = std::sqrt(cs.gyro_psd / 0.1);
+    int expect = 10;  // gnc.yaml's window_ticks (quiet sensors)
+    if (cs.gyro_psd > 0.0 || cs.star_psd > 0.0) {
+      const gnc::Mat3 j = gnc::total_inertia(p.mass_hat);
+      double a_min = 1e300;
+      for (int ch = 0; ch < gnc::kChannels; ++ch) {
+        const auto k = static_cast<std::size_t>(ch);
+        const gnc::Vec3 arm = p.mass_hat.r_so_bcm +
+                              p.rcs.pod_position[static_cast<std::size_t>(p.rcs.channel_pod[k])];
+        const gnc::Vec3 b = arm.cross(p.rcs.channel_direction[k]);
+        a_min = std::fmin(a_min, j.ldlt().solve(b).norm() * p.rcs.u_max);
+      }
+      expect = 25;  // window_noisy_ticks
+      for (int n = 10; n < 25; ++n) {
+        double mean = 0.0;
+        for (int t = 1; t <= n; ++t) mean += t;
+        mean /= n;
+        double stt = 0.0;
+        for (int t = 1; t <= n; ++t) stt += (t - mean) * (t - mean);
+        if (sigma > 0.0 && a_min * 0.1 * std::sqrt(stt) / sigma >= snr) {
+          expect = n;
+          break;
+        }
+        if (!(sigma > 0.0)) {
+          expect = 10;
+          break;
+        }
+      }
+    }
+    EXPECT_EQ(p.fdi.window_ticks, expect) << "case " << c;
+  }
+  // The study's noisy cases: case 5's gyro (3.2e-6 rad/s a sample) flies the quiet window, cases
+  // 6-7 (3.2e-5) a long one.
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(5)).flight.fdi.window_ticks, 10);
+  EXPECT_GE(load_run(kMission, kGnc, case_file(6)).flight.fdi.window_ticks, 20);
+  expect_optional_fdi_key(line, "window_snr", "  window_snr: -1", "", [](const std::string& gnc) {
+    EXPECT_EQ(load_run(kMission, gnc, case_file(5)).flight.fdi.window_ticks, 25);
+  });
+}
+
+// (F27) aligned isolation tests, (F28) the centred gyro noise and (F29) the test's partial-loss
+// rival: gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is not
+// a boolean names the file and key.
+TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
+  for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival"}) {
     const std::string line = std::string("  ") + key + ": true";
-    ASSERT_NE(read(kGnc).find(line), std::string::npos) << key;
     const auto get = [&](const auto& f) {
-      return std::string(key) == "probe_aligned" ? f.probe_aligned : f.centred_gyro_noise;
+      const std::string k = key;
+      return k == "probe_aligned" ? f.probe_aligned
+                                  : k == "centred_gyro_noise" ? f.centred_gyro_noise
+                                                              : f.probe_partial_rival;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(6)).flight.fdi)) << key;
-    TempFile absent("gnc.yaml", replaced(read(kGnc), line, "  #"));
-    EXPECT_FALSE(get(load_run(kMission, absent.path(), case_file(1)).flight.fdi)) << key;
-    TempFile bad("gnc.yaml", replaced(read(kGnc), line, std::string("  ") + key + ": 3"));
-    expect_error([&] { load_gnc(bad.path()); }, bad.path(), std::string("fdi.") + key, "");
+    expect_optional_fdi_key(line, key, std::string("  ") + key + ": 3", "",
+                            [&](const std::string& gnc) {
+                              EXPECT_FALSE(get(load_run(kMission, gnc, case_file(1)).flight.fdi))
+                                  << key;
+                            });
   }
 }
 
