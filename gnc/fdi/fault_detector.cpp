@@ -8,6 +8,18 @@
 #include <Eigen/LU>
 
 namespace rocksteady::gnc {
+namespace {
+
+// (F13) The LLR of "a jet lost a fraction a of its thrust", a in (0, 1] fitted, from its stuck-off
+// LLR and energy E = sum |S~|^2 / var over some windows: with SR = LLR + E / 2, the maximum over a
+// of a SR - a^2 E / 2 is SR^2 / (2 E) for SR < E, and the stuck-off LLR (a = 1) beyond.
+double fitted_loss_llr(double llr_off, double e) {
+  const double sr = llr_off + 0.5 * e;
+  if (!(sr > 0.0) || !(e > 0.0)) return 0.0;
+  return sr >= e ? llr_off : sr * sr / (2.0 * e);
+}
+
+}  // namespace
 
 Check validate(const FaultDetectorParams& p) {
   auto bad = [](const char* field, const char* reason) { return Check{false, field, reason}; };
@@ -1131,16 +1143,13 @@ int FaultDetector::probe_verdict() const {
   if (p_.probe_partial_rival) {
     // (F29) A jet that lost part of its thrust leaves that part of its stuck-off signature, which
     // no hypothesis of the bank explains at full amplitude: over the test's windows its fitted
-    // loss, max over a in (0, 1] of a SR - a^2 E / 2 (F13, SR = LLR_off + E / 2), may explain the
-    // motion as well as the tested pod's stuck-on jet (a jet at half strength read as a stuck-on
-    // jet of another pod on a one-window test).
+    // loss (F13) may explain the motion as well as the tested pod's stuck-on jet (a jet at half
+    // strength read as a stuck-on jet of another pod on a one-window test).
     for (int i = 0; i < kThrusters; ++i) {
       if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
       const auto k = static_cast<std::size_t>(i);
-      const double e = probe_energy_[k];
-      const double sr = probe_llr_[k + static_cast<std::size_t>(kThrusters)] + 0.5 * e;
-      if (!(e > 0.0) || !(sr > 0.0)) continue;
-      const double partial = sr >= e ? sr - 0.5 * e : sr * sr / (2.0 * e);
+      const double partial =
+          fitted_loss_llr(probe_llr_[k + static_cast<std::size_t>(kThrusters)], probe_energy_[k]);
       if (best_llr - partial <= p_.margin_llr) return -1;
     }
   }
@@ -1195,11 +1204,7 @@ double FaultDetector::partial_loss_llr(int g) const {
   // (F13) The episode's LLR of "thruster g lost a fraction a of its thrust", a in (0, 1] fitted:
   // with SR = sum S~.r~ / var = Lambda + E / 2 and E = sum |S~|^2 / var = |b|^2 A, the maximum
   // over a of a SR - a^2 E / 2 is SR^2 / (2 E) for SR < E, and Lambda (a = 1) beyond.
-  const auto k = static_cast<std::size_t>(g);
-  const double e = partial_loss_energy(g);
-  const double sr = lambda(k) + 0.5 * e;
-  if (sr <= 0.0 || e <= 0.0) return 0.0;
-  return sr >= e ? lambda(k) : sr * sr / (2.0 * e);
+  return fitted_loss_llr(lambda(static_cast<std::size_t>(g)), partial_loss_energy(g));
 }
 
 int FaultDetector::partial_loss_alternative(int h) const {

@@ -753,6 +753,18 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
   return out;
 }
 
+// Confirmed by a test of pod 0: in the 10-tick window that reopens it or its evaluation.
+bool confirmed_by_a_test_of_pod_0(const AmbiguousRun& run) {
+  for (std::size_t i = 0; i < run.probe_ends.size(); ++i) {
+    const int end = run.probe_ends[i];
+    if (run.probe_pods[i] == 0 && run.r.confirmed_at >= end &&
+        run.r.confirmed_at <= end + 10 + FaultDetector::kEvaluationSteps + 1) {
+      return true;
+    }
+  }
+  return false;
+}
+
 TEST(FaultDetector, OppositePodAxialJetsAreNotConfusedWhenOnlyTheModelErrorSeparatesThem) {
   FaultDetectorParams former;
   former.model_sigmas = 0.0;
@@ -779,17 +791,9 @@ TEST(FaultDetector, TheIsolationTestIsReadOverAllItsWindows) {
   ASSERT_GE(run.r.confirmed_at, 0) << "not isolated";
   EXPECT_EQ(run.r.thruster, 2);
   EXPECT_EQ(run.r.kind, FaultKind::kStuckOn);
-  // Confirmed by a test of pod 0: in the window that reopens it (10 ticks) or its evaluation (4).
-  bool by_test = false;
-  for (std::size_t i = 0; i < run.probe_ends.size(); ++i) {
-    const int end = run.probe_ends[i];
-    if (run.probe_pods[i] == 0 && run.r.confirmed_at >= end &&
-        run.r.confirmed_at <= end + 10 + FaultDetector::kEvaluationSteps + 1) {
-      by_test = true;
-    }
-  }
-  EXPECT_TRUE(by_test) << "confirmed at tick " << run.r.confirmed_at << " after "
-                       << run.probe_ends.size() << " tests, not by a test's outcome";
+  EXPECT_TRUE(confirmed_by_a_test_of_pod_0(run))
+      << "confirmed at tick " << run.r.confirmed_at << " after " << run.probe_ends.size()
+      << " tests, not by a test's outcome";
 }
 
 // (F27) A test of one window. The decision that starts a test comes kEvaluationSteps updates into
@@ -819,16 +823,9 @@ TEST(FaultDetector, AnAlignedTestOfOneWindowIsFlownClosedThroughoutAndRead) {
   // Each test: one window of 10 ticks from its closure, plus the evaluation that ends it.
   const int per_test = 10 + FaultDetector::kEvaluationSteps;
   EXPECT_EQ(run.probe_windows_closed, per_test * static_cast<int>(run.probe_ends.size()));
-  bool by_test = false;
-  for (std::size_t i = 0; i < run.probe_ends.size(); ++i) {
-    const int end = run.probe_ends[i];
-    if (run.probe_pods[i] == 0 && run.r.confirmed_at >= end &&
-        run.r.confirmed_at <= end + 10 + FaultDetector::kEvaluationSteps + 1) {
-      by_test = true;
-    }
-  }
-  EXPECT_TRUE(by_test) << "confirmed at tick " << run.r.confirmed_at << " after "
-                       << run.probe_ends.size() << " tests, not by a test's outcome";
+  EXPECT_TRUE(confirmed_by_a_test_of_pod_0(run))
+      << "confirmed at tick " << run.r.confirmed_at << " after " << run.probe_ends.size()
+      << " tests, not by a test's outcome";
   // The first aligned test is read one window sooner than the first unaligned two-window test.
   FaultDetectorParams two_windows;
   two_windows.probe_windows = 2;
