@@ -33,6 +33,7 @@ const char* to_string(ReferencePhase p) {
     case ReferencePhase::kHold: return "hold";
     case ReferencePhase::kTrack: return "track";
     case ReferencePhase::kTrackAugmented: return "track_augmented";
+    case ReferencePhase::kTrackSlew: return "track_slew";
   }
   return "?";
 }

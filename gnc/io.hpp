@@ -36,6 +36,7 @@ enum class ReferencePhase : std::uint8_t {
   kHold = 2,            // Eq. (51) phase 2 / hold: q_d = q_final, qdot_d = 0
   kTrack = 3,           // Eq. (45): follow omega_d(t)
   kTrackAugmented = 4,  // Eqs. (46)-(48): omega_d plus convergence to q_final
+  kTrackSlew = 5,       // after the plan: the acquisition slew to q_final (guidance.slew_s > 0)
 };
 const char* to_string(ReferencePhase p);
 

@@ -200,6 +200,8 @@ ParamCheck validate(const GncParams& p) {
   if (!std::isfinite(g.track_reset_period_s) || g.track_reset_period_s < 0.0) {
     return bad("guidance.track_reset_period", "must be >= 0");
   }
+  if (!std::isfinite(g.slew_s) || g.slew_s < 0.0) return bad("guidance.slew", "must be >= 0");
+  if (!finite_positive(g.slew_ramp_s)) return bad("guidance.slew_ramp", "must be positive");
 
   const EstimatorParams& e = p.estimator;
   if (static_cast<int>(e.kind) >= kEstimatorKindCount) {

@@ -16,6 +16,14 @@ struct GuidanceParams {
   // [Rocksteady choice] period of the TRACK reference reset from the current estimate; 0: only at
   // activation.
   double track_reset_period_s{0.0};
+  // [Rocksteady choice] acquisition slew. 0: the study's Eqs. (46)-(48). > 0: once the plan is over and |omega_hat| <= omega_switch, the TRACK reference
+  // turns from where it is to q_final about the eigenaxis, rest to rest, in slew_s seconds: a
+  // trapezoidal rate with ramps of slew_ramp_s (at most slew_s / 2). Eq. (47)'s exponential starts
+  // at its highest rate, 4 k_qd |q_d - q_final| / (1 + |.|^2), and a rest-to-rest turn costs about
+  // 2 J omega_peak of torque impulse, so the coast at the slowest rate that still arrives in
+  // slew_s costs the least. No augmentation (46)-(48) while the plan runs.
+  double slew_s{0.0};
+  double slew_ramp_s{1000.0};
   double eps_trans{0.5 * 2.0 * 3.14159265358979323846 / 60.0};  // 0.5 rpm in rad/s (SPEC §5)
 };
 
@@ -42,9 +50,18 @@ class References {
 
   double plan_time(double t) const { return t - t0_; }
   bool augmented() const { return augmented_; }
+  bool slewing() const { return slewing_; }
+  // The acquisition slew's eigenaxis (the reference frame at the slew's start), angle (rad) and
+  // coast rate (rad/s); zero before a slew starts.
+  const Vec3& slew_axis() const { return slew_axis_; }
+  double slew_angle() const { return slew_angle_; }
+  double slew_rate() const { return slew_rate_; }
 
  private:
   Vec3 track_rate(const TrajectoryTable& traj, double t, const Vec3& q_d) const;
+  bool plan_over(const TrajectoryTable& traj, double t) const;
+  void start_slew(double t);
+  mrp::WithRates slew_reference(double t) const;
 
   GuidanceParams g_{};
   double dt_{0.1};
@@ -55,6 +72,15 @@ class References {
   double t_prev_{0.0};
   double t_last_reset_{0.0};
   bool augmented_{false};
+  // Acquisition slew state (slew_s > 0)
+  bool slewing_{false};
+  double slew_t0_{0.0};
+  double slew_duration_{0.0};
+  double slew_ramp_{0.0};
+  Vec3 slew_q0_{Vec3::Zero()};
+  Vec3 slew_axis_{Vec3::Zero()};
+  double slew_angle_{0.0};
+  double slew_rate_{0.0};
 };
 
 }  // namespace rocksteady::gnc

@@ -212,6 +212,10 @@ int main(int argc, char** argv) {
                     "planning once every observable offset direction is within it; 0: the "
                     "flight's identification.offset_confident_m)")
         ->capture_default_str();
+    sub->add_option("--replan-slew", spec.replan.slew_s,
+                    "replan strategies: after the last plan, the flight turns to q_final rest to "
+                    "rest in this time, s (guidance.slew_s; 0: the flight's own setting)")
+        ->capture_default_str();
     sub->add_option("--replan-adopt-settle", spec.replan.adopt_settle_tau,
                     "replan strategies: after the flight adopts a model, no plan for this many "
                     "time constants of its rate stage (the rate estimate relaxes to the new "

@@ -63,6 +63,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     if (options.replan.offset_confident_m > 0.0) {
       fs.params.identification.config.r_confident = options.replan.offset_confident_m;
     }
+    if (options.replan.slew_s > 0.0) fs.params.guidance.slew_s = options.replan.slew_s;
   }
   fs.start_mode = strategy.needs_trajectory() ? gnc::Mode::kTrack : gnc::Mode::kDetumble;
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;

@@ -390,6 +390,7 @@ DispersionSpec load_spec(const std::string& path) {
     if (r.has("offset_confident_m")) {
       s.replan.offset_confident_m = r.non_negative("offset_confident_m");
     }
+    if (r.has("slew_s")) s.replan.slew_s = r.non_negative("slew_s");
     if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
       r.fail("first_plan_max_s", "must not be below first_plan_s");
     }

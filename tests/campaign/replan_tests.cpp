@@ -194,6 +194,38 @@ TEST(ReplanStrategy, AWiderOffsetBoundAdoptsAndPlansForTheIdentifiedModelInCase7
   EXPECT_LT(first.t_state_s - at_adoption.replan.events.front().t_state_s, settle + 0.2);
 }
 
+// The replan strategies' acquisition slew (ReplanOptions::slew_s -> the flight's guidance.slew_s):
+// once the despin is over the flight turns to q_final at the slew's coast, below the SPEC §7 rate
+// goal (10^-4 rad/s) for the whole turn, where Eqs. (46)-(48) (slew_s 0: gnc.yaml's own) start at
+// their highest rate, above the goal in case 1.
+TEST(ReplanStrategy, TheAcquisitionSlewTurnsBelowTheRateGoalWhereTheExponentialDoesNot) {
+  ASSERT_TRUE(have_planner());
+  const config::RunSetup s = case1();
+  ASSERT_EQ(s.flight.guidance.slew_s, 0.0);  // gnc.yaml: the study's (46)-(48)
+  const auto peak_after_despin = [&](double slew_s) {
+    FswFlightSide flight;
+    RunOptions opt;
+    opt.duration_s = 5000.0;
+    opt.log_interval_s = 10.0;
+    opt.replan.slew_s = slew_s;
+    const RunResult r = run_closed_loop(s, *parse_strategy("ntcl+replan"), flight, nullptr, opt);
+    EXPECT_EQ(r.status, RunStatus::kOk) << r.note;
+    EXPECT_FALSE(r.replan.events.empty());
+    if (r.replan.events.empty()) return 0.0;
+    const ReplanEvent& last = r.replan.events.back();
+    const double plan_end = last.t_delivered_s + last.t_final_s;  // the last plan flown
+    EXPECT_LT(plan_end, 4000.0);
+    double peak = 0.0;
+    for (const TimeRow& row : r.series) {
+      if (row.t > plan_end) peak = std::fmax(peak, row.omega.norm());
+    }
+    return peak;
+  };
+  ASSERT_EQ(ReplanOptions{}.slew_s, 40000.0);
+  EXPECT_LT(peak_after_despin(ReplanOptions{}.slew_s), 1e-4);
+  EXPECT_GT(peak_after_despin(0.0), 1e-4);
+}
+
 // The bare flight core has no uplink: the replan strategy says so instead of flying half a plan.
 TEST(ReplanStrategy, CoreOnlyFlightSideRefusesTheUplinkAndTheRunSaysWhy) {
   ASSERT_TRUE(have_planner());

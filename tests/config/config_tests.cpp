@@ -151,6 +151,28 @@ TEST(ConfigShipped, AllocatorKeyIsOptionalAndSelectsTheL1Allocator) {
   EXPECT_EQ(load_gnc(absent.path()).params.allocator, gnc::AllocatorKind::kPseudoInverse);
 }
 
+// The acquisition slew (guidance.slew_s, slew_ramp_s): off (Eqs. 46-48) in the shipped file, the
+// defaults when the keys are absent, and a bad value names the file and key.
+TEST(ConfigShipped, TheAcquisitionSlewIsOptionalAndChecked) {
+  const gnc::GncParams defaults;
+  const std::string slew = read(kGnc).substr(read(kGnc).find("  slew_s: 0.0"));
+  const std::string slew_line = slew.substr(0, slew.find('\n'));
+  const std::string ramp = read(kGnc).substr(read(kGnc).find("  slew_ramp_s: 1000.0"));
+  const std::string ramp_line = ramp.substr(0, ramp.find('\n'));
+  EXPECT_EQ(load_gnc(kGnc).params.guidance.slew_s, 0.0);
+  EXPECT_EQ(load_gnc(kGnc).params.guidance.slew_ramp_s, 1000.0);
+  TempFile absent("gnc.yaml", replaced(replaced(read(kGnc), slew_line, ""), ramp_line, ""));
+  EXPECT_EQ(load_gnc(absent.path()).params.guidance.slew_s, defaults.guidance.slew_s);
+  EXPECT_EQ(load_gnc(absent.path()).params.guidance.slew_ramp_s, defaults.guidance.slew_ramp_s);
+  TempFile set("gnc.yaml", replaced(read(kGnc), slew_line, "  slew_s: 40000"));
+  EXPECT_EQ(load_gnc(set.path()).params.guidance.slew_s, 40000.0);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), slew_line, "  slew_s: -1"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "guidance.slew_s", "must not be negative");
+  TempFile bad_ramp("gnc.yaml", replaced(read(kGnc), ramp_line, "  slew_ramp_s: 0"));
+  expect_error([&] { load_gnc(bad_ramp.path()); }, bad_ramp.path(), "guidance.slew_ramp_s",
+               "must be positive");
+}
+
 // The MEKF's rate stage (gnc/estimation/README.md (M8)): on at the SPEC §6 cutoff in the shipped
 // file, off (the raw gyro less the bias) when the key is absent, and a negative value is an error.
 TEST(ConfigShipped, MekfRateCutoffIsOptionalAndChecked) {

@@ -34,7 +34,7 @@ TEST(DispersionFiles, ReplanStrategyAndItsPolicyLoad) {
                    "sampling: random",
                    "sampling: random\nreplan: {latency_s: 25, period_s: 0, min_horizon_s: 1400, "
                    "adopt_sigmas: 4, adopt_wait_s: 30, adopt_settle_tau: 2, "
-                   "offset_confident_m: 0.25}");
+                   "offset_confident_m: 0.25, slew_s: 30000}");
   const DispersionSpec s = load_spec(test::write_temp("replan.yaml", text));
   ASSERT_EQ(s.strategies.size(), 2u);
   EXPECT_TRUE(s.strategies[1].replans());
@@ -46,6 +46,7 @@ TEST(DispersionFiles, ReplanStrategyAndItsPolicyLoad) {
   EXPECT_EQ(s.replan.adopt_wait_s, 30.0);
   EXPECT_EQ(s.replan.adopt_settle_tau, 2.0);
   EXPECT_EQ(s.replan.offset_confident_m, 0.25);
+  EXPECT_EQ(s.replan.slew_s, 30000.0);
   EXPECT_EQ(s.replan.first_plan_s, campaign::ReplanOptions{}.first_plan_s);  // default kept
 }
 

@@ -260,6 +260,37 @@ TEST(ZeroAllocation, NoHeapWhenATrajectoryIsStagedAndSwitchedAtATickBoundary) {
   delete loop;
 }
 
+// The acquisition slew after the plan (guidance.slew_s): its start (the rotation to q_final) and
+// every tick of it, under the counter.
+TEST(ZeroAllocation, NoHeapInTheAcquisitionSlew) {
+  GncParams p = test::small_vehicle_params();
+  p.guidance.q_final = Vec3(0.1, -0.1, 0.05);
+  p.guidance.slew_s = 60.0;
+  p.guidance.slew_ramp_s = 5.0;
+  auto* loop = new test::SmallLoop(p);
+  loop->body.omega = Vec3(0.06, -0.04, 0.05);
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  auto* tab = new TrajectoryTable();
+  test::linear_despin_table(loop->body.omega, 30.0, *tab);
+  ASSERT_EQ(loop->gnc.load_trajectory(*tab), TrajectoryError::kOk);
+  int slew_ticks = 0;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kTrack;
+    loop->tick(c);
+    for (int i = 0; i < 2400; ++i) {  // 120 s: the plan, the slew and rest
+      loop->tick();
+      slew_ticks += loop->out.telemetry.phase == ReferencePhase::kTrackSlew ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(rocksteady::test::heap_allocations(), 0);
+  EXPECT_GT(slew_ticks, 1200);
+  delete tab;
+  delete loop;
+}
+
 // gnc/fdi/README.md (F14), estimation README (I22)-(I23): the identifier's fault torque state,
 // its per-window scoring of the 16 stuck-on columns and the detector's confirmation from it, with
 // channel 1's "+" jet stuck on from the first tick: no heap in any tick.
