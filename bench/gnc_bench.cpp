@@ -58,6 +58,49 @@ BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_hold, LawId::kNtcl, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, so3_hold, LawId::kSo3, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
 
+// TRACK after the plan with the acquisition slew (guidance.slew_s, the replan strategies): the
+// eigenaxis turn's closed-form reference every tick (SPEC §6 filter, NTCL, pseudoinverse).
+void BM_GncTickSlew(benchmark::State& state) {
+  GncParams p = study_gnc_params(200.0);
+  p.law = LawId::kNtcl;
+  p.estimator.kind = EstimatorKind::kFilter;
+  p.mode.auto_hold = false;
+  p.guidance.slew_s = 40000.0;
+  Gnc gnc;
+  if (!gnc.init(p).ok) {
+    state.SkipWithError("parameters rejected");
+    return;
+  }
+  std::vector<TrajectoryTable> table(1);  // a plan already at rest: the slew starts at once
+  table[0].count = 2;
+  table[0].samples[1].t = 10.0;
+  table[0].checksum = trajectory_checksum(table[0]);
+  if (gnc.load_trajectory(table[0]) != TrajectoryError::kOk) {
+    state.SkipWithError("trajectory refused");
+    return;
+  }
+  const auto at_rest = [](double t) {
+    SensorSample s = study_sample(t);
+    s.gyro_rate = Vec3::Zero();
+    return s;
+  };
+  GncOutput out;
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kTrack;
+  double t = 0.0;
+  gnc.step(at_rest(t), c, out);
+  c = GncCommands{};
+  for (int i = 0; i < 200; ++i) gnc.step(at_rest(t += p.dt), c, out);  // past the plan's end
+  for (auto _ : state) {
+    t += p.dt;
+    gnc.step(at_rest(t), c, out);
+    benchmark::DoNotOptimize(out);
+  }
+  state.SetLabel(to_string(out.telemetry.phase));
+}
+BENCHMARK(BM_GncTickSlew);
+
 // Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (gnc.yaml's
 // flight settings for this gyro: 60 s windows, the second-order term, the gate, the gyro bias;
 // study priors, automatic adoption), fault detection, L1 allocation under limits, NTCL in DETUMBLE. The rate
