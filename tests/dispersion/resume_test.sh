@@ -22,7 +22,7 @@ for _ in $(seq 3000); do  # up to 150 s: a loaded machine writes its first draws
   [ "$n" -ge 3 ] && break
   sleep 0.05
 done
-kill -9 -- "-$pid" 2>/dev/null || kill -9 "$pid"
+kill -9 "-$pid" 2>/dev/null || kill -9 "$pid"  # dash's kill takes no "--"
 wait "$pid" 2>/dev/null || true
 sleep 0.2
 done_before=$(ls "$work/run/draws" | grep -c '\.json$' || true)
