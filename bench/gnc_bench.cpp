@@ -27,23 +27,30 @@ SensorSample study_sample(double t) {
   return s;
 }
 
+// Initialise the flight core (or mark the benchmark failed) and fly its first tick in `mode`.
+bool start(benchmark::State& state, Gnc& gnc, const GncParams& p, Mode mode,
+           const SensorSample& first, GncOutput& out) {
+  if (!gnc.init(p).ok) {
+    state.SkipWithError("parameters rejected");
+    return false;
+  }
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = mode;
+  gnc.step(first, c, out);
+  return true;
+}
+
 void BM_GncTick(benchmark::State& state, LawId law, Mode mode) {
   GncParams p = study_gnc_params(200.0);
   p.law = law;
   p.estimator.kind = EstimatorKind::kFilter;
   p.mode.auto_hold = false;
   Gnc gnc;
-  if (!gnc.init(p).ok) {
-    state.SkipWithError("parameters rejected");
-    return;
-  }
   GncOutput out;
-  GncCommands c;
-  c.has_mode_request = true;
-  c.mode_request = mode;
   double t = 0.0;
-  gnc.step(study_sample(t), c, out);
-  c = GncCommands{};
+  if (!start(state, gnc, p, mode, study_sample(t), out)) return;
+  const GncCommands c;
   for (auto _ : state) {
     t += p.dt;
     gnc.step(study_sample(t), c, out);
@@ -67,29 +74,26 @@ void BM_GncTickSlew(benchmark::State& state) {
   p.mode.auto_hold = false;
   p.guidance.slew_s = 40000.0;
   Gnc gnc;
-  if (!gnc.init(p).ok) {
-    state.SkipWithError("parameters rejected");
-    return;
-  }
   std::vector<TrajectoryTable> table(1);  // a plan already at rest: the slew starts at once
   table[0].count = 2;
   table[0].samples[1].t = 10.0;
   table[0].checksum = trajectory_checksum(table[0]);
-  if (gnc.load_trajectory(table[0]) != TrajectoryError::kOk) {
-    state.SkipWithError("trajectory refused");
-    return;
-  }
   const auto at_rest = [](double t) {
     SensorSample s = study_sample(t);
     s.gyro_rate = Vec3::Zero();
     return s;
   };
   GncOutput out;
+  double t = 0.0;
+  if (!start(state, gnc, p, Mode::kIdle, at_rest(t), out)) return;
+  if (gnc.load_trajectory(table[0]) != TrajectoryError::kOk) {
+    state.SkipWithError("trajectory refused");
+    return;
+  }
   GncCommands c;
   c.has_mode_request = true;
   c.mode_request = Mode::kTrack;
-  double t = 0.0;
-  gnc.step(at_rest(t), c, out);
+  gnc.step(at_rest(t += p.dt), c, out);
   c = GncCommands{};
   for (int i = 0; i < 200; ++i) gnc.step(at_rest(t += p.dt), c, out);  // past the plan's end
   for (auto _ : state) {
@@ -135,17 +139,10 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.episode_restart = true;               // (F25) the episode since the fault showed, as flown
   p.mode.auto_hold = false;
   Gnc gnc;
-  if (!gnc.init(p).ok) {
-    state.SkipWithError("parameters rejected");
-    return;
-  }
   GncOutput out;
-  GncCommands c;
-  c.has_mode_request = true;
-  c.mode_request = Mode::kDetumble;
   double t = 0.0;
-  gnc.step(study_sample(t), c, out);
-  c = GncCommands{};
+  if (!start(state, gnc, p, Mode::kDetumble, study_sample(t), out)) return;
+  GncCommands c;
   // The samples are made before the timed loop: the loop times Gnc::step and the clock reads
   // around it, not the test's own sample synthesis.
   const auto n = static_cast<std::size_t>(state.max_iterations);

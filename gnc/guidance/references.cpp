@@ -45,7 +45,7 @@ void References::start_slew(double t) {
   slew_t0_ = t;
   slew_q0_ = q_d_;
   slew_duration_ = g_.slew_s;
-  slew_ramp_ = g_.slew_ramp_s < 0.5 * g_.slew_s ? g_.slew_ramp_s : 0.5 * g_.slew_s;
+  slew_ramp_ = std::fmin(g_.slew_ramp_s, 0.5 * g_.slew_s);
   const Vec4 delta = quat::error(mrp::to_quaternion(q_final_), mrp::to_quaternion(slew_q0_));
   const double s = delta.head<3>().norm();
   slew_angle_ = 2.0 * std::atan2(s, delta.w());

@@ -16,9 +16,10 @@ struct GuidanceParams {
   // [Rocksteady choice] period of the TRACK reference reset from the current estimate; 0: only at
   // activation.
   double track_reset_period_s{0.0};
-  // [Rocksteady choice] acquisition slew. 0: the study's Eqs. (46)-(48). > 0: once the plan is over and |omega_hat| <= omega_switch, the TRACK reference
-  // turns from where it is to q_final about the eigenaxis, rest to rest, in slew_s seconds: a
-  // trapezoidal rate with ramps of slew_ramp_s (at most slew_s / 2). Eq. (47)'s exponential starts
+  // [Rocksteady choice] acquisition slew. 0: the study's Eqs. (46)-(48). > 0: once the plan is
+  // over and |omega_hat| <= omega_switch, the TRACK reference turns from where it is to q_final
+  // about the eigenaxis, rest to rest, in slew_s seconds: a trapezoidal rate with ramps of
+  // slew_ramp_s (at most slew_s / 2). Eq. (47)'s exponential starts
   // at its highest rate, 4 k_qd |q_d - q_final| / (1 + |.|^2), and a rest-to-rest turn costs about
   // 2 J omega_peak of torque impulse, so the coast at the slowest rate that still arrives in
   // slew_s costs the least. No augmentation (46)-(48) while the plan runs.
