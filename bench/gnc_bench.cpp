@@ -105,6 +105,48 @@ void BM_GncTickSlew(benchmark::State& state) {
 }
 BENCHMARK(BM_GncTickSlew);
 
+// TRACK on a plan with momentum tracking (guidance.track_momentum_k, the replan strategies): the
+// plan's torque turned into the body frame plus the momentum feedback every tick, in place of the
+// law (SPEC §6 filter, pseudoinverse). The body tumbles at the study's rate; the plan despins it.
+void BM_GncTickMomentum(benchmark::State& state) {
+  GncParams p = study_gnc_params(200.0);
+  p.law = LawId::kNtcl;
+  p.estimator.kind = EstimatorKind::kFilter;
+  p.mode.auto_hold = false;
+  p.guidance.track_momentum_k = 1e-3;
+  Gnc gnc;
+  std::vector<TrajectoryTable> table(1);
+  const Vec3 w0 = study_sample(0.0).gyro_rate;
+  table[0].count = 101;
+  for (int i = 0; i < table[0].count; ++i) {  // omega_d decays linearly to rest over 10^5 s
+    const double s = static_cast<double>(i) / (table[0].count - 1);
+    table[0].samples[i].t = s * 1e5;
+    table[0].samples[i].omega_d = (1.0 - s) * w0;
+    table[0].samples[i].omega_d_dot = -w0 / 1e5;
+  }
+  table[0].samples[table[0].count - 1].omega_d_dot.setZero();
+  table[0].checksum = trajectory_checksum(table[0]);
+  GncOutput out;
+  double t = 0.0;
+  if (!start(state, gnc, p, Mode::kIdle, study_sample(t), out)) return;
+  if (gnc.load_trajectory(table[0]) != TrajectoryError::kOk) {
+    state.SkipWithError("trajectory refused");
+    return;
+  }
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kTrack;
+  gnc.step(study_sample(t += p.dt), c, out);
+  c = GncCommands{};
+  for (auto _ : state) {
+    t += p.dt;
+    gnc.step(study_sample(t), c, out);
+    benchmark::DoNotOptimize(out);
+  }
+  state.SetLabel(to_string(out.telemetry.phase));
+}
+BENCHMARK(BM_GncTickMomentum);
+
 // Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (gnc.yaml's
 // flight settings for this gyro: 60 s windows, the second-order term, the gate, the gyro bias;
 // study priors, automatic adoption), fault detection, L1 allocation under limits, NTCL in DETUMBLE. The rate

@@ -322,6 +322,9 @@ GncConfig load_gnc(const std::string& path) {
   p.guidance.track_reset_period_s = gd.non_negative("track_reset_period_s");
   if (gd.has("slew_s")) p.guidance.slew_s = gd.non_negative("slew_s");
   if (gd.has("slew_ramp_s")) p.guidance.slew_ramp_s = gd.positive("slew_ramp_s");
+  if (gd.has("track_momentum_k")) {
+    p.guidance.track_momentum_k = gd.non_negative("track_momentum_k");
+  }
   p.guidance.eps_trans = gd.positive("eps_trans_rpm") * 2.0 * kPi / 60.0;
   gd.finish();
 

@@ -629,7 +629,12 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   Vec3 u_c = Vec3::Zero();
   if (actuating(mode)) {
     const LawInput in{omega_hat, q_hat, ref, last_saturated_};
-    u_c = laws_.compute(params_.law, in, rr);
+    if (ref.phase == ReferencePhase::kTrack && params_.guidance.track_momentum_k > 0.0) {
+      u_c = momentum_torque(laws_.j_hat(), laws_.j_hat_inverse(), params_.guidance.track_momentum_k,
+                            q_hat, omega_hat, ref, rr);
+    } else {
+      u_c = laws_.compute(params_.law, in, rr);
+    }
     if (!u_c.allFinite()) {
       u_c.setZero();
       rr = RateReference{};

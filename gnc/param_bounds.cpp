@@ -68,6 +68,8 @@ constexpr ParamBound kBounds[] = {
      "acquisition slew after the plan: 0 = Eqs. (46)-(48); at most ~4 months"},
     {"guidance.slew_ramp", BoundKind::kScalar, 1e-3, 1e7, "s",
      "the slew's acceleration ramps (capped at half the slew)"},
+    {"guidance.track_momentum_k", BoundKind::kScalar, 0.0, 10.0, "1/s",
+     "momentum tracking's feedback: 0 = the law on the plan's rates; at most the tick's rate"},
     {"estimator.omega_c", BoundKind::kScalar, 1e-5, kPi / 1e-3, "rad/s",
      "filter cutoff (SPEC 6), also below pi/dt (checked by validate)"},
     {"estimator.gyro_max_rate", BoundKind::kScalar, 1e-3, 20.0, "rad/s",
@@ -168,6 +170,7 @@ Check check_bounds(const GncParams& p) {
     else if (!std::strcmp(n, "guidance.track_reset_period")) ok = scalar(p.guidance.track_reset_period_s);
     else if (!std::strcmp(n, "guidance.slew")) ok = scalar(p.guidance.slew_s);
     else if (!std::strcmp(n, "guidance.slew_ramp")) ok = scalar(p.guidance.slew_ramp_s);
+    else if (!std::strcmp(n, "guidance.track_momentum_k")) ok = scalar(p.guidance.track_momentum_k);
     else if (!std::strcmp(n, "estimator.omega_c")) ok = scalar(p.estimator.omega_c);
     else if (!std::strcmp(n, "estimator.gyro_max_rate")) ok = scalar(p.estimator.gyro_max_rate);
     else if (!std::strcmp(n, "estimator.quat_norm_tolerance")) ok = scalar(p.estimator.quat_norm_tolerance);

@@ -202,6 +202,9 @@ ParamCheck validate(const GncParams& p) {
   }
   if (!std::isfinite(g.slew_s) || g.slew_s < 0.0) return bad("guidance.slew", "must be >= 0");
   if (!finite_positive(g.slew_ramp_s)) return bad("guidance.slew_ramp", "must be positive");
+  if (!std::isfinite(g.track_momentum_k) || g.track_momentum_k < 0.0) {
+    return bad("guidance.track_momentum_k", "must be >= 0");
+  }
 
   const EstimatorParams& e = p.estimator;
   if (static_cast<int>(e.kind) >= kEstimatorKindCount) {

@@ -53,6 +53,18 @@ Vec3 ntcl_torque(const Mat3& j_hat, const Mat3& k, const Vec3& omega, const Rate
   return j_hat * r.omega_r_dot - skew(j_hat * omega) * r.omega_r - k * (omega - r.omega_r);
 }
 
+Vec3 momentum_torque(const Mat3& j_hat, const Mat3& j_hat_inv, double k, const Vec3& q,
+                     const Vec3& omega, const ReferenceSample& ref, RateReference& rr) {
+  const Mat3 dr = mrp::to_dcm(q).transpose() * mrp::to_dcm(ref.q.q);  // R' R_d
+  const Vec3 h_plan = j_hat * ref.plan_omega;
+  const Vec3 tau_plan = j_hat * ref.plan_omega_dot + ref.plan_omega.cross(h_plan);
+  const Vec3 h_d = dr * h_plan;  // the plan's momentum in today's body frame
+  const Vec3 tau_d = dr * tau_plan;
+  rr.omega_r = j_hat_inv * h_d;
+  rr.omega_r_dot = j_hat_inv * (tau_d - omega.cross(h_d));
+  return tau_d + k * (h_d - j_hat * omega);
+}
+
 Vec3 el_torque(const Mat3& j_hat, const Mat3& k, const Vec3& q, const Vec3& omega,
                const RateReference& r) {
   const Mat3 z = mrp::z_matrix(q);
@@ -125,6 +137,7 @@ Mat3 project_inertia(const Mat3& j, double lo, double hi) {
 void ControlLaws::configure(const LawGains& g, const Mat3& j_hat, double dt) {
   g_ = g;
   j_hat_ = j_hat;
+  j_hat_inv_ = j_hat.inverse();
   dt_ = dt;
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   es.computeDirect(j_hat, Eigen::EigenvaluesOnly);

@@ -84,6 +84,20 @@ Vec3 feedforward_torque(const Mat3& j_hat, const Mat3& k, const Vec3& omega,
 // Eqs. (49)-(50): -K_d w while damping; -k_p beta_err,v - K_d w when holding an attitude.
 Vec3 dpd_torque(const DpdGains& g, const Vec3& omega, const Vec3& q, const ReferenceSample& ref);
 
+// [Rocksteady choice] momentum tracking of a plan (GuidanceParams::track_momentum_k). The plan
+// (Eq. 44, made for J_hat) gives the body rate omega_d(t), omega_d_dot(t) and, through Eq. (45), the
+// attitude R_d(t) it expects; its inertial angular momentum is h_d = R_d J_hat omega_d and
+// h_d' = R_d tau_d with tau_d = J_hat omega_d_dot + omega_d x J_hat omega_d. The true momentum
+// obeys h' = R u whatever the inertia, so
+//   u = dR tau_d + k (dR J_hat omega_d - J_hat omega),  dR = R' R_d,
+// drives h to h_d at rate k with no gyroscopic term: where J_hat is off, the body turns away from
+// R_d (its free motion differs), but no thrust is spent holding it on the plan's rates. The NTCL
+// (Eq. 9) instead fires S(J_hat omega) omega_r for every rate the body takes off the plan.
+// Writes omega_r = J_hat^-1 dR J_hat omega_d (the rate that carries h_d) and its derivative
+// J_hat^-1 (dR tau_d - omega x dR J_hat omega_d) for telemetry.
+Vec3 momentum_torque(const Mat3& j_hat, const Mat3& j_hat_inv, double k, const Vec3& q,
+                     const Vec3& omega, const ReferenceSample& ref, RateReference& rr);
+
 // Regressor of Eq. (34): Y(w, w_r, w_r_dot) a = J w_r_dot - S(J w) w_r, with
 // a = [Jxx, Jyy, Jzz, Jxy, Jxz, Jyz].
 Mat36 regressor(const Vec3& omega, const Vec3& omega_r, const Vec3& omega_r_dot);
@@ -109,10 +123,13 @@ class ControlLaws {
 
   const Vec3& integral() const { return integral_; }
   const Vec6& a_hat() const { return a_hat_; }
+  const Mat3& j_hat() const { return j_hat_; }
+  const Mat3& j_hat_inverse() const { return j_hat_inv_; }
 
  private:
   LawGains g_{};
   Mat3 j_hat_{Mat3::Identity()};
+  Mat3 j_hat_inv_{Mat3::Identity()};
   double dt_{0.1};
   double eig_lo_{0.0};
   double eig_hi_{0.0};

@@ -137,8 +137,14 @@ ReferenceSample References::update(Mode mode, bool entered, double t, const Vec3
     }
     t_prev_ = t;
   }
+  // Momentum tracking lets the attitude go where the body takes it: the attitude phases after
+  // the plan start from the estimate, not from the plan's q_d.
+  const bool momentum = g_.track_momentum_k > 0.0;
   if (slew) {
-    if (!slewing_ && plan_over(traj, t) && omega_hat.norm() <= g_.omega_switch) start_slew(t);
+    if (!slewing_ && plan_over(traj, t) && omega_hat.norm() <= g_.omega_switch) {
+      if (momentum) q_d_ = q_hat;
+      start_slew(t);
+    }
     if (slewing_) {
       const mrp::WithRates r = slew_reference(t);
       q_d_ = r.q;
@@ -148,6 +154,7 @@ ReferenceSample References::update(Mode mode, bool entered, double t, const Vec3
     }
   } else if (!augmented_ && omega_hat.norm() <= g_.omega_switch) {
     augmented_ = true;  // latched until TRACK is re-entered
+    if (momentum) q_d_ = q_hat;
   }
 
   const TrajectoryPoint p = interpolate(traj, t - t0_);
@@ -156,6 +163,8 @@ ReferenceSample References::update(Mode mode, bool entered, double t, const Vec3
   r.q = q_d_;
   if (!augmented_) {
     s.phase = ReferencePhase::kTrack;
+    s.plan_omega = p.omega_d;
+    s.plan_omega_dot = p.omega_d_dot;
     r.q_dot = z * p.omega_d;                                              // Eq. (45)
     r.q_ddot = mrp::z_dot(q_d_, r.q_dot) * p.omega_d + z * p.omega_d_dot;  // Eq. (45)
   } else {

@@ -25,6 +25,11 @@ struct GuidanceParams {
   // slew_s costs the least. No augmentation (46)-(48) while the plan runs.
   double slew_s{0.0};
   double slew_ramp_s{1000.0};
+  // [Rocksteady choice] momentum tracking (gnc/control/laws.hpp momentum_torque). 0: the law
+  // tracks the plan's rates (Eq. 45). > 0: while the plan runs, TRACK flies the plan's inertial
+  // angular momentum h_d = R_d J_hat omega_d instead, with this feedback gain (1/s): the plan's
+  // torque turned into the body frame plus k (h_d - R J_hat omega_hat), no gyroscopic term.
+  double track_momentum_k{0.0};
   double eps_trans{0.5 * 2.0 * 3.14159265358979323846 / 60.0};  // 0.5 rpm in rad/s (SPEC §5)
 };
 
@@ -32,6 +37,9 @@ struct ReferenceSample {
   ReferencePhase phase{ReferencePhase::kNone};
   // q_d, qdot_d, qddot_d (MRP), expressed in the set of the current estimate.
   mrp::WithRates q{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  // kTrack: the plan's omega_d and omega_d_dot at this tick (body frame of q_d).
+  Vec3 plan_omega{Vec3::Zero()};
+  Vec3 plan_omega_dot{Vec3::Zero()};
   bool rate_only() const { return phase == ReferencePhase::kDamping; }
 };
 

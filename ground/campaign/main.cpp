@@ -216,6 +216,11 @@ int main(int argc, char** argv) {
                     "replan strategies: after the last plan, the flight turns to q_final rest to "
                     "rest in this time, s (guidance.slew_s; 0: the flight's own setting)")
         ->capture_default_str();
+    sub->add_option("--replan-momentum", spec.replan.momentum_k,
+                    "replan strategies: the flight tracks the plan's inertial angular momentum "
+                    "with this feedback gain, 1/s (guidance.track_momentum_k; 0: the flight's own "
+                    "setting)")
+        ->capture_default_str();
     sub->add_option("--replan-adopt-settle", spec.replan.adopt_settle_tau,
                     "replan strategies: after the flight adopts a model, no plan for this many "
                     "time constants of its rate stage (the rate estimate relaxes to the new "

@@ -64,6 +64,9 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       fs.params.identification.config.r_confident = options.replan.offset_confident_m;
     }
     if (options.replan.slew_s > 0.0) fs.params.guidance.slew_s = options.replan.slew_s;
+    if (options.replan.momentum_k > 0.0) {
+      fs.params.guidance.track_momentum_k = options.replan.momentum_k;
+    }
   }
   fs.start_mode = strategy.needs_trajectory() ? gnc::Mode::kTrack : gnc::Mode::kDetumble;
   fs.trajectory = strategy.needs_trajectory() ? trajectory : nullptr;

@@ -391,6 +391,7 @@ DispersionSpec load_spec(const std::string& path) {
       s.replan.offset_confident_m = r.non_negative("offset_confident_m");
     }
     if (r.has("slew_s")) s.replan.slew_s = r.non_negative("slew_s");
+    if (r.has("momentum_k")) s.replan.momentum_k = r.non_negative("momentum_k");
     if (s.replan.first_plan_max_s < s.replan.first_plan_s) {
       r.fail("first_plan_max_s", "must not be below first_plan_s");
     }

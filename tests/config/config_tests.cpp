@@ -151,6 +151,22 @@ TEST(ConfigShipped, AllocatorKeyIsOptionalAndSelectsTheL1Allocator) {
   EXPECT_EQ(load_gnc(absent.path()).params.allocator, gnc::AllocatorKind::kPseudoInverse);
 }
 
+// Momentum tracking (guidance.track_momentum_k): off (the law on the plan's rates) in the shipped
+// file and when the key is absent; set, read; negative, the file and key named.
+TEST(ConfigShipped, MomentumTrackingIsOptionalAndChecked) {
+  const std::string from = read(kGnc).substr(read(kGnc).find("  track_momentum_k: 0.0"));
+  const std::string line = from.substr(0, from.find('\n'));
+  EXPECT_EQ(load_gnc(kGnc).params.guidance.track_momentum_k, 0.0);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), line, ""));
+  EXPECT_EQ(load_gnc(absent.path()).params.guidance.track_momentum_k,
+            gnc::GncParams{}.guidance.track_momentum_k);
+  TempFile set("gnc.yaml", replaced(read(kGnc), line, "  track_momentum_k: 0.001"));
+  EXPECT_EQ(load_gnc(set.path()).params.guidance.track_momentum_k, 0.001);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  track_momentum_k: -0.001"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "guidance.track_momentum_k",
+               "must not be negative");
+}
+
 // The acquisition slew (guidance.slew_s, slew_ramp_s): off (Eqs. 46-48) in the shipped file, the
 // defaults when the keys are absent, and a bad value names the file and key.
 TEST(ConfigShipped, TheAcquisitionSlewIsOptionalAndChecked) {

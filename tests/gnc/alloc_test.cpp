@@ -291,6 +291,37 @@ TEST(ZeroAllocation, NoHeapInTheAcquisitionSlew) {
   delete loop;
 }
 
+// Momentum tracking (guidance.track_momentum_k): every tick of a plan flown on its inertial
+// momentum, a body 10 % off the model, under the counter.
+TEST(ZeroAllocation, NoHeapInMomentumTracking) {
+  GncParams p = test::small_vehicle_params();
+  p.guidance.omega_switch = 1e-3;
+  p.guidance.track_momentum_k = 0.2;
+  auto* loop = new test::SmallLoop(p);
+  loop->body.j *= 1.1;
+  loop->body.omega = Vec3(0.3, -0.2, 0.25);
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  auto* tab = new TrajectoryTable();
+  test::linear_despin_table(loop->body.omega, 60.0, *tab);
+  ASSERT_EQ(loop->gnc.load_trajectory(*tab), TrajectoryError::kOk);
+  int track_ticks = 0;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kTrack;
+    loop->tick(c);
+    for (int i = 0; i < 1200; ++i) {  // the plan's 60 s
+      loop->tick();
+      track_ticks += loop->out.telemetry.phase == ReferencePhase::kTrack ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(rocksteady::test::heap_allocations(), 0);
+  EXPECT_GT(track_ticks, 1150);
+  delete tab;
+  delete loop;
+}
+
 // gnc/fdi/README.md (F14), estimation README (I22)-(I23): the identifier's fault torque state,
 // its per-window scoring of the 16 stuck-on columns and the detector's confirmation from it, with
 // channel 1's "+" jet stuck on from the first tick: no heap in any tick.
