@@ -105,15 +105,16 @@ void BM_GncTickSlew(benchmark::State& state) {
 }
 BENCHMARK(BM_GncTickSlew);
 
-// TRACK on a plan with momentum tracking (guidance.track_momentum_k, the replan strategies): the
-// plan's torque turned into the body frame plus the momentum feedback every tick, in place of the
-// law (SPEC §6 filter, pseudoinverse). The body tumbles at the study's rate; the plan despins it.
-void BM_GncTickMomentum(benchmark::State& state) {
+// TRACK on a plan (SPEC §6 filter, pseudoinverse): the NTCL on the plan's rates (k = 0), or
+// momentum tracking (guidance.track_momentum_k, the replan strategies), the plan's torque turned
+// into the body frame plus the momentum feedback every tick in place of the law. The body tumbles
+// at the study's rate; the plan despins it.
+void BM_GncTickTrack(benchmark::State& state, double momentum_k) {
   GncParams p = study_gnc_params(200.0);
   p.law = LawId::kNtcl;
   p.estimator.kind = EstimatorKind::kFilter;
   p.mode.auto_hold = false;
-  p.guidance.track_momentum_k = 1e-3;
+  p.guidance.track_momentum_k = momentum_k;
   Gnc gnc;
   std::vector<TrajectoryTable> table(1);
   const Vec3 w0 = study_sample(0.0).gyro_rate;
@@ -145,7 +146,8 @@ void BM_GncTickMomentum(benchmark::State& state) {
   }
   state.SetLabel(to_string(out.telemetry.phase));
 }
-BENCHMARK(BM_GncTickMomentum);
+BENCHMARK_CAPTURE(BM_GncTickTrack, rates, 0.0);
+BENCHMARK_CAPTURE(BM_GncTickTrack, momentum, 1e-3);
 
 // Every module on (the flight-core budget of DEVELOPERS.md): MEKF, identification (gnc.yaml's
 // flight settings for this gyro: 60 s windows, the second-order term, the gate, the gyro bias;
