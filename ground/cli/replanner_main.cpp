@@ -60,6 +60,10 @@ gnc::GncTelemetry from_bus(const rocksteady::gnc_telemetry_t& m) {
   t.t = m.t;
   t.mode = static_cast<gnc::Mode>(m.mode);
   t.omega_hat = gnc::Vec3(m.omega_hat[0], m.omega_hat[1], m.omega_hat[2]);
+  // The reference's phase and attitude: momentum tracking's rates (Replanner::aimed_rate).
+  t.phase = static_cast<gnc::ReferencePhase>(m.phase);
+  t.q_hat = gnc::Vec3(m.q_hat[0], m.q_hat[1], m.q_hat[2]);
+  t.q_d = gnc::Vec3(m.q_d[0], m.q_d[1], m.q_d[2]);
   t.alloc.torque_achieved =
       gnc::Vec3(m.torque_achieved[0], m.torque_achieved[1], m.torque_achieved[2]);
   t.est.identifying = m.identifying;

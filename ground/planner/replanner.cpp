@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "gnc/estimation/identifier.hpp"
+#include "gnc/math/rotation.hpp"
 
 namespace rocksteady::ground::planner {
 
@@ -105,12 +106,22 @@ bool Replanner::awaiting_adoption(const gnc::GncTelemetry& tl) const {
   return !apriori_confirmed(flown_, tl.est, policy_.early_sigmas, inf, inf);
 }
 
+gnc::Vec3 Replanner::aimed_rate(const gnc::GncTelemetry& tl, const gnc::Vec3& omega_d) const {
+  if (!(flight_.guidance.track_momentum_k > 0.0) || tl.phase != gnc::ReferencePhase::kTrack) {
+    return omega_d;
+  }
+  const gnc::Mat3 j = gnc::total_inertia(flown_.mass_hat);
+  const gnc::Mat3 dr = gnc::mrp::to_dcm(tl.q_hat).transpose() * gnc::mrp::to_dcm(tl.q_d);
+  return j.inverse() * (dr * (j * omega_d));
+}
+
 gnc::Vec3 Replanner::predict(const gnc::GncTelemetry& tl, double ahead) const {
   if (flying_table_ != nullptr && tl.mode == gnc::Mode::kTrack && !resync_) {
-    // Tracking: the flight follows the plan; carry today's tracking error along.
+    // Tracking: the flight follows the plan; carry today's tracking error along (with momentum
+    // tracking, the plan's rates turned as the body has turned off the plan's attitude).
     const double tau = tl.t - t0_;
-    return gnc::interpolate(*flying_table_, tau + ahead).omega_d + tl.omega_hat -
-           gnc::interpolate(*flying_table_, tau).omega_d;
+    return aimed_rate(tl, gnc::interpolate(*flying_table_, tau + ahead).omega_d) + tl.omega_hat -
+           aimed_rate(tl, gnc::interpolate(*flying_table_, tau).omega_d);
   }
   // Not tracking yet (the D+PD reference): Euler's equations (SPEC Eq. 2) for the model with the
   // torque the flight applies now held in the body frame, RK4.
@@ -231,7 +242,7 @@ std::optional<ReplanTrigger> Replanner::decide(const gnc::GncTelemetry& tl) {
     return ReplanTrigger::kModelUpdate;
   }
   if (policy_.error_fraction > 0.0 && flying_table_ != nullptr) {
-    const gnc::Vec3 w_d = gnc::interpolate(*flying_table_, tl.t - t0_).omega_d;
+    const gnc::Vec3 w_d = aimed_rate(tl, gnc::interpolate(*flying_table_, tl.t - t0_).omega_d);
     if ((tl.omega_hat - w_d).norm() > policy_.error_fraction * w_d.norm() + policy_.error_floor) {
       return ReplanTrigger::kTrackingError;
     }

@@ -137,6 +137,10 @@ class Replanner {
   void plan_now(const gnc::GncTelemetry& tl, ReplanTrigger why);
   // The rate the flight will have `ahead` seconds after this telemetry.
   gnc::Vec3 predict(const gnc::GncTelemetry& tl, double ahead) const;
+  // The rate the flight aims at for the plan's omega_d: omega_d itself, or, with momentum tracking
+  // (guidance.track_momentum_k) while the plan runs, the rate that carries the plan's momentum in
+  // today's body frame, J_hat^-1 dR J_hat omega_d with dR = R(q_hat)' R(q_d) from the telemetry.
+  gnc::Vec3 aimed_rate(const gnc::GncTelemetry& tl, const gnc::Vec3& omega_d) const;
   // The identified model is confident but the flight still flies a model it refutes.
   bool awaiting_adoption(const gnc::GncTelemetry& tl) const;
 

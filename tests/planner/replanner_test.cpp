@@ -147,6 +147,59 @@ TEST(Replanner, RePlanWhileTrackingStartsOnThePlanVerifiesAndARefusalKeepsThePre
   EXPECT_TRUE(rp.records().back().ok) << rp.records().back().error;
 }
 
+// With momentum tracking (guidance.track_momentum_k) the flight holds the plan's inertial momentum
+// and lets the attitude drift off the plan's: its rate is then J_hat^-1 dR J_hat omega_d, dR the
+// turn from the plan's attitude (telemetry q_d) to the body's (q_hat). The tracking-error trigger
+// measures against that rate: a body 30 degrees off the plan's attitude and on the plan's momentum
+// asks for no re-plan, where the same telemetry with the law on the plan's rates does.
+TEST(Replanner, WithMomentumTrackingTheTrackingErrorIsAgainstTheRateThatCarriesThePlansMomentum) {
+  for (const double k : {0.0, 1e-3}) {
+    gnc::GncParams table = case1_table();
+    table.guidance.track_momentum_k = k;
+    ReplanPolicy pol = policy(0.0);
+    pol.error_fraction = 0.1;
+    pol.period_s = 0.0;
+    Replanner rp(table, pol);
+    std::optional<Delivery> first;
+    double t = 0.0;
+    const Vec3 w0(0.01, 0.02, 0.03);
+    for (int j = 0; j <= 100 && !first; ++j) {
+      t = j * table.dt;
+      first = rp.update(tlm(t, gnc::Mode::kDetumble, w0));
+    }
+    ASSERT_TRUE(first.has_value());
+    const double t_switch = t + table.dt;
+    const gnc::TrajectoryTable& plan = *first->table;
+    // The body 30 degrees about a fixed axis off the plan's attitude (q_d = 0), through the
+    // plant's quaternion algebra.
+    const double angle = std::acos(-1.0) / 6.0;
+    const Eigen::Vector4d b = rocksteady::test::axis_angle(Vec3(1.0, -2.0, 0.5), angle);
+    const gnc::Mat3 dr = rocksteady::test::quat_to_matrix(b).transpose();
+    const gnc::Mat3 j = gnc::total_inertia(table.mass_hat);
+    for (int i = 1; i <= 1000; ++i) {  // 100 s on the plan's momentum
+      // The switch's tick starts the plan at the body's attitude (q_d <- q_hat, dR = I) and
+      // re-synchronises both plan clocks; the body is off the plan's attitude from then on.
+      const gnc::Mat3 turn = i == 1 ? gnc::Mat3::Identity() : dr;
+      t = t_switch + (i - 1) * table.dt;
+      gnc::GncTelemetry tl =
+          tlm(t, gnc::Mode::kTrack,
+              j.inverse() * (turn * (j * gnc::interpolate(plan, t - t_switch).omega_d)));
+      tl.phase = gnc::ReferencePhase::kTrack;
+      tl.q_d = Vec3::Zero();
+      tl.q_hat = i == 1 ? Vec3::Zero() : Vec3(rocksteady::test::quat_to_mrp(b));
+      rp.update(tl);
+    }
+    if (k > 0.0) {
+      EXPECT_EQ(rp.records().size(), 1u);  // the first plan only
+    } else {
+      ASSERT_GE(rp.records().size(), 2u);  // and again each min_interval_s: the error stays
+      EXPECT_EQ(rp.records()[1].trigger, ReplanTrigger::kTrackingError);
+      // as soon as min_interval_s after the first plan allows
+      EXPECT_NEAR(rp.records()[1].t_state, rp.records()[0].t_state + pol.min_interval_s, 0.15);
+    }
+  }
+}
+
 // An identifier report around the table's J_tot and r_SO/BCM, offset by `dj` (inertia parameter
 // i, kg m^2) and `dr` (offset component i, m), with 1 sigma `sj` and `sr` on every component.
 gnc::EstimationTelemetry report(const gnc::GncParams& table, double sj, double sr, int ij = 0,
