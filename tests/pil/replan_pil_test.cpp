@@ -15,13 +15,31 @@ namespace rocksteady::pil {
 namespace {
 
 constexpr int kTrack = 3;
+constexpr int kPhaseTrack = 3;  // gnc::ReferencePhase::kTrack
 constexpr int kEvTrajectoryLoaded = 122, kEvTrajectorySwitched = 137, kEvTrajectoryStale = 138;
 
 TEST(PilReplan, ThePlannerProcessReplansAndTheFlightSwitchesTablesDuringTrack) {
   const std::string dir = scratch_dir("replan");
   const std::string url = lcm_url(7871);
-  const std::string mission = config_dir() + "/mission.yaml", gnc = config_dir() + "/gnc.yaml",
+  const std::string mission = config_dir() + "/mission.yaml",
                     case_file = config_dir() + "/cases/case1.yaml";
+  // The flight settings the campaign's replan strategies set (ground/campaign/runner.hpp
+  // ReplanOptions): momentum tracking and the acquisition slew, in the gnc file the flight and the
+  // planner both read (the planner's tracking error and prediction follow the momentum tracking
+  // from the telemetry's q_hat, q_d and phase).
+  const std::string gnc = dir + "/gnc.yaml";
+  {
+    std::string text = read_file(config_dir() + "/gnc.yaml");
+    const auto set_key = [&text](const std::string& key, const std::string& value) {
+      const std::size_t at = text.find("  " + key + ": ");
+      ASSERT_NE(at, std::string::npos) << key;
+      const std::size_t end = text.find('\n', at);
+      text.replace(at, end - at, "  " + key + ": " + value);
+    };
+    set_key("track_momentum_k", "0.001");
+    set_key("slew_s", "40000");
+    write_file(gnc, text);
+  }
   // A key file shared by the flight and the planner (format of rocksteady-ground keygen).
   const std::string key = dir + "/keys";
   write_file(key,
@@ -56,6 +74,7 @@ TEST(PilReplan, ThePlannerProcessReplansAndTheFlightSwitchesTablesDuringTrack) {
   EXPECT_FALSE(bus.has_event(kEvTrajectoryStale));
   bus.spin_for(0.5);
   EXPECT_EQ(bus.tlm.mode, kTrack);
+  EXPECT_EQ(bus.tlm.phase, kPhaseTrack);  // the plan running: flown on its momentum here
   EXPECT_TRUE(bus.tlm.trajectory_loaded);
 
   // The planner saw the switch (an authentic event) and exits on its own.
