@@ -50,7 +50,7 @@ void BM_GncTick(benchmark::State& state, LawId law, Mode mode) {
   GncOutput out;
   double t = 0.0;
   if (!start(state, gnc, p, mode, study_sample(t), out)) return;
-  const GncCommands c;
+  const GncCommands c{};
   for (auto _ : state) {
     t += p.dt;
     gnc.step(study_sample(t), c, out);
@@ -65,13 +65,34 @@ BENCHMARK_CAPTURE(BM_GncTick, ntcl_dpd_ref_hold, LawId::kNtcl, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, so3_hold, LawId::kSo3, Mode::kHold);
 BENCHMARK_CAPTURE(BM_GncTick, adaptive_hold, LawId::kAdaptive, Mode::kHold);
 
-// TRACK after the plan with the acquisition slew (guidance.slew_s, the replan strategies): the
-// eigenaxis turn's closed-form reference every tick (SPEC §6 filter, NTCL, pseudoinverse).
-void BM_GncTickSlew(benchmark::State& state) {
+// The TRACK benchmarks' table: the study's vehicle, SPEC §6 filter, NTCL, pseudoinverse, no
+// automatic HOLD.
+GncParams track_params() {
   GncParams p = study_gnc_params(200.0);
   p.law = LawId::kNtcl;
   p.estimator.kind = EstimatorKind::kFilter;
   p.mode.auto_hold = false;
+  return p;
+}
+
+// Load `table` and fly one tick that requests TRACK (or mark the benchmark failed).
+bool enter_track(benchmark::State& state, Gnc& gnc, const TrajectoryTable& table,
+                 const SensorSample& sample, GncOutput& out) {
+  if (gnc.load_trajectory(table) != TrajectoryError::kOk) {
+    state.SkipWithError("trajectory refused");
+    return false;
+  }
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kTrack;
+  gnc.step(sample, c, out);
+  return true;
+}
+
+// TRACK after the plan with the acquisition slew (guidance.slew_s, the replan strategies): the
+// eigenaxis turn's closed-form reference every tick (SPEC §6 filter, NTCL, pseudoinverse).
+void BM_GncTickSlew(benchmark::State& state) {
+  GncParams p = track_params();
   p.guidance.slew_s = 40000.0;
   Gnc gnc;
   std::vector<TrajectoryTable> table(1);  // a plan already at rest: the slew starts at once
@@ -86,15 +107,8 @@ void BM_GncTickSlew(benchmark::State& state) {
   GncOutput out;
   double t = 0.0;
   if (!start(state, gnc, p, Mode::kIdle, at_rest(t), out)) return;
-  if (gnc.load_trajectory(table[0]) != TrajectoryError::kOk) {
-    state.SkipWithError("trajectory refused");
-    return;
-  }
-  GncCommands c;
-  c.has_mode_request = true;
-  c.mode_request = Mode::kTrack;
-  gnc.step(at_rest(t += p.dt), c, out);
-  c = GncCommands{};
+  if (!enter_track(state, gnc, table[0], at_rest(t += p.dt), out)) return;
+  const GncCommands c{};
   for (int i = 0; i < 200; ++i) gnc.step(at_rest(t += p.dt), c, out);  // past the plan's end
   for (auto _ : state) {
     t += p.dt;
@@ -110,10 +124,7 @@ BENCHMARK(BM_GncTickSlew);
 // into the body frame plus the momentum feedback every tick in place of the law. The body tumbles
 // at the study's rate; the plan despins it.
 void BM_GncTickTrack(benchmark::State& state, double momentum_k) {
-  GncParams p = study_gnc_params(200.0);
-  p.law = LawId::kNtcl;
-  p.estimator.kind = EstimatorKind::kFilter;
-  p.mode.auto_hold = false;
+  GncParams p = track_params();
   p.guidance.track_momentum_k = momentum_k;
   Gnc gnc;
   std::vector<TrajectoryTable> table(1);
@@ -130,15 +141,8 @@ void BM_GncTickTrack(benchmark::State& state, double momentum_k) {
   GncOutput out;
   double t = 0.0;
   if (!start(state, gnc, p, Mode::kIdle, study_sample(t), out)) return;
-  if (gnc.load_trajectory(table[0]) != TrajectoryError::kOk) {
-    state.SkipWithError("trajectory refused");
-    return;
-  }
-  GncCommands c;
-  c.has_mode_request = true;
-  c.mode_request = Mode::kTrack;
-  gnc.step(study_sample(t += p.dt), c, out);
-  c = GncCommands{};
+  if (!enter_track(state, gnc, table[0], study_sample(t += p.dt), out)) return;
+  const GncCommands c{};
   for (auto _ : state) {
     t += p.dt;
     gnc.step(study_sample(t), c, out);

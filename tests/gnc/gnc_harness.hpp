@@ -43,6 +43,17 @@ inline gnc::GncParams small_vehicle_params() {
   return p;
 }
 
+// MRP -> quaternion (scalar last) and -> rotation matrix through the plant's algebra, written out
+// here so that a test's truth shares no code with gnc/math.
+inline V4 mrp_to_quat(const V3& q) {
+  const double n = q.squaredNorm();
+  V4 b;
+  b.head<3>() = 2.0 * q / (1.0 + n);
+  b.w() = (1.0 - n) / (1.0 + n);
+  return b;
+}
+inline M3 mrp_to_dcm(const V3& q) { return quat_to_matrix(mrp_to_quat(q)); }
+
 // A despin plan for the small vehicle: omega_d decays linearly to rest over `duration`.
 inline void linear_despin_table(const gnc::Vec3& omega0, double duration, gnc::TrajectoryTable& t) {
   t.count = 101;

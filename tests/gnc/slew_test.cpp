@@ -17,15 +17,8 @@ using test::M3;
 using test::V3;
 using test::V4;
 
-// MRP -> quaternion (scalar last) and -> rotation matrix through the plant's algebra.
-V4 mrp_to_quat(const V3& q) {
-  const double n = q.squaredNorm();
-  V4 b;
-  b.head<3>() = 2.0 * q / (1.0 + n);
-  b.w() = (1.0 - n) / (1.0 + n);
-  return b;
-}
-M3 dcm(const V3& q) { return test::quat_to_matrix(mrp_to_quat(q)); }
+M3 dcm(const V3& q) { return test::mrp_to_dcm(q); }
+using test::mrp_to_quat;
 
 M3 rodrigues(const V3& axis, double angle) {
   M3 k;
