@@ -173,7 +173,8 @@ int main(int argc, char** argv) {
                     "replan strategies: first plan by then even without a confident model, s")
         ->capture_default_str();
     sub->add_option("--replan-horizon", spec.replan.horizon_factor,
-                    "replan strategies: plan horizon in shortest despins from the current state")
+                    "replan strategies: plan horizon in shortest despins from the current state (0: "
+                    "automatic, 16 when the flight tracks the plan's momentum, 8 on the law's rates)")
         ->capture_default_str();
     sub->add_option("--replan-min-horizon", spec.replan.min_horizon_s,
                     "replan strategies: shortest plan horizon, s")

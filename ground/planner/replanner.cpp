@@ -106,6 +106,11 @@ bool Replanner::awaiting_adoption(const gnc::GncTelemetry& tl) const {
   return !apriori_confirmed(flown_, tl.est, policy_.early_sigmas, inf, inf);
 }
 
+double Replanner::horizon_factor() const {
+  if (policy_.horizon_factor > 0.0) return policy_.horizon_factor;
+  return flight_.guidance.track_momentum_k > 0.0 ? kMomentumHorizonFactor : kHorizonFactor;
+}
+
 gnc::Vec3 Replanner::aimed_rate(const gnc::GncTelemetry& tl, const gnc::Vec3& omega_d) const {
   if (!(flight_.guidance.track_momentum_k > 0.0) || tl.phase != gnc::ReferencePhase::kTrack) {
     return omega_d;
@@ -277,7 +282,7 @@ void Replanner::plan_now(const gnc::GncTelemetry& tl, ReplanTrigger why) {
   // Receding horizon: never shorter than the rest of the plan being flown, nor than horizon_factor
   // shortest despins from here (the least fuel falls with the horizon, steeply below ~4x: keeping
   // the first plan's end would make every re-plan dearer than the plan it replaces).
-  t_f = policy_.horizon_factor * t_lower;
+  t_f = horizon_factor() * t_lower;
   if (flying_ == nullptr) {
     t_f = std::max(t_f, policy_.min_horizon_s);
   } else {

@@ -15,7 +15,8 @@
 //                  periodic: period_s after the last plan;
 //                  tracking error: |omega_hat - omega_d| > error_fraction |omega_d| + error_floor;
 //                  model update: the flight adopted an identified model (adoption count grew);
-//   horizon      the first plan: horizon_factor shortest despins (at least min_horizon_s); a
+//   horizon      the first plan: horizon_factor shortest despins (at least min_horizon_s; by
+//                default 16 when the flight tracks the plan's momentum, 8 otherwise); a
 //                re-plan: the rest of the plan being flown, or horizon_factor shortest despins
 //                from the current state if that is longer (a fixed minimum would recede for ever);
 //   stop         once |omega_hat| < stop_rate_fraction |omega| at the first plan, or the plan's
@@ -61,9 +62,10 @@ struct ReplanPolicy {
                                     // identifier's model became confident (adopted or not)
   double min_interval_s{120.0};     // between two plans (also after a failed one)
   double latency_s{10.0};           // planning latency: delivered no earlier than t + latency
-  double horizon_factor{kHorizonFactor};  // t_f = factor x shortest despin from the state,
-  double min_horizon_s{0.0};              // the first plan at least this long (the least fuel
-                                          // falls with t_f); re-plans keep its end
+  // t_f = factor x shortest despin from the state (<= 0: automatic, kMomentumHorizonFactor when the
+  // flight tracks the plan's momentum, guidance.track_momentum_k > 0, else kHorizonFactor),
+  double horizon_factor{0.0};
+  double min_horizon_s{0.0};  // the first plan at least this long (the least fuel falls with t_f)
   // Plan for the model the flight tracks with: once the identified model is confident, while it
   // refutes the flight's active model (some J or r component beyond early_sigmas of its 1 sigma;
   // the flight adopts such a model at its next boundary), the plan waits for the adoption, at
@@ -131,6 +133,9 @@ class Replanner {
   const ReplanPolicy& policy() const { return policy_; }
   // The model the next plan is for (the latest confident identified model, else the table).
   const gnc::GncParams& model() const { return model_; }
+  // The plan horizon in shortest despins: the policy's, or the automatic one for the flight's
+  // TRACK (ReplanPolicy::horizon_factor <= 0).
+  double horizon_factor() const;
 
  private:
   std::optional<ReplanTrigger> decide(const gnc::GncTelemetry& tl);

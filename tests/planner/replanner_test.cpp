@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/guidance/trajectory.hpp"
@@ -198,6 +199,38 @@ TEST(Replanner, WithMomentumTrackingTheTrackingErrorIsAgainstTheRateThatCarriesT
       EXPECT_NEAR(rp.records()[1].t_state, rp.records()[0].t_state + pol.min_interval_s, 0.15);
     }
   }
+}
+
+// The automatic horizon (ReplanPolicy::horizon_factor <= 0): 16 shortest despins when the flight
+// tracks the plan's momentum, 8 on the law's rates; a policy's own factor wins. The same tumble's
+// first plan reaches the planner with it: twice the final time (the despin's least fuel falls with
+// the horizon, so the plan uses all of it) and less fuel.
+TEST(Replanner, TheAutomaticHorizonIsTwiceAsLongWhenTheFlightTracksThePlansMomentum) {
+  const auto first_plan = [](double momentum_k, double factor) {
+    gnc::GncParams table = case1_table();
+    table.guidance.track_momentum_k = momentum_k;
+    ReplanPolicy pol = policy(0.0);
+    pol.horizon_factor = factor;
+    Replanner rp(table, pol);
+    std::optional<Delivery> d;
+    for (int j = 0; j <= 100 && !d; ++j) {
+      d = rp.update(tlm(j * table.dt, gnc::Mode::kDetumble, Vec3(0.01, 0.02, 0.03)));
+    }
+    EXPECT_TRUE(d.has_value());
+    EXPECT_EQ(rp.records().size(), 1u);
+    return std::make_pair(rp.horizon_factor(), rp.records().front());
+  };
+  ASSERT_LE(ReplanPolicy{}.horizon_factor, 0.0);  // automatic by default
+  const auto [f_rates, rates] = first_plan(0.0, 0.0);
+  const auto [f_momentum, momentum] = first_plan(1e-3, 0.0);
+  EXPECT_EQ(f_rates, kHorizonFactor);
+  EXPECT_EQ(f_momentum, kMomentumHorizonFactor);
+  EXPECT_EQ(first_plan(1e-3, 12.0).first, 12.0);
+  ASSERT_TRUE(rates.ok) << rates.error;
+  ASSERT_TRUE(momentum.ok) << momentum.error;
+  // Both plans start from the same predicted rate, so the same shortest despin.
+  EXPECT_NEAR(momentum.t_final / rates.t_final, kMomentumHorizonFactor / kHorizonFactor, 0.02);
+  EXPECT_LT(momentum.fuel_kg, rates.fuel_kg);
 }
 
 // An identifier report around the table's J_tot and r_SO/BCM, offset by `dj` (inertia parameter
