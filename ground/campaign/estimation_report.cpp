@@ -46,22 +46,23 @@ nlohmann::json estimation_json(const EstimationReport& e) {
           {"strengths_after_firing", strengths}};
 }
 
-nlohmann::json replan_json(const ReplanReport& r) {
+nlohmann::json replan_json(const ReplanReport& r, bool with_wall) {
   nlohmann::json plans = nlohmann::json::array();
   for (const ReplanEvent& e : r.events) {
-    plans.push_back({{"trigger", e.trigger},
-                     {"t_state_s", e.t_state_s},
-                     {"t_due_s", e.t_due_s},
-                     {"t_delivered_s", e.t_delivered_s},
-                     {"ok", e.ok},
-                     {"error", e.error},
-                     {"identified_model", e.identified},
-                     {"planned_fuel_kg", e.planned_fuel_kg},
-                     {"t_final_s", e.t_final_s},
-                     {"nodes", e.nodes},
-                     {"iterations", e.iterations},
-                     {"solve_wall_s", e.wall_s},
-                     {"upload_id", e.upload_id}});
+    nlohmann::json p = {{"trigger", e.trigger},
+                        {"t_state_s", e.t_state_s},
+                        {"t_due_s", e.t_due_s},
+                        {"t_delivered_s", e.t_delivered_s},
+                        {"ok", e.ok},
+                        {"error", e.error},
+                        {"identified_model", e.identified},
+                        {"planned_fuel_kg", e.planned_fuel_kg},
+                        {"t_final_s", e.t_final_s},
+                        {"nodes", e.nodes},
+                        {"iterations", e.iterations},
+                        {"upload_id", e.upload_id}};
+    if (with_wall) p["solve_wall_s"] = e.wall_s;
+    plans.push_back(std::move(p));
   }
   return {{"enabled", r.enabled},   {"plans", r.plans},       {"failed", r.failed},
           {"delivered", r.delivered}, {"switched", r.switched}, {"refused", r.refused},
@@ -115,6 +116,34 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
     f.fault_commanded_impulse_ns = j.at("fault_commanded_impulse_ns").get<double>();
   }
   return f;
+}
+
+ReplanReport replan_from_json(const nlohmann::json& j) {
+  ReplanReport r;
+  r.enabled = j.at("enabled").get<bool>();
+  r.plans = j.at("plans").get<int>();
+  r.failed = j.at("failed").get<int>();
+  r.delivered = j.at("delivered").get<int>();
+  r.switched = j.at("switched").get<int>();
+  r.refused = j.at("refused").get<int>();
+  for (const nlohmann::json& p : j.at("events")) {
+    ReplanEvent e;
+    e.trigger = p.at("trigger").get<std::string>();
+    e.t_state_s = p.at("t_state_s").get<double>();
+    e.t_due_s = p.at("t_due_s").get<double>();
+    e.t_delivered_s = p.at("t_delivered_s").get<double>();
+    e.ok = p.at("ok").get<bool>();
+    e.error = p.at("error").get<std::string>();
+    e.identified = p.at("identified_model").get<bool>();
+    e.planned_fuel_kg = p.at("planned_fuel_kg").get<double>();
+    e.t_final_s = p.at("t_final_s").get<double>();
+    e.nodes = p.at("nodes").get<int>();
+    e.iterations = p.at("iterations").get<int>();
+    e.upload_id = p.at("upload_id").get<int>();
+    if (p.contains("solve_wall_s")) e.wall_s = p.at("solve_wall_s").get<double>();
+    r.events.push_back(std::move(e));
+  }
+  return r;
 }
 
 EstimationReport estimation_from_json(const nlohmann::json& j) {

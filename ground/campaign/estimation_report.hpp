@@ -11,7 +11,11 @@ namespace rocksteady::campaign {
 nlohmann::json estimation_json(const EstimationReport& e);
 nlohmann::json fdi_json(const FdiReport& f);
 FdiReport fdi_from_json(const nlohmann::json& j);
-nlohmann::json replan_json(const ReplanReport& r);
+// The re-planner's plans; `with_wall` adds each solve's wall time (not part of a reproducible
+// result: the dispersion tool's draw files leave it out).
+nlohmann::json replan_json(const ReplanReport& r, bool with_wall = true);
+// Throws nlohmann::json::exception on a malformed object (the caller names the file).
+ReplanReport replan_from_json(const nlohmann::json& j);
 // Throws nlohmann::json::exception on a malformed object (the caller names the file).
 EstimationReport estimation_from_json(const nlohmann::json& j);
 

@@ -78,6 +78,7 @@ StrategyOutcome outcome_of(const campaign::RunResult& r, double eps_trans) {
   o.final_rate_rad_s = r.final_rate_rad_s;
   o.final_q_error = r.final_q_error;
   o.final_mode = r.final_mode;
+  o.replan = r.replan;
   o.ticks = r.ticks;
   o.clipped_ticks = r.clipped_ticks;
   o.saturated_ticks = r.saturated_ticks;
@@ -359,26 +360,29 @@ json to_json(const DrawResult& r, bool with_timing) {
   json runs = json::array();
   json run_wall = json::object();
   for (const StrategyOutcome& o : r.runs) {
-    runs.push_back({{"strategy", o.strategy},
-                    {"status", o.status},
-                    {"note", o.note},
-                    {"success", o.success},
-                    {"t_omega_conv_s", opt(o.t_omega_conv_s)},
-                    {"fuel_at_t_omega_kg", opt(o.fuel_at_t_omega_kg)},
-                    {"t_q_conv_s", opt(o.t_q_conv_s)},
-                    {"fuel_at_t_q_kg", opt(o.fuel_at_t_q_kg)},
-                    {"total_fuel_kg", opt(o.total_fuel_kg)},
-                    {"fuel_estimate_kg", o.fuel_hat_kg},
-                    {"max_rate_rad_s", o.max_rate_rad_s},
-                    {"final_rate_rad_s", o.final_rate_rad_s},
-                    {"final_q_error", o.final_q_error},
-                    {"final_mode", o.final_mode},
-                    {"ticks", o.ticks},
-                    {"plant_clipped_ticks", o.clipped_ticks},
-                    {"allocator_saturated_ticks", o.saturated_ticks},
-                    {"simulated_s", o.sim_s},
-                    {"estimation", campaign::estimation_json(o.estimation)},
-                    {"fdi", campaign::fdi_json(o.fdi)}});
+    json run = {{"strategy", o.strategy},
+                {"status", o.status},
+                {"note", o.note},
+                {"success", o.success},
+                {"t_omega_conv_s", opt(o.t_omega_conv_s)},
+                {"fuel_at_t_omega_kg", opt(o.fuel_at_t_omega_kg)},
+                {"t_q_conv_s", opt(o.t_q_conv_s)},
+                {"fuel_at_t_q_kg", opt(o.fuel_at_t_q_kg)},
+                {"total_fuel_kg", opt(o.total_fuel_kg)},
+                {"fuel_estimate_kg", o.fuel_hat_kg},
+                {"max_rate_rad_s", o.max_rate_rad_s},
+                {"final_rate_rad_s", o.final_rate_rad_s},
+                {"final_q_error", o.final_q_error},
+                {"final_mode", o.final_mode},
+                {"ticks", o.ticks},
+                {"plant_clipped_ticks", o.clipped_ticks},
+                {"allocator_saturated_ticks", o.saturated_ticks},
+                {"simulated_s", o.sim_s},
+                {"estimation", campaign::estimation_json(o.estimation)},
+                {"fdi", campaign::fdi_json(o.fdi)}};
+    // The plans of a replan strategy, without their solve wall times (the result is reproducible).
+    if (o.replan.enabled) run["replan"] = campaign::replan_json(o.replan, false);
+    runs.push_back(std::move(run));
     run_wall[o.strategy] = o.wall_s;
   }
   json out = {{"result",
@@ -482,6 +486,7 @@ DrawResult draw_from_json(const json& top) {
     x.sim_s = o.at("simulated_s").get<double>();
     if (o.contains("estimation")) x.estimation = campaign::estimation_from_json(o.at("estimation"));
     if (o.contains("fdi")) x.fdi = campaign::fdi_from_json(o.at("fdi"));
+    if (o.contains("replan")) x.replan = campaign::replan_from_json(o.at("replan"));
     if (timing != nullptr && timing->at("run_wall_s").contains(x.strategy)) {
       x.wall_s = timing->at("run_wall_s").at(x.strategy).get<double>();
     }

@@ -58,6 +58,7 @@ struct StrategyOutcome {
   double wall_s{0.0};  // timing (not part of the result proper)
   campaign::EstimationReport estimation;  // estimator and identification against the truth
   campaign::FdiReport fdi;                // fault detection
+  campaign::ReplanReport replan;          // the re-planner's plans (replan strategies)
 };
 
 struct DrawResult {

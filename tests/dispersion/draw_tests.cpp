@@ -87,5 +87,54 @@ TEST(DrawFlown, ReflownDrawIsBitForBitAndJsonRoundTripsExactly) {
   EXPECT_EQ(to_json(c).dump(), to_json(a).dump());
 }
 
+// A replan strategy's plans are in its draw file (a re-flown draw says what the re-planner did),
+// without the solves' wall times, and read back exactly.
+TEST(DrawFlown, ReplanEventsAreWrittenWithoutWallTimesAndReadBack) {
+  Fixture f;
+  NoPlanner planner;
+  DrawResult a = fly_draw(f.mission, f.gnc, f.spec, Sampler(f.spec, f.mission), 3, planner);
+  ASSERT_FALSE(a.runs.empty());
+  EXPECT_EQ(to_json(a)["result"]["runs"][0].count("replan"), 0u);  // not a replan strategy
+  campaign::ReplanReport& rp = a.runs[0].replan;
+  rp.enabled = true;
+  rp.plans = 2;
+  rp.failed = 1;
+  rp.delivered = 1;
+  rp.switched = 1;
+  for (int i = 0; i < 2; ++i) {
+    campaign::ReplanEvent e;
+    e.trigger = i == 0 ? "first" : "periodic";
+    e.t_state_s = 827.9 + 600.0 * i;
+    e.t_due_s = e.t_state_s + 10.0;
+    e.t_delivered_s = i == 0 ? e.t_due_s : -1.0;
+    e.ok = i == 0;
+    e.error = i == 0 ? "" : "not verified";
+    e.identified = true;
+    e.planned_fuel_kg = 65.29 - 15.0 * i;
+    e.t_final_s = 2157.27 - 500.0 * i;
+    e.nodes = 101 + i;
+    e.iterations = 77 + i;
+    e.wall_s = 1.25;
+    e.upload_id = 10 + i;
+    rp.events.push_back(e);
+  }
+  const nlohmann::json j = to_json(a);
+  const nlohmann::json& events = j["result"]["runs"][0]["replan"]["events"];
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].count("solve_wall_s"), 0u);
+  const DrawResult back = draw_from_json(j);
+  const campaign::ReplanReport& r = back.runs[0].replan;
+  EXPECT_TRUE(r.enabled);
+  EXPECT_EQ(r.failed, 1);
+  ASSERT_EQ(r.events.size(), 2u);
+  EXPECT_EQ(r.events[1].trigger, "periodic");
+  EXPECT_EQ(r.events[1].error, "not verified");
+  EXPECT_EQ(r.events[1].t_delivered_s, -1.0);
+  EXPECT_EQ(r.events[0].planned_fuel_kg, 65.29);
+  EXPECT_EQ(r.events[1].upload_id, 11);
+  EXPECT_EQ(r.events[0].wall_s, 0.0);  // not written
+  EXPECT_EQ(to_json(back).dump(), j.dump());
+}
+
 }  // namespace
 }  // namespace rocksteady::dispersion
