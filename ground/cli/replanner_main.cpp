@@ -173,7 +173,8 @@ int main(int argc, char** argv) {
   app.add_option("--min-interval", pol.min_interval_s, "between two plans, s")->capture_default_str();
   app.add_option("--error-fraction", pol.error_fraction, "tracking-error trigger (0: off)")
       ->capture_default_str();
-  app.add_option("--horizon-factor", pol.horizon_factor, "horizon, shortest despins (0: automatic, 16 when the gnc file's "
+  app.add_option("--horizon-factor", pol.horizon_factor,
+                 "horizon, shortest despins (0: automatic, 16 when the gnc file's "
                  "guidance.track_momentum_k > 0, else 8)")
       ->capture_default_str();
   app.add_option("--min-horizon", pol.min_horizon_s, "shortest horizon, s")->capture_default_str();

@@ -63,7 +63,7 @@ struct ReplanPolicy {
   double min_interval_s{120.0};     // between two plans (also after a failed one)
   double latency_s{10.0};           // planning latency: delivered no earlier than t + latency
   // t_f = factor x shortest despin from the state (<= 0: automatic, kMomentumHorizonFactor when the
-  // flight tracks the plan's momentum, guidance.track_momentum_k > 0, else kHorizonFactor),
+  // flight tracks the plan's momentum, guidance.track_momentum_k > 0, else kHorizonFactor).
   double horizon_factor{0.0};
   double min_horizon_s{0.0};  // the first plan at least this long (the least fuel falls with t_f)
   // Plan for the model the flight tracks with: once the identified model is confident, while it

@@ -44,13 +44,13 @@ ReplanOptions fast_policy(double latency_s) {
 }
 
 RunResult fly(const config::RunSetup& s, const ReplanOptions& policy, double duration,
-              double log_interval) {
+              double log_interval, const std::string& strategy = "ntcl+replan") {
   FswFlightSide flight;
   RunOptions opt;
   opt.duration_s = duration;
   opt.log_interval_s = log_interval;
   opt.replan = policy;
-  return run_closed_loop(s, *parse_strategy("ntcl+replan"), flight, nullptr, opt);
+  return run_closed_loop(s, *parse_strategy(strategy), flight, nullptr, opt);
 }
 
 TEST(ReplanStrategy, NameParsesWithIdentificationImplied) {
@@ -247,13 +247,10 @@ TEST(ReplanStrategy, MomentumTrackingFliesCase7sFirstPlanForLessFuelThanTheNtcl)
                                               kConfigs + "/cases/case7.yaml");
   ASSERT_EQ(s.flight.guidance.track_momentum_k, 0.0);  // gnc.yaml: the study's law on the rates
   const auto fly7 = [&](double momentum_k) {
-    FswFlightSide flight;
-    RunOptions opt;
-    opt.duration_s = 1430.0;
-    opt.log_interval_s = 0.0;
-    opt.replan.momentum_k = momentum_k;
-    opt.replan.horizon_factor = ground::planner::kHorizonFactor;  // the same plan for both
-    return run_closed_loop(s, *parse_strategy("ntcl+replan:mekf"), flight, nullptr, opt);
+    ReplanOptions o;
+    o.momentum_k = momentum_k;
+    o.horizon_factor = ground::planner::kHorizonFactor;  // the same plan for both
+    return fly(s, o, 1430.0, 0.0, "ntcl+replan:mekf");
   };
   const RunResult ntcl = fly7(0.0);
   const RunResult momentum = fly7(ReplanOptions{}.momentum_k);
@@ -285,12 +282,10 @@ TEST(ReplanStrategy, WithMomentumTrackingTheLongerHorizonDespinsCase7ForLessFuel
   ASSERT_LE(ReplanOptions{}.horizon_factor, 0.0);  // the re-planner's automatic horizon
   ASSERT_GT(ReplanOptions{}.momentum_k, 0.0);
   const auto fly7 = [&](double horizon_factor) {
-    FswFlightSide flight;
-    RunOptions opt;
-    opt.duration_s = 6500.0;  // both despins over (16 despins: by ~5700 s)
-    opt.log_interval_s = 0.0;
-    opt.replan.horizon_factor = horizon_factor;
-    return run_closed_loop(s, *parse_strategy("ntcl+replan:mekf"), flight, nullptr, opt);
+    ReplanOptions o;
+    o.horizon_factor = horizon_factor;
+    // 6500 s: both despins over (16 despins: by ~5700 s).
+    return fly(s, o, 6500.0, 0.0, "ntcl+replan:mekf");
   };
   const RunResult eight = fly7(ground::planner::kHorizonFactor);
   const RunResult automatic = fly7(0.0);
