@@ -223,6 +223,7 @@ GncConfig load_gnc(const std::string& path) {
       xc.duration_s = x.non_negative("duration_s");
       xc.r_sigma_stop_m = x.positive("r_sigma_stop_m");
       if (x.has("start_after_s")) xc.start_after_s = x.non_negative("start_after_s");
+      if (x.has("r_sigma_target_m")) xc.r_sigma_target_m = x.non_negative("r_sigma_target_m");
       x.finish();
     }
     r.finish();

@@ -678,6 +678,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
           static_cast<double>(ident_.counters().windows) * params_.identification.config.window_s;
       if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable,
                                     identified_s)) {
+        // (X7) The amplitude for this window's noise (fixed within a window: the noise is the
+        // last closed window's).
+        excite_.size_to_window_noise(ident_.latched_window_noise(),
+                                     params_.identification.config.window_s);
         excite_status_ = excite_.apply(excite_.force(ident_.counters().windows), lim.lo, lim.hi,
                                        params_.dt, u);
       }

@@ -26,6 +26,9 @@ ExcitationConfigCheck validate(const ExcitationConfig& c) {
   if (!finite_positive(c.r_sigma_stop_m)) {
     return {false, "identification.excitation.r_sigma_stop_m", "must be positive and finite"};
   }
+  if (!(std::isfinite(c.r_sigma_target_m) && c.r_sigma_target_m >= 0.0)) {
+    return {false, "identification.excitation.r_sigma_target_m", "must be >= 0 and finite"};
+  }
   return {};
 }
 
@@ -40,6 +43,32 @@ void IdentificationExcitation::configure(const ExcitationConfig& c) {
       ++n_directions_;
     }
   }
+  // (X7) Every component of r is seen from the forces normal to it: r_a from the other axes'.
+  min_pair_ = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    double pair = 0.0;
+    for (int b = 0; b < 3; ++b) {
+      if (b != a) pair += c.force_n(b) * c.force_n(b);
+    }
+    if (a == 0 || pair < min_pair_) min_pair_ = pair;
+  }
+  scale_ = 1.0;
+}
+
+void IdentificationExcitation::size_to_window_noise(double rho, double window_s) {
+  // (X7) (X1) summed over a cycle: an axis a of the n in the cycle gets 1/n of the D/T windows, and
+  // the others' forces f_b give r_a the information (D/T)(1/n)(T^2/(4 rho)) sum_{b != a} f_b^2.
+  // Set to 1/sigma^2 for the worst-seen component and solved for the common scale s of f.
+  scale_ = 1.0;
+  const double sigma = config_.r_sigma_target_m;
+  const double d = config_.duration_s;
+  if (!(sigma > 0.0) || !(d > 0.0) || !(min_pair_ > 0.0) || !(rho > 0.0) || !std::isfinite(rho) ||
+      !(window_s > 0.0) || !std::isfinite(window_s)) {
+    return;
+  }
+  const double n = static_cast<double>(n_directions_ / 2);
+  const double s2 = 4.0 * n * rho / (d * window_s * sigma * sigma * min_pair_);
+  scale_ = s2 < 1.0 ? std::sqrt(s2) : 1.0;
 }
 
 void IdentificationExcitation::set_model(const Mat38& b_hat, const RcsLayout& rcs) {
@@ -115,7 +144,7 @@ bool IdentificationExcitation::wanted(double max_r_sigma, int unobservable,
 
 Vec3 IdentificationExcitation::force(std::uint32_t window_index) const {
   if (n_directions_ == 0) return Vec3::Zero();
-  return directions_[window_index % static_cast<std::uint32_t>(n_directions_)];  // (X3)
+  return scale_ * directions_[window_index % static_cast<std::uint32_t>(n_directions_)];  // (X3), (X7)
 }
 
 ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, const Vec8& hi,

@@ -14,6 +14,9 @@
 // window (X3): every component of r is normal to four of the six, and a constant unmodelled
 // torque (a gyro bias's gyroscopic term, a disturbance) cancels between a window and the next.
 //
+// (X7) With r_sigma_target_m > 0 the amplitudes are scaled per window to what (X6) needs for that
+// 1 sigma of r given the identifier's window noise: quiet gyros fly a tenth of noisy ones' force.
+//
 // N and Z depend only on B_hat and E: they are computed once per model change, spread over
 // kModelStages ticks (set_model, then step_model once a tick); the excitation stays off until
 // they are ready. Per tick: 24 multiply-adds for N F, a scan of the eight channels and eight
@@ -40,6 +43,11 @@ struct ExcitationConfig {
   // Start only after this much identification (closed windows times their length, s): the first
   // windows, with r_hat still up to 1 m off, would fit the excitation's torque into J (README §I.6).
   double start_after_s{0.0};
+  // (X7) 0: force_n is flown as given. > 0: force_n is the largest amplitude, and each window flies
+  // force_n * s with the s that (X6) needs for this 1 sigma of r over duration_s of excitation,
+  // given the identifier's window noise (at most 1): quiet sensors need a fraction of the force
+  // that noisy ones do (README §I.6).
+  double r_sigma_target_m{0.0};
 };
 
 struct ExcitationConfigCheck {
@@ -76,8 +84,15 @@ class IdentificationExcitation {
   // r_sigma_stop_m in every direction (max_r_sigma: largest 1 sigma of r_hat; unobservable:
   // directions of r the data have not shown).
   bool wanted(double max_r_sigma, int unobservable, double identified_s) const;
+  // (X7) Sizes the amplitude to the window noise: rho, the variance of one row of the
+  // identifier's window equation ((N m s)^2, I5), for windows of window_s. With
+  // r_sigma_target_m > 0, s = min(1, sqrt(4 n rho / (D T sigma^2 min_a sum_{b != a} f_b^2))), n the
+  // axes in the cycle, D = duration_s, T = window_s, f = force_n; otherwise (or when rho or T is
+  // not a positive finite number) s = 1. A few multiplies and a square root.
+  void size_to_window_noise(double rho, double window_s);
+  double amplitude_scale() const { return scale_; }
   // The force of window `window_index` (X3): +x, -x, +y, -y, +z, -z with the axes' amplitudes
-  // (axes at zero amplitude skipped).
+  // (axes at zero amplitude skipped), times amplitude_scale() (X7).
   Vec3 force(std::uint32_t window_index) const;
   // Adds the excitation for net force f to the allocated channel forces u (effective force, as
   // B_hat multiplies) within lo <= u <= hi (X4, X5), and counts dt of excitation time. Returns
@@ -103,6 +118,8 @@ class IdentificationExcitation {
   Mat82 z_{Mat82::Zero()};
   Vec3 directions_[kDirections]{};
   int n_directions_{0};
+  double min_pair_{0.0};  // min over the cycle's axes a of sum_{b != a} f_b^2 (X7), N^2
+  double scale_{1.0};     // (X7)
   int stage_{kModelStages};
   bool valid_{false};
   double elapsed_{0.0};

@@ -289,6 +289,9 @@ class Identifier {
   const IdentifierExcitation& excitation() const { return exc_; }
   const IdentifierObservability& observability() const { return obs_; }
   const IdentifierCounters& counters() const { return counters_; }
+  // (I5) The variance of one row of the last closed window's equation, (N m s)^2: the gyro's
+  // noise through the window, the held disturbance, the floor (0 before the first window).
+  double latched_window_noise() const { return counters_.windows > 0 ? latched_noise_ : 0.0; }
   const Mat6& inertia_covariance() const { return p_j_; }
   const Mat3& offset_covariance() const { return p_r_; }
   const Mat16& strength_covariance() const { return p_k_; }

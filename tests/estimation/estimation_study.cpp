@@ -4,7 +4,7 @@
 // Farrenkopf steady state. Ground tool: prints a table, asserts nothing.
 //
 //   estimation_study CONFIG_DIR
-//   estimation_study CONFIG_DIR excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M]]]
+//   estimation_study CONFIG_DIR excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M [R_SIGMA_TARGET_M]]]]
 //     the seven cases with the flight's identifier settings, without and with the identification
 //     excitation (README §I.6), and the fuel each run spent
 #include <cmath>
@@ -58,6 +58,7 @@ struct Outcome {
   double fuel_kg{0.0};
   double excitation_s{0.0};
   double gamma_mean{0.0};
+  double scale_mean{0.0};  // mean amplitude scale of (X7) over the excited ticks
 };
 
 // window_s <= 0: the flight's window for the case (gnc.yaml, quiet or noisy sensors).
@@ -106,6 +107,7 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
   for (int i = 0; i < gnc::IdentificationExcitation::kModelStages; ++i) ex.step_model();
   const Vec8 lo = Vec8::Constant(-run.flight.rcs.u_max), hi = Vec8::Constant(run.flight.rcs.u_max);
   double gamma_sum = 0.0;
+  double scale_sum = 0.0;
   long excited_ticks = 0;
   gnc::Identifier id;
   id.configure(c);
@@ -141,7 +143,9 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
     Vec8 u = allocate(b_hat, dpd(s.gyro.rate, s.star.quat, pd), run.flight.rcs.u_max);
     if (ex.wanted(id.estimate().r_sigma.maxCoeff(), id.observability().offset_unobservable,
                   static_cast<double>(id.counters().windows) * c.window_s)) {
+      ex.size_to_window_noise(id.latched_window_noise(), c.window_s);  // (X7)
       const gnc::ExcitationStatus xs = ex.apply(ex.force(id.counters().windows), lo, hi, c.dt, u);
+      scale_sum += ex.amplitude_scale();
       gamma_sum += xs.gamma;
       ++excited_ticks;
     }
@@ -151,6 +155,7 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
   }
   out.excitation_s = ex.elapsed();
   out.gamma_mean = excited_ticks > 0 ? gamma_sum / static_cast<double>(excited_ticks) : 0.0;
+  out.scale_mean = excited_ticks > 0 ? scale_sum / static_cast<double>(excited_ticks) : 0.0;
   if (!print) return out;
   std::printf("case %d %-10s T=%2.0f s k0 1s %.2f bias %.0e |", case_number,
               mode == gnc::IdentifierMode::kJoint ? "joint" : "concurrent", window_s, k_prior_sigma,
@@ -166,8 +171,10 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
 
 // The seven cases without and with the excitation: markdown rows for the design note.
 void excitation_table(const std::string& dir, const gnc::ExcitationConfig& x) {
-  std::printf("excitation F (%.0f, %.0f, %.0f) N, after %.0f s, at most %.0f s, stop at r 1s %.3f m%s\n",
+  std::printf("excitation F (%.0f, %.0f, %.0f) N, after %.0f s, at most %.0f s, stop at r 1s %.3f m, "
+              "sized for r 1s %.3f m (0: not sized)%s\n",
               x.force_n(0), x.force_n(1), x.force_n(2), x.start_after_s, x.duration_s, x.r_sigma_stop_m,
+              x.r_sigma_target_m,
               g_estimate_bias ? ", gyro bias estimated" : "");
   std::printf("| case | excitation | 60 s | 300 s | 600 s | 1000 s | 3000 s | fuel 3000 s (kg) | excited (s) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
@@ -181,7 +188,8 @@ void excitation_table(const std::string& dir, const gnc::ExcitationConfig& x) {
       for (const Errors& e : o->e) {
         std::printf(" %.1e · %.3f (%.3f) · %.3f |", e.j, e.r, e.r_sigma_max, e.k);
       }
-      std::printf(" %.2f | %.0f (gamma %.2f) |\n", o->fuel_kg, o->excitation_s, o->gamma_mean);
+      std::printf(" %.2f | %.0f (gamma %.2f, scale %.3f) |\n", o->fuel_kg, o->excitation_s, o->gamma_mean,
+                  o->scale_mean);
     }
     std::printf("| %d | cost | | | | | | %+.2f | |\n", cs, b.fuel_kg - a.fuel_kg);
     std::fflush(stdout);
@@ -269,8 +277,8 @@ int run(int argc, char** argv) {
     g_estimate_bias = true;
     --argc;
   }
-  if (argc < 2 || (argc > 2 && std::string(argv[2]) != "excitation") || argc > 6) {
-    std::fprintf(stderr, "usage: %s CONFIG_DIR [excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M]]]]\n",
+  if (argc < 2 || (argc > 2 && std::string(argv[2]) != "excitation") || argc > 7) {
+    std::fprintf(stderr, "usage: %s CONFIG_DIR [excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M [R_SIGMA_TARGET_M]]]]]\n",
                  argv[0]);
     return 2;
   }
@@ -294,6 +302,7 @@ int run(int argc, char** argv) {
     }
     if (argc > 4) x.duration_s = std::stod(argv[4]);
     if (argc > 5) x.r_sigma_stop_m = std::stod(argv[5]);
+    if (argc > 6) x.r_sigma_target_m = std::stod(argv[6]);
     const gnc::ExcitationConfigCheck xc = gnc::validate(x);
     if (!xc.ok) {
       std::fprintf(stderr, "bad excitation: %s: %s\n", xc.field, xc.reason);

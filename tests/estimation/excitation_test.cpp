@@ -210,6 +210,75 @@ TEST(IdentificationExcitation, ConfigValidationNamesTheField) {
   c = ExcitationConfig{};
   c.start_after_s = -1.0;
   EXPECT_STREQ(validate(c).field, "identification.excitation.start_after_s");
+  c = ExcitationConfig{};
+  c.r_sigma_target_m = -0.01;
+  EXPECT_STREQ(validate(c).field, "identification.excitation.r_sigma_target_m");
+}
+
+// (X7) Sized to the window noise. Independent truth: the information on r summed window by window
+// from (X1), I_win = (T^2 / 4 rho) (|F|^2 I - F F'), over the D/T windows the cycle flies with the
+// scaled forces; its inverse's largest diagonal is the worst 1 sigma, which the sizing must put at
+// the target (or below it, at full amplitude, when the noise asks for more than force_n).
+double worst_sigma_from_windows(const IdentificationExcitation& ex, double rho, double t_win,
+                                double duration) {
+  Mat3 info = Mat3::Zero();
+  const int windows = static_cast<int>(std::lround(duration / t_win));
+  for (int w = 0; w < windows; ++w) {
+    const Vec3 f = ex.force(static_cast<std::uint32_t>(w));
+    info += (t_win * t_win / (4.0 * rho)) * (f.squaredNorm() * Mat3::Identity() - f * f.transpose());
+  }
+  return std::sqrt(info.inverse().diagonal().maxCoeff());
+}
+
+TEST(IdentificationExcitation, SizedToTheWindowNoiseTheCycleReachesTheTargetSigma) {
+  // 24 windows: whole cycles of six and of four directions.
+  const double t_win = 20.0, duration = 480.0, target = 0.01;
+  for (const Vec3& force : {Vec3(100.0, 100.0, 400.0), Vec3(100.0, 100.0, 0.0), Vec3(50.0, 80.0, 20.0)}) {
+    ExcitationConfig c;
+    c.enabled = true;
+    c.force_n = force;
+    c.duration_s = duration;
+    c.r_sigma_target_m = target;
+    IdentificationExcitation ex;
+    ex.configure(c);
+    // The case-1 disturbance's window noise (sqrt(rho) ~ 4.3 N m s), then case-6 noise (152).
+    for (const double rho : {4.3 * 4.3, 30.0 * 30.0, 152.0 * 152.0}) {
+      ex.size_to_window_noise(rho, t_win);
+      const double s = ex.amplitude_scale();
+      ASSERT_GT(s, 0.0);
+      ASSERT_LE(s, 1.0);
+      // The force flown is force_n times the scale, direction by direction.
+      EXPECT_NEAR(ex.force(0)(0), s * force(0), 1e-9 * force(0));  // +x first (X3)
+      EXPECT_NEAR(ex.force(1)(0), -s * force(0), 1e-9 * force(0));
+      const double sigma = worst_sigma_from_windows(ex, rho, t_win, duration);
+      if (s < 1.0) {
+        EXPECT_NEAR(sigma, target, 1e-9) << "force " << force.transpose() << " rho " << rho;
+      } else {
+        EXPECT_GE(sigma, target * (1.0 - 1e-12)) << "full amplitude only when it is not enough";
+      }
+    }
+    // With gnc.yaml's amplitudes quiet sensors need a fraction of the force; the case-6 window
+    // noise needs all of it.
+    if (force == Vec3(100.0, 100.0, 400.0)) {
+      ex.size_to_window_noise(4.3 * 4.3, t_win);
+      EXPECT_LT(ex.amplitude_scale(), 0.2);
+    }
+    ex.size_to_window_noise(152.0 * 152.0, 60.0);
+    EXPECT_EQ(ex.amplitude_scale(), 1.0) << force.transpose();
+    // No noise figure yet (before the first window), or nonsense: the amplitude as given.
+    for (const double bad : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
+      ex.size_to_window_noise(bad, t_win);
+      EXPECT_EQ(ex.amplitude_scale(), 1.0) << bad;
+    }
+  }
+  // Not sized (target 0): the amplitude as given, whatever the noise.
+  ExcitationConfig c;
+  c.enabled = true;
+  IdentificationExcitation ex;
+  ex.configure(c);
+  ex.size_to_window_noise(1.0, t_win);
+  EXPECT_EQ(ex.amplitude_scale(), 1.0);
+  EXPECT_EQ(ex.force(0), Vec3(c.force_n(0), 0.0, 0.0));
 }
 
 }  // namespace

@@ -304,7 +304,10 @@ struct DespinRun {
   double max_telemetry_force{0.0};   // largest |asked force| the telemetry reports, N
   double min_active_gamma{1.0};
 };
-DespinRun despin_identification(bool excite, AllocatorKind allocator) {
+// quiet: a noise-free gyro (the flight's 20 s window, no bias to consider), the disturbance kept.
+// r_sigma_target_m: the excitation sized to the window noise (X7); 0 flies force_n as given.
+DespinRun despin_identification(bool excite, AllocatorKind allocator, bool quiet = false,
+                                double r_sigma_target_m = 0.0) {
   const GncParams truth = study_gnc_params(200.0);
   test::SmallLoop loop(truth);
   loop.body.omega = Vec3(0.01, 0.02, 0.03);
@@ -317,10 +320,10 @@ DespinRun despin_identification(bool excite, AllocatorKind allocator) {
   p.mass_hat.j_ast(2, 2) -= 3.0e6;
   IdentificationParams& id = p.identification;
   id.enabled = true;
-  id.config.window_s = 60.0;
-  const double gyro_sigma = std::sqrt(1e-10 / p.dt);
+  id.config.window_s = quiet ? 20.0 : 60.0;
+  const double gyro_sigma = quiet ? 0.0 : std::sqrt(1e-10 / p.dt);
   id.config.gyro_sigma = gyro_sigma;
-  id.config.gyro_bias_sigma = 3e-5;
+  id.config.gyro_bias_sigma = quiet ? 0.0 : 3e-5;
   id.config.j_prior_sigma = 1e7;
   id.config.r_prior_sigma = 1.0;
   id.config.k_prior_sigma = 0.01;
@@ -329,6 +332,7 @@ DespinRun despin_identification(bool excite, AllocatorKind allocator) {
   id.excitation.enabled = excite;
   id.excitation.force_n = Vec3(100.0, 100.0, 400.0);
   id.excitation.start_after_s = 60.0;  // the flight setting (gnc.yaml)
+  id.excitation.r_sigma_target_m = r_sigma_target_m;
   EXPECT_TRUE(loop.gnc.init(p).ok);
   GncCommands c;
   c.has_mode_request = true;
@@ -392,6 +396,36 @@ TEST(GncIdentification, ExcitationRecoversTheOffsetWithin600sOfDespin) {
     EXPECT_LT(on.max_model_torque_gap, 1e-6) << to_string(a);
     EXPECT_LE(on.max_force, 200.0) << to_string(a);
   }
+}
+
+// (X7) With a quiet gyro the excitation sized for r to 1 cm (1 sigma) over its 600 s flies a
+// fraction of gnc.yaml's amplitudes and still recovers r to 2 cm within 600 s of despin, for a
+// fraction of the fuel; with case 7's gyro the same sizing asks for the whole amplitude.
+TEST(GncIdentification, SizedToTheGyroNoiseTheExcitationCostsAFractionOfTheFuel) {
+  const DespinRun off = despin_identification(false, AllocatorKind::kPseudoInverse, true);
+  const DespinRun full = despin_identification(true, AllocatorKind::kPseudoInverse, true);
+  const DespinRun sized = despin_identification(true, AllocatorKind::kPseudoInverse, true, 0.01);
+  const double full_cost = full.fuel_kg - off.fuel_kg;
+  const double sized_cost = sized.fuel_kg - off.fuel_kg;
+  RecordProperty("off_mm", static_cast<int>(1000.0 * off.r_error));
+  RecordProperty("full_mm", static_cast<int>(1000.0 * full.r_error));
+  RecordProperty("sized_mm", static_cast<int>(1000.0 * sized.r_error));
+  RecordProperty("full_cost_g", static_cast<int>(1000.0 * full_cost));
+  RecordProperty("sized_cost_g", static_cast<int>(1000.0 * sized_cost));
+  EXPECT_GT(off.r_error, 0.02) << "the quiet rig must need the excitation";
+  EXPECT_LE(full.r_error, 0.02);
+  EXPECT_LE(sized.r_error, 0.02) << "1 sigma " << sized.r_sigma;
+  EXPECT_LE(sized.r_sigma, 0.015);
+  EXPECT_GT(full_cost, 0.0);
+  EXPECT_LT(sized_cost, 0.25 * full_cost);
+  // The telemetry shows the scaled force, within gnc.yaml's amplitudes (400 N on z).
+  EXPECT_NEAR(full.max_telemetry_force, 400.0, 1e-9);
+  EXPECT_GT(sized.max_telemetry_force, 0.0);
+  EXPECT_LT(sized.max_telemetry_force, 0.25 * 400.0);
+  EXPECT_NEAR(sized.telemetry_active_ticks * 0.1, sized.excited_s, 0.1 + 1e-9);
+  // Case 7's gyro: the window noise needs all of force_n.
+  const DespinRun noisy = despin_identification(true, AllocatorKind::kPseudoInverse, false, 0.01);
+  EXPECT_NEAR(noisy.max_telemetry_force, 400.0, 1e-9);
 }
 
 TEST(GncIdentification, OffByDefaultAndTelemetryZero) {
