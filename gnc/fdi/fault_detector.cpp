@@ -172,6 +172,8 @@ void FaultDetector::reset() {
   check_prev_ = -1;
   quiet_var_ = 0.0;
   eval_unfit_ = false;
+  eval_slope_.setZero();
+  eval_stt_ = 0.0;
   const std::uint16_t on = st_.confirmed_on;
   const std::uint16_t off = st_.confirmed_off;
   const std::uint16_t degraded = st_.confirmed_degraded;
@@ -626,6 +628,8 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   // jet's signature b_i (a jet that produced less than commanded: -a b_i f); the part normal to
   // b_i is a model error the check exposed, not the jet.
   eval_unfit_ = false;
+  eval_slope_ = slope;  // (F31) what a check about to start must explain
+  eval_stt_ = stt;
   if (w.check_jet >= 0) {
     const Vec3& b = b_[static_cast<std::size_t>(w.check_jet)];
     if (check_normal_chi2(b, slope, stt, var) > p_.check_fit_chi2) {
@@ -1294,6 +1298,7 @@ void FaultDetector::update_check() {
   // Gnc, no torque on the model). Its stuck-off signature then has the energy of a firm firing:
   // a healthy jet loses about half of it from each hypothesis (exonerated within a window), a
   // failed one gains it (confirmed by F6 / F13 / F18 as before). Nothing here decides anything.
+  const bool suspicious = st_.chi2 > p_.suspect_chi2;  // the window just evaluated
   if (check_left_ > 0) {
     if (--check_left_ == 0) end_check();
     return;
@@ -1321,6 +1326,13 @@ void FaultDetector::update_check() {
     }
     const double e = std::fmax(score_[k + static_cast<std::size_t>(kThrusters)], deg_cusum_[k]);
     if (e < evidence) continue;
+    // (F31) After a suspicious window, only a jet whose signature the window's unexplained motion
+    // lies along (the fit of a check window, F19): motion normal to it is another fault's, which
+    // a check of this jet would only keep the bank from scoring.
+    if (p_.check_fit_on_suspicion && suspicious &&
+        check_normal_chi2(b_[k], eval_slope_, eval_stt_, eval_var_) > p_.check_fit_chi2) {
+      continue;
+    }
     if (signature_rel_error(i) <= p_.check_max_model_error &&
         (!(p_.check_min_llr > 0.0) || expected_check_llr(i) >= p_.check_min_llr)) {
       evidence = e;

@@ -127,6 +127,13 @@ struct FaultDetectorParams {
   // check and of the jets that compensate it). A check that cannot even undo the evidence that
   // started it only kicks the vehicle. 0: off.
   double check_min_llr{0.0};
+  // (F31) No check starts for an evident fault that is not its jet: after a window whose no-fault
+  // chi-square exceeded suspect_chi2, only a jet whose signature that window's unexplained motion
+  // lies along (check_fit_chi2, as a check window's fit) may be checked. A check's windows are not
+  // scored when they show motion that is not the checked jet's, so a check started on the
+  // stuck-off evidence that a stuck-on jet's first window raised kept the bank from scoring the
+  // stuck-on jet for the check's windows. false: as before.
+  bool check_fit_on_suspicion{false};
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -320,6 +327,8 @@ class FaultDetector {
   double quiet_var_{0.0};   // (F24) the residual variance of the last window flown without a check
   int check_prev_{-1};      // the jet checked on the previous update (its thrust is this one's)
   bool eval_unfit_{false};  // the evaluated window's check showed a model error: not scored
+  Vec3 eval_slope_{Vec3::Zero()};  // (F31) the evaluated window's residual slope ...
+  double eval_stt_{0.0};           // ... and its time spread (check_normal_chi2's inputs)
   bool eval_onset_{false};  // (F21) the evaluated window is the one a fault started in: not scored
   bool last_suspicious_{false};  // (F21) the window before it exceeded suspect_chi2
   std::array<std::uint32_t, kThrusters> last_check_{};  // window count at each jet's last check, +1

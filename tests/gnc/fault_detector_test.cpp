@@ -1189,6 +1189,89 @@ TEST(FaultDetector, AJetCheckConfirmsAPartialLossWithItsFactor) {
   }
 }
 
+// (F31) A jet stuck on near a check of a healthy jet, every jet at onsets before, inside and after
+// that check. A check's windows are not scored when they show motion that is not the checked
+// jet's (F19), so a check started on the stuck-off evidence that the stuck jet's first window
+// raised in another jet kept the bank from scoring the stuck jet. With (F31) no check starts after
+// a suspicious window for a jet that window's motion is not along. The harness honours the
+// detector's isolation tests (F9: the tested pod's valve closed) as the Gnc does. Check level low,
+// as in the healthy-check test below, so that checks are flown around the onsets.
+struct StuckDuringCheck {
+  DegradedRun run;
+  int checked_ticks_to_confirmation{0};  // ticks flown with any check from the onset to the confirmation
+};
+StuckDuringCheck fly_stuck_during_check(bool fit_on_suspicion, int stuck, int onset,
+                                        std::uint64_t seed) {
+  Truth t;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
+  p.degraded_min_loss = 0.1;
+  p.check_llr = 0.5;
+  p.check_fit_on_suspicion = fit_on_suspicion;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  d.set_model(identified_model(t));
+  WeakFiring firing(seed);
+  Vec16 prev = Vec16::Zero();
+  StuckDuringCheck out;
+  for (int k = 0; k < onset + 2000 && out.run.r.confirmed_at < 0; ++k) {
+    if (k == onset) t.stuck_on = stuck;
+    for (int q = 0; q < 4; ++q) t.valve[static_cast<std::size_t>(q)] = d.probe_pod() != q;
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    in.valve_open = t.valve;
+    out.run.note(d.update(in), k);
+    Vec16 cmd = firing.next(k);
+    if (d.check_jet() >= 0) {
+      cmd(d.check_jet()) += d.check_force();
+      if (k >= onset && out.run.r.confirmed_at < 0) ++out.checked_ticks_to_confirmation;
+    }
+    t.advance(cmd);
+    prev = cmd;
+  }
+  return out;
+}
+
+TEST(FaultDetector, NoCheckStartsForAnEvidentFaultThatIsNotItsJet) {
+  // Where the first check of a healthy jet starts under this firing.
+  Truth t0;
+  FaultDetector d0 = make_checking_detector(t0, 0.5);
+  const CheckRun healthy = fly_checked(t0, d0, 40000, 5);
+  ASSERT_FALSE(healthy.checked.empty());
+  const int start = healthy.check_ticks[0];
+  int given_way = 0;
+  for (int stuck = 0; stuck < 16; ++stuck) {
+    for (int off : {-200, -50, 3, 100, 400, 1000}) {
+      const int onset = start + off;
+      const std::string what = "thruster " + std::to_string(stuck) + " stuck on at tick " +
+                               std::to_string(onset);
+      const StuckDuringCheck before = fly_stuck_during_check(false, stuck, onset, 5);
+      const StuckDuringCheck after = fly_stuck_during_check(true, stuck, onset, 5);
+      for (const StuckDuringCheck* r : {&before, &after}) {
+        ASSERT_GE(r->run.r.confirmed_at, onset) << what;
+        EXPECT_EQ(r->run.r.thruster, stuck) << what;
+        EXPECT_EQ(r->run.r.kind, FaultKind::kStuckOn) << what;
+        EXPECT_EQ(r->run.confirmations, 1) << what;
+      }
+      // (F31) never later, never more check firing between the onset and the confirmation.
+      EXPECT_LE(after.run.r.confirmed_at, before.run.r.confirmed_at) << what;
+      EXPECT_LE(after.checked_ticks_to_confirmation, before.checked_ticks_to_confirmation) << what;
+      if (after.checked_ticks_to_confirmation < before.checked_ticks_to_confirmation &&
+          after.run.r.confirmed_at + 10 <= before.run.r.confirmed_at) {
+        ++given_way;
+        RecordProperty("given_way_" + std::to_string(stuck) + "_" + std::to_string(off),
+                       std::to_string(before.run.r.confirmed_at - onset) + " -> " +
+                           std::to_string(after.run.r.confirmed_at - onset) + " ticks");
+      }
+    }
+  }
+  // Thruster 4 stuck on inside the check's first window: the suspicious window raises another
+  // jet's stuck-off evidence, and without (F31) that jet's check delays the confirmation by
+  // three windows (127 -> 97 ticks on x86-64).
+  EXPECT_GE(given_way, 1) << "no check gave way to the stuck jet";
+}
+
 // Healthy jets checked (the check level set low enough that weak firing's noise starts checks):
 // each check exonerates the jet and nothing is confirmed; a jet is checked again only after
 // check_interval_s, and its third check only after twice that.
