@@ -1199,6 +1199,10 @@ TEST(FaultDetector, AJetCheckConfirmsAPartialLossWithItsFactor) {
 struct StuckDuringCheck {
   DegradedRun run;
   int checked_ticks_to_confirmation{0};  // ticks flown with any check from the onset to the confirmation
+  // Checks started on the decision after a suspicious window (the evaluated window's chi-square
+  // above suspect_chi2) for a jet whose signature (the truth's b_i = J^-1 (p_i + r) x e_i) is more
+  // than 30 degrees off that window's unexplained rate change.
+  int misaligned_starts{0};
 };
 StuckDuringCheck fly_stuck_during_check(bool fit_on_suspicion, int stuck, int onset,
                                         std::uint64_t seed) {
@@ -1221,10 +1225,19 @@ StuckDuringCheck fly_stuck_during_check(bool fit_on_suspicion, int stuck, int on
     in.omega_valid = true;
     in.thrust = prev;
     in.valve_open = t.valve;
+    const int checking = d.check_jet();
     out.run.note(d.update(in), k);
+    const int jet = d.check_jet();
+    if (jet >= 0 && jet != checking && d.status().chi2 > p.suspect_chi2) {
+      const auto i = static_cast<std::size_t>(jet);
+      const V3 b = t.body.j.inverse() * (t.pos[i] + t.r).cross(t.dir[i]);
+      const V3 m = d.status().residual;
+      const double c = std::fabs(b.dot(m)) / (b.norm() * m.norm());
+      if (c < std::cos(30.0 * M_PI / 180.0)) ++out.misaligned_starts;
+    }
     Vec16 cmd = firing.next(k);
-    if (d.check_jet() >= 0) {
-      cmd(d.check_jet()) += d.check_force();
+    if (jet >= 0) {
+      cmd(jet) += d.check_force();
       if (k >= onset && out.run.r.confirmed_at < 0) ++out.checked_ticks_to_confirmation;
     }
     t.advance(cmd);
@@ -1241,8 +1254,10 @@ TEST(FaultDetector, NoCheckStartsForAnEvidentFaultThatIsNotItsJet) {
   ASSERT_FALSE(healthy.checked.empty());
   const int start = healthy.check_ticks[0];
   int given_way = 0;
+  int misaligned_before = 0;
+  int misaligned_after = 0;
   for (int stuck = 0; stuck < 16; ++stuck) {
-    for (int off : {-200, -50, 3, 100, 400, 1000}) {
+    for (int off : {-200, -50, 1, 3, 5, 7, 9, 100, 400, 1000}) {
       const int onset = start + off;
       const std::string what = "thruster " + std::to_string(stuck) + " stuck on at tick " +
                                std::to_string(onset);
@@ -1257,6 +1272,8 @@ TEST(FaultDetector, NoCheckStartsForAnEvidentFaultThatIsNotItsJet) {
       // (F31) never later, never more check firing between the onset and the confirmation.
       EXPECT_LE(after.run.r.confirmed_at, before.run.r.confirmed_at) << what;
       EXPECT_LE(after.checked_ticks_to_confirmation, before.checked_ticks_to_confirmation) << what;
+      misaligned_before += before.misaligned_starts;
+      misaligned_after += after.misaligned_starts;
       if (after.checked_ticks_to_confirmation < before.checked_ticks_to_confirmation &&
           after.run.r.confirmed_at + 10 <= before.run.r.confirmed_at) {
         ++given_way;
@@ -1266,10 +1283,17 @@ TEST(FaultDetector, NoCheckStartsForAnEvidentFaultThatIsNotItsJet) {
       }
     }
   }
-  // Thruster 4 stuck on inside the check's first window: the suspicious window raises another
-  // jet's stuck-off evidence, and without (F31) that jet's check delays the confirmation by
-  // three windows (127 -> 97 ticks on x86-64).
-  EXPECT_GE(given_way, 1) << "no check gave way to the stuck jet";
+  RecordProperty("misaligned_starts_without", misaligned_before);
+  RecordProperty("given_way", given_way);
+  // With (F31) no check starts after a suspicious window for a jet that window's motion is not
+  // along (checked here against the truth's signatures, independently of the detector's fit).
+  EXPECT_EQ(misaligned_after, 0);
+  // Where such a check started without (F31), the stuck jet was confirmed at least a window
+  // sooner with it. The chaotic rig makes that happen on x86-64 (jet 4 at +3 and one more run:
+  // 127 -> 97 ticks), not under aarch64's rounding, where no misaligned check starts either way.
+  if (misaligned_before > 0) {
+    EXPECT_GE(given_way, 1) << "a misaligned check started and held the confirmation back";
+  }
 }
 
 // Healthy jets checked (the check level set low enough that weak firing's noise starts checks):
