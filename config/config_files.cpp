@@ -277,7 +277,9 @@ GncConfig load_gnc(const std::string& path) {
       fd.check_max_model_error = r.positive("check_max_model_error");
     }
     if (r.has("check_min_llr")) fd.check_min_llr = r.non_negative("check_min_llr");  // (F24)
-    if (r.has("check_fit_on_suspicion")) fd.check_fit_on_suspicion = r.boolean("check_fit_on_suspicion");  // (F31)
+    if (r.has("check_fit_on_suspicion")) {  // (F31)
+      fd.check_fit_on_suspicion = r.boolean("check_fit_on_suspicion");
+    }
     p.fdi_table_rel_sigma = r.non_negative("table_model_rel_sigma");
     r.finish();
   }

@@ -144,7 +144,8 @@ bool IdentificationExcitation::wanted(double max_r_sigma, int unobservable,
 
 Vec3 IdentificationExcitation::force(std::uint32_t window_index) const {
   if (n_directions_ == 0) return Vec3::Zero();
-  return scale_ * directions_[window_index % static_cast<std::uint32_t>(n_directions_)];  // (X3), (X7)
+  // (X3) the window's direction, (X7) at the sized amplitude
+  return scale_ * directions_[window_index % static_cast<std::uint32_t>(n_directions_)];
 }
 
 ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, const Vec8& hi,
