@@ -176,11 +176,13 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.check_llr = fdi ? 5.0 : 0.0;          // (F19) jet checks, as flown
   p.fdi.check_max_model_error = 0.5;          // ... against the model's stated 1 sigma, as flown
   p.fdi.check_min_llr = 5.0;                  // (F24) ... when the check can move the evidence
+  p.fdi.check_fit_on_suspicion = fdi;         // (F31) ... and not for an evident fault elsewhere
   p.fdi.model_rel_floor = 0.005;              // the model's relative error floor, as flown
   p.fdi.model_floor_gyroscopic = true;        // (F22) ... on both terms, as flown
   p.fdi.probe_windows = 1;                    // isolation tests of one window ...
   p.fdi.probe_aligned = true;                 // (F27) ... flown closed throughout, as flown
   p.fdi.probe_partial_rival = true;           // (F29) ... read against partial losses
+  p.fdi.probe_read_closed = true;             // (F32) ... and first on the closed window
   p.fdi.centred_gyro_noise = true;            // (F28) the gyro's variance sigma_g^2, as flown
   p.fdi.suspect_chi2 = 30.66;                 // ... and the suspicion at 1 - 1e-6, as flown
   p.fdi.skip_onset_window = true;             // (F21) the onset window not scored: 5-tick windows

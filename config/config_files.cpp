@@ -253,6 +253,7 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("probe_aligned")) fd.probe_aligned = r.boolean("probe_aligned");  // (F27), optional
     if (r.has("centred_gyro_noise")) fd.centred_gyro_noise = r.boolean("centred_gyro_noise");  // (F28), optional
     if (r.has("probe_partial_rival")) fd.probe_partial_rival = r.boolean("probe_partial_rival");  // (F29), optional
+    if (r.has("probe_read_closed")) fd.probe_read_closed = r.boolean("probe_read_closed");  // (F32), optional
     if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");

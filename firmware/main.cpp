@@ -212,6 +212,7 @@ int firmware_main() {
     g_params.fdi.probe_windows = 1;            // isolation tests of one window ...
     g_params.fdi.probe_aligned = true;         // (F27) ... flown closed throughout, as flown
     g_params.fdi.probe_partial_rival = true;   // (F29) ... read against partial losses
+    g_params.fdi.probe_read_closed = true;     // (F32) ... and first on the closed window
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows

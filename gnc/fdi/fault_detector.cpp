@@ -807,12 +807,29 @@ void FaultDetector::decide() {
   }
   if (probe_left_ > 0) {
     // (F15) A window flown with the tested pod closed throughout.
-    if (eval_open_fraction_ <= 0.0) ++probe_closed_;
+    if (eval_open_fraction_ <= 0.0) {
+      ++probe_closed_;
+      for (std::size_t h = 0; h < closed_llr_.size(); ++h) closed_llr_[h] += window_llr_[h];
+      for (std::size_t i = 0; i < closed_energy_.size(); ++i) {
+        closed_energy_[i] += window_energy_[i];
+      }
+    }
     if (--probe_left_ == 0) {
       st_.probe_pod = -1;
       ambiguous_windows_ = 0;
       probe_ended = true;
       verdict_pending_ = true;
+      // (F32) The verdict on the window before the closure and the closed ones; the confirmation
+      // closes the valve on this same update, so the tested pod stays closed.
+      const int h = p_.probe_read_closed ? closed_probe_verdict() : -1;
+      if (h >= 0) {
+        end_probe_verdict();
+        declare(h, FaultKind::kStuckOn);
+        pending_.confirmed = true;
+        pending_.thruster = h;
+        pending_.kind = FaultKind::kStuckOn;
+        return;
+      }
     }
   } else if (verdict_pending_ && eval_open_fraction_ >= 0.5) {
     // (F15) The first window flown mostly with the tested pod open again.
@@ -896,6 +913,11 @@ void FaultDetector::decide() {
     ambiguous_windows_ = 0;
     end_probe_verdict();
     probe_tested_pod_ = pod;
+    trigger_llr_ = window_llr_;  // (F32)
+    trigger_energy_ = window_energy_;
+    closed_llr_.fill(0.0);
+    closed_energy_.fill(0.0);
+    probe_blocker_ = blocking;
   }
 }
 
@@ -1154,6 +1176,65 @@ int FaultDetector::probe_verdict() const {
       const auto k = static_cast<std::size_t>(i);
       const double partial =
           fitted_loss_llr(probe_llr_[k + static_cast<std::size_t>(kThrusters)], probe_energy_[k]);
+      if (best_llr - partial <= p_.margin_llr) return -1;
+    }
+  }
+  return best;
+}
+
+int FaultDetector::closed_probe_verdict() const {
+  // (F32) Read when the test's closed windows end. The window that started the test showed the
+  // motion (the leader, a stuck-on jet of the tested pod, ahead of everything beyond its own pod
+  // only within the model's error); in every window flown with the pod closed throughout it was
+  // gone. A stuck-on jet of another pod, behind its open valve, would have gone on firing there
+  // (LLR -E/2 per quiet window); a stuck-off jet shows only where it is commanded. So the sum over
+  // the start window and the closed ones is read as (F15) reads its own, with two conditions of
+  // its own: the alternative that blocked the leader is contradicted by the closed windows (it is
+  // on another pod, or no closure could have told them apart), and so is every alternative the
+  // start window alone cannot tell from the leader by margin_llr. Anything else waits for the
+  // reopened window (F15).
+  if (probe_closed_ == 0 || probe_tested_pod_ < 0) return -1;
+  const auto sum = [this](int h) {
+    const auto k = static_cast<std::size_t>(h);
+    return trigger_llr_[k] + closed_llr_[k];
+  };
+  int best = -1;
+  double best_llr = -1e300;
+  double second = -1e300;
+  for (int h = 0; h < kHypotheses; ++h) {
+    const double l = sum(h);
+    if (l > best_llr) {
+      second = best_llr;
+      best_llr = l;
+      best = h;
+    } else if (l > second) {
+      second = l;
+    }
+  }
+  if (best < 0 || best >= kThrusters || pod_[static_cast<std::size_t>(best)] != probe_tested_pod_) {
+    return -1;
+  }
+  if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  const auto contradicted = [this](int g) {
+    return closed_llr_[static_cast<std::size_t>(g)] < -p_.margin_llr;
+  };
+  if (probe_blocker_ < 0 || !contradicted(probe_blocker_)) return -1;
+  const double lead_start = trigger_llr_[static_cast<std::size_t>(best)];
+  for (int g = 0; g < kHypotheses; ++g) {
+    if (g == best) continue;
+    const int tg = g % kThrusters;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> tg) & 1u) != 0) continue;
+    if (g < kThrusters && pod_[static_cast<std::size_t>(tg)] == probe_tested_pod_) continue;
+    const double lead = lead_start - trigger_llr_[static_cast<std::size_t>(g)];
+    if (lead <= p_.margin_llr && !contradicted(g)) return -1;
+  }
+  if (p_.probe_partial_rival) {  // (F29) over the same windows
+    for (int i = 0; i < kThrusters; ++i) {
+      if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+      const auto k = static_cast<std::size_t>(i);
+      const auto ko = k + static_cast<std::size_t>(kThrusters);
+      const double partial = fitted_loss_llr(trigger_llr_[ko] + closed_llr_[ko],
+                                             trigger_energy_[k] + closed_energy_[k]);
       if (best_llr - partial <= p_.margin_llr) return -1;
     }
   }

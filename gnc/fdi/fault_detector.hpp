@@ -78,6 +78,13 @@ struct FaultDetectorParams {
   // (F29) A test's verdict (F15) names its stuck-on jet only when it also leads, over the test's
   // windows, every jet's partial loss of thrust (F13's fit) by margin_llr.
   bool probe_partial_rival{false};
+  // (F32) The verdict is first read when the test's closed windows end, on the window that started
+  // the test and the closed ones: the motion was there before the closure and gone behind it. It
+  // names the tested pod's stuck-on jet as (F15) does, and only when the closed windows contradict
+  // the alternative that started the test and every other one that window could not tell from the
+  // leader; otherwise the valve reopens and (F15) reads the reopened window as before. A stuck-on
+  // jet so decided never fires again (false: the valve always reopens for the verdict).
+  bool probe_read_closed{false};
   // (F14) Stuck-on isolation inside identification: the identifier's constant fault torque d
   // (estimation README I22) scored against each stuck-on column (I23). Thruster i is confirmed
   // stuck on when, in identified_windows fitted windows in a row, d-hat is at least
@@ -474,6 +481,15 @@ class FaultDetector {
   // (F29) ... and each jet's stuck-off energy over the same windows, for its partial loss.
   std::array<double, kThrusters> probe_energy_{};
   int probe_llr_pod_{-1};
+  // (F32) The window that started the test (its LLR and stuck-off energy per hypothesis), the
+  // alternative that blocked its leader, and the sums over this test's windows flown closed
+  // throughout.
+  std::array<double, kHypotheses> trigger_llr_{};
+  std::array<double, kThrusters> trigger_energy_{};
+  std::array<double, kHypotheses> closed_llr_{};
+  std::array<double, kThrusters> closed_energy_{};
+  int probe_blocker_{-1};
+  int closed_probe_verdict() const;
   void reset_probe_llr() {
     probe_llr_.fill(0.0);
     probe_energy_.fill(0.0);

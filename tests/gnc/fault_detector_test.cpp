@@ -708,7 +708,7 @@ void mirror_trap(Truth& t, FaultDetectorParams p, FaultDetector& d) {
   d.set_model(m);
 }
 
-AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
+AmbiguousRun fly_ambiguous(FaultDetectorParams p, double firing_scale = 1.0) {
   Truth t;
   FaultDetector d;
   mirror_trap(t, p, d);
@@ -743,7 +743,7 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p) {
     } else if (out.probe_pods.size() > out.probe_ends.size()) {
       out.probe_ends.push_back(k);
     }
-    Vec16 cmd = random_firing(rng);
+    Vec16 cmd = random_firing(rng) * firing_scale;
     cmd(2) = cmd(3) = cmd(10) = cmd(11) = 0.0;  // channels 1 and 5 never commanded
     t.advance(cmd);
     prev = cmd;
@@ -832,6 +832,38 @@ TEST(FaultDetector, AnAlignedTestOfOneWindowIsFlownClosedThroughoutAndRead) {
   const AmbiguousRun two = fly_ambiguous(two_windows);
   ASSERT_FALSE(two.probe_ends.empty());
   EXPECT_LT(run.probe_ends.front(), two.probe_ends.front());
+}
+
+// (F32) The trap's test read on the window that started it and the closed one. With the other jets
+// at a tenth of their firing (the model's noise, F5, charges the centre of mass's 1 sigma against
+// their force) one window of the stuck jet stands far above the noise, but the mirror jet 11 still
+// explains it within the model's error (F8), so a test closes pod 0. The motion was there before
+// the closure and gone behind it, where 11, behind its open valve, would have fired: the trap's
+// jet is confirmed when the test's closed window ends, pod 0 is never reopened from its first
+// closure on, and the confirmation comes at least one window before the reopened window's (F15).
+TEST(FaultDetector, AStuckOnJetDecidedBehindItsClosedValveNeverFiresAgain) {
+  constexpr double kLightFiring = 0.1;
+  FaultDetectorParams p;
+  p.probe_windows = 1;
+  p.probe_aligned = true;
+  const AmbiguousRun reopened = fly_ambiguous(p, kLightFiring);
+  ASSERT_GE(reopened.r.confirmed_at, 0) << "not isolated";
+  ASSERT_FALSE(reopened.probe_ends.empty()) << "the trap needs a test";
+  EXPECT_EQ(reopened.r.thruster, 2);
+
+  p.probe_read_closed = true;
+  const AmbiguousRun run = fly_ambiguous(p, kLightFiring);
+  ASSERT_GE(run.r.confirmed_at, 0) << "not isolated";
+  EXPECT_EQ(run.r.thruster, 2);
+  EXPECT_EQ(run.r.kind, FaultKind::kStuckOn);
+  ASSERT_EQ(run.probe_pods.size(), 1u) << "one test of one window decides";
+  EXPECT_EQ(run.probe_pods.front(), 0);
+  ASSERT_EQ(run.probe_ends.size(), 1u);
+  // The test ends on the update that confirms: the confirmation's valve takes over from the test's.
+  EXPECT_EQ(run.r.confirmed_at, run.probe_ends.front());
+  EXPECT_EQ(run.probe_windows_closed, 10 + FaultDetector::kEvaluationSteps);
+  EXPECT_LE(run.r.confirmed_at + 10, reopened.r.confirmed_at)
+      << "read on the closed window, at least one window before the reopened one";
 }
 
 TEST(FaultDetector, WithoutTheIsolationTestAnAmbiguousPairIsNeverDecided) {
@@ -1623,7 +1655,8 @@ struct SteadyRun {
 };
 
 // test: 0 no isolation test; 1 aligned one-window tests (F27) whose verdict knows only the bank's
-// hypotheses; 2 the same, the verdict also against every jet's partial loss (F29). With a test, the
+// hypotheses; 2 the same, the verdict also against every jet's partial loss (F29); 3 as 2, the test
+// also read on its closed window (F32). With a test, the
 // flight's allocation follows the valve: with the rival's pod closed, jet 0 (which the steady
 // firing balances against the rival) is not commanded either.
 SteadyRun fly_steady_loss(bool episode_restart, int test = 0) {
@@ -1648,7 +1681,8 @@ SteadyRun fly_steady_loss(bool episode_restart, int test = 0) {
   FaultDetectorParams p = bank_params(t.gyro_sigma);
   p.probe_windows = test == 0 ? 0 : 1;
   p.probe_aligned = test != 0;
-  p.probe_partial_rival = test == 2;
+  p.probe_partial_rival = test >= 2;
+  p.probe_read_closed = test == 3;
   p.degraded_min_loss = 0.1;  // (F18)
   p.episode_restart = episode_restart;
   FaultDetector d;
@@ -1714,6 +1748,27 @@ TEST(FaultDetector, AnIsolationTestsVerdictBeatsEveryJetsPartialLoss) {
   EXPECT_GT(now.tests, 0);
   EXPECT_FALSE(now.confirmations > 0 && now.first.kind == FaultKind::kStuckOn)
       << "thruster " << now.first.thruster << " confirmed stuck on";
+  if (now.confirmations > 0) {
+    EXPECT_EQ(now.first.thruster, 0);
+    EXPECT_EQ(now.first.kind, FaultKind::kDegraded);
+  }
+}
+
+// (F32) The same trap read on the closed window: it is quiet because the allocation stopped
+// commanding jet 0 with the rival's pod closed, not because a stuck jet stopped. The alternative
+// that blocked the leader is jet 0's loss, which a window where jet 0 is not commanded cannot
+// contradict, so the closed window names nothing and the run is flown as without (F32). Either
+// guard holds the trap alone: the blocker's contradiction, or (F29)'s partial rival over the start
+// and closed windows; with neither, the closed window names a stuck-on jet of the rival's pod.
+TEST(FaultDetector, ATestsClosedWindowQuietForAnotherReasonNamesNoJetOfThatPod) {
+  const SteadyRun reopened = fly_steady_loss(true, 2);
+  const SteadyRun now = fly_steady_loss(true, 3);
+  EXPECT_GT(now.tests, 0) << "no isolation test";
+  EXPECT_FALSE(now.confirmations > 0 && now.first.kind == FaultKind::kStuckOn)
+      << "thruster " << now.first.thruster << " confirmed stuck on";
+  // Nothing is read on the closed window: the run is the reopened window's verdict's (F29).
+  EXPECT_EQ(now.tests, reopened.tests);
+  EXPECT_EQ(now.confirmations, reopened.confirmations);
   if (now.confirmations > 0) {
     EXPECT_EQ(now.first.thruster, 0);
     EXPECT_EQ(now.first.kind, FaultKind::kDegraded);
