@@ -254,6 +254,13 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("centred_gyro_noise")) fd.centred_gyro_noise = r.boolean("centred_gyro_noise");  // (F28), optional
     if (r.has("probe_partial_rival")) fd.probe_partial_rival = r.boolean("probe_partial_rival");  // (F29), optional
     if (r.has("probe_read_closed")) fd.probe_read_closed = r.boolean("probe_read_closed");  // (F32), optional
+    if (r.has("detect_early_ticks")) {  // (F33)
+      fd.detect_early_ticks = r.integer("detect_early_ticks");
+      if (fd.detect_early_ticks < 0 || fd.detect_early_ticks > 1000) {
+        r.fail("detect_early_ticks", "must be in [0, 1000]");
+      }
+    }
+    if (r.has("detect_early_chi2")) fd.detect_early_chi2 = r.positive("detect_early_chi2");
     if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");

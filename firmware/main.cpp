@@ -215,6 +215,7 @@ int firmware_main() {
     g_params.fdi.probe_read_closed = true;     // (F32) ... and first on the closed window
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
+    g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown
     g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows
     g_params.fdi.episode_restart = true;       // (F25) the episode since the fault showed, as flown
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the

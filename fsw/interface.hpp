@@ -163,7 +163,7 @@ enum class EventId : std::int32_t {
   kModelAdopted = 129,  // the identified model became the active table (automatic policy)
   kModelRefused = 130,  // a confident identified model failed table validation
   kModelLoaded = 131,   // PARAM_LOAD_IDENTIFIED: the identified model is in the inactive table
-  kFaultSuspected = 132,   // arg0 = leading thruster (-1 none), arg1 = 1 stuck-on / 2 stuck-off
+  kFaultSuspected = 132,   // arg0 = leading thruster (-1 none or not ranked yet), arg1 = 1 stuck-on / 2 stuck-off
   kFaultConfirmed = 133,   // arg0 = thruster, arg1 = gnc::FaultKind; latched until cleared
   kValveClosed = 134,      // arg0 = pod, arg1 = the stuck-on thruster it isolates
   kFaultOverride = 135,    // arg0 = thruster / pod / -1, arg1 = kind / 10 open / 11 close / 20, 21 inhibit

@@ -255,7 +255,8 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
   }
   if (fe.suspected && !fe.confirmed) {
     ModeEvent e{EventId::kFaultSuspected, mode, mode, TransitionCheck::kOk};
-    const int best = fdi_.status().best;
+    // (F33) Detected before its window closed: no hypothesis is ranked on it yet.
+    const int best = fe.early ? -1 : fdi_.status().best;
     e.arg0 = static_cast<std::int16_t>(best < 0 ? -1 : best % kThrusters);
     e.arg1 = static_cast<std::int16_t>(best < 0 ? 0 : best < kThrusters ? 1 : 2);
     events.push(e);

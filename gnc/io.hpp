@@ -63,7 +63,8 @@ enum class EventId : std::uint8_t {
   kTrajectoryStale,     // a staged trajectory was refused at the boundary; the active one kept
   kModelAdopted,     // the identified model became the active table (automatic policy)
   kModelRefused,     // a confident identified model failed table validation (kept the old one)
-  kFaultSuspected,   // a residual window failed the no-fault test (arg0 = leading thruster or -1)
+  kFaultSuspected,   // a residual window failed the no-fault test (arg0 = leading thruster or -1;
+                     // -1 also when detected before the window closed, F33)
   kFaultConfirmed,   // a thruster fault confirmed and latched (arg0 = thruster, arg1 = FaultKind)
   kValveClosed,      // a pod's latch valve closed to isolate a stuck-on thruster (arg0 = pod)
   kFaultOverride,    // a ground override applied (arg0 = thruster or pod, arg1 = what)

@@ -36,6 +36,12 @@ Check validate(const FaultDetectorParams& p) {
   if (!finite_positive(p.confirm_llr)) return bad("fdi.confirm_llr", "must be positive");
   if (!finite_non_negative(p.margin_llr)) return bad("fdi.margin_llr", "must be >= 0");
   if (!finite_positive(p.suspect_chi2)) return bad("fdi.suspect_chi2", "must be positive");
+  if (p.detect_early_ticks < 0 || p.detect_early_ticks > 1000) {
+    return bad("fdi.detect_early_ticks", "must be in [0, 1000]");
+  }
+  if (!finite_positive(p.detect_early_chi2)) {
+    return bad("fdi.detect_early_chi2", "must be positive");
+  }
   if (!finite_non_negative(p.min_signature)) return bad("fdi.min_signature", "must be >= 0");
   if (!finite_non_negative(p.model_sigmas)) return bad("fdi.model_sigmas", "must be >= 0");
   if (p.probe_after_windows < 0 || p.probe_after_windows > 1000) {
@@ -416,6 +422,16 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   } else {
     accumulate<false>(acc, in, r);
   }
+  // (F33) The window so far, from detect_early_ticks samples until its last (which the closed
+  // window's evaluation reads), once per window.
+  if (p_.detect_early_ticks > 0 && n_ >= p_.detect_early_ticks && n_ < p_.window_ticks &&
+      !acc.early_suspected && early_chi2(acc, static_cast<double>(n_)) > p_.detect_early_chi2) {
+    acc.early_suspected = true;
+    ++st_.suspicions;
+    ++st_.early_detections;
+    pending_.suspected = true;
+    pending_.early = true;
+  }
   // (F19) The thrust of this update was commanded while the check of the previous one ran.
   if (check_prev_ >= 0) acc.check_jet = check_prev_;
   check_prev_ = st_.check_jet;
@@ -523,6 +539,7 @@ void FaultDetector::start_window(const Vec3& omega) {
   w.thrust_motion = 0.0;
   w.live = 0;
   w.check_jet = -1;
+  w.early_suspected = false;
 }
 
 void FaultDetector::close_window() {
@@ -587,12 +604,12 @@ void FaultDetector::evaluate_step() {
   }
 }
 
-void FaultDetector::evaluate_noise(const WindowSums& w) {
-  const double n = static_cast<double>(w.n);
+double FaultDetector::window_var(const WindowSums& w, double n) const {
   // (F5) noise of a residual sample: the gyro (start and sample), the disturbance over the window,
   // and the model's relative uncertainty times the motion it predicts.
   const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
-  const double dist = p_.disturbance_sigma * j_inv_.norm() * n * dt_;
+  const double j_inv_f = j_inv_.norm();
+  const double dist = p_.disturbance_sigma * j_inv_f * n * dt_;
   // (F22) With the floor on the thrust's term only: rel of the thrust's motion, the identifier's
   // own 1 sigma of the gyroscopic term's bound (the rest of the motion).
   const double model = p_.model_floor_gyroscopic
@@ -600,11 +617,23 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
                            : rel * w.thrust_motion + m_.j_rel_sigma * (w.motion - w.thrust_motion);
   // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
   // r_sigma times the jets' force, and k_sigma times their torque.
-  const double offset = r_sigma_ * j_inv_.norm() * w.force_impulse;
+  const double offset = r_sigma_ * j_inv_f * w.force_impulse;
   const double strength = m_.k_sigma * w.thrust_motion;
   const double gyro_var = (p_.centred_gyro_noise ? 1.0 : 2.0) * p_.gyro_sigma * p_.gyro_sigma;
-  const double var = gyro_var + dist * dist + model * model +
-                     offset * offset + strength * strength + 1e-30;
+  return gyro_var + dist * dist + model * model + offset * offset + strength * strength + 1e-30;
+}
+
+double FaultDetector::early_chi2(const WindowSums& w, double n) const {
+  // (F33) The slope test of evaluate_noise on the samples flown so far.
+  const double stt = w.sum_tt - w.sum_t * w.sum_t / n;
+  if (!(stt > 0.0)) return 0.0;
+  const Vec3 str = w.sum_tr - w.sum_t * (w.sum_r / n);
+  return str.squaredNorm() / (stt * window_var(w, n));
+}
+
+void FaultDetector::evaluate_noise(const WindowSums& w) {
+  const double n = static_cast<double>(w.n);
+  const double var = window_var(w, n);
   eval_var_ = var;
   if (w.check_jet < 0) quiet_var_ = var;  // (F24) the noise of a window without a check
   st_.noise_sigma = std::sqrt(var);
@@ -789,8 +818,8 @@ void FaultDetector::decide() {
   const double best_s = st_.best_llr;
   const double second = st_.runner_up_llr;
   const int runner_up = runner_up_;
-  if (st_.chi2 > p_.suspect_chi2) {
-    ++st_.suspicions;
+  if (st_.chi2 > p_.suspect_chi2 && !win_[static_cast<std::size_t>(acc_ ^ 1)].early_suspected) {
+    ++st_.suspicions;  // (F33) not again for a window whose suspicion was raised early
     pending_.suspected = true;
   }
   // An isolation test runs its course; the valve reopens after it unless a confirmation closes it.

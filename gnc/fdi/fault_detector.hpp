@@ -141,6 +141,15 @@ struct FaultDetectorParams {
   // stuck-off evidence that a stuck-on jet's first window raised kept the bank from scoring the
   // stuck-on jet for the check's windows. false: as before.
   bool check_fit_on_suspicion{false};
+  // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
+  // window flown so far (the no-fault slope statistic with the noise of F5 on those samples)
+  // against detect_early_chi2, and the first crossing raises the window's suspicion there and
+  // then (the counter and the event; the window's own evaluation does not raise it again).
+  // Scores, model holds and decisions still wait for the closed window, so isolation is the same.
+  // A window's end is at most window_ticks + kEvaluationSteps updates after a fault starts; this
+  // is a few updates after it shows. 0: off.
+  int detect_early_ticks{0};
+  double detect_early_chi2{35.41};  // chi-square(3) at 1 - 1e-7: several tests per window
 };
 
 // (F14) The identifier's stuck-on evidence after one of its windows (estimation README I23).
@@ -211,11 +220,13 @@ struct FaultDetectorStatus {
   int check_jet{-1};                          // (F19) the jet being checked, -1 none
   std::uint32_t checks{0};                    // (F19) jet checks started
   std::uint32_t checks_unfit{0};              // (F19) check windows not scored (model error)
+  std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
 };
 
 // Raised by update(); the caller turns them into events.
 struct FaultEvents {
   bool suspected{false};       // a window crossed suspect_chi2 with no fault confirmed yet
+  bool early{false};           // (F33) ... a window still open: no hypothesis ranked on it yet
   bool confirmed{false};       // a fault was confirmed this tick
   int thruster{-1};
   FaultKind kind{FaultKind::kNone};
@@ -403,6 +414,7 @@ class FaultDetector {
     std::array<double, kBasisPairs> sum_xx{};
     std::uint32_t live{0};
     int check_jet{-1};  // (F19) the jet checked during the window, -1 none
+    bool early_suspected{false};  // (F33) its suspicion was raised before it closed
   };
   template <bool kFirst>
   void accumulate(WindowSums& w, const FaultDetectorInput& in, const Vec3& r);
@@ -410,6 +422,10 @@ class FaultDetector {
   // stuck-off scores and the ranking, 3 the episode's cross sums, 4 the decision.
   void evaluate_step();
   void evaluate_noise(const WindowSums& w);
+  // (F5) The variance of a residual sample over the window's first n samples, and (F33) the
+  // no-fault slope statistic of those samples.
+  double window_var(const WindowSums& w, double n) const;
+  double early_chi2(const WindowSums& w, double n) const;
   void evaluate_scores(const WindowSums& w, int first, int last);
   void rank_hypotheses();
   void evaluate_cross(const WindowSums& w);

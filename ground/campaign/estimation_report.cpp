@@ -84,6 +84,7 @@ nlohmann::json fdi_json(const FdiReport& f) {
           {"suspicions", f.suspicions},
           {"checks", f.checks},
           {"checks_unfit", f.checks_unfit},
+          {"fault_detected_s", opt(f.fault_detected_s)},
           {"fault_first_commanded_s", opt(f.fault_first_commanded_s)},
           {"fault_commanded_s", f.fault_commanded_s},
           {"fault_commanded_impulse_ns", f.fault_commanded_impulse_ns}};
@@ -110,6 +111,7 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
     f.confirmed_degraded = j.at("confirmed_degraded").get<std::uint16_t>();
     f.factor = j.at("factor").get<double>();
   }
+  if (j.contains("fault_detected_s")) f.fault_detected_s = to_opt(j.at("fault_detected_s"));
   if (j.contains("fault_first_commanded_s")) {
     f.fault_first_commanded_s = to_opt(j.at("fault_first_commanded_s"));
     f.fault_commanded_s = j.at("fault_commanded_s").get<double>();

@@ -301,6 +301,10 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       d.confirmed_on = f.confirmed_on;
       d.confirmed_off = f.confirmed_off;
       d.confirmed_degraded = f.confirmed_degraded;
+      if (!setup.truth.faults.empty() && !d.fault_detected_s && f.suspicions > d.suspicions &&
+          t >= setup.truth.faults.front().onset_s) {
+        d.fault_detected_s = t;
+      }
       d.suspicions = f.suspicions;
       d.checks = f.checks;
       d.checks_unfit = f.checks_unfit;

@@ -99,6 +99,9 @@ struct EstimationReport {
 struct FdiReport {
   bool enabled{false};
   std::optional<double> first_suspicion_s;  // first window above the no-fault bound
+  // The first such window at or after the injected fault's onset (its detection; a healthy
+  // window above the bound earlier in the run is not it).
+  std::optional<double> fault_detected_s;
   std::optional<double> first_confirmation_s;
   int thruster{-1};           // first confirmed thruster (flight index 2c "+", 2c+1 "-")
   std::string kind;           // stuck-on | stuck-off | degraded

@@ -128,7 +128,7 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
           g.kind = plant::to_string(kind);
           g.onset_s = onset;
           g.case_number = c;
-          std::vector<double> lat, pen, cmd, imp;
+          std::vector<double> lat, pen, cmd, imp, det, valve;
           for (const DrawResult& d : draws) {
             if (!d.sampled.has_fault || d.sampled.fault.kind != kind ||
                 d.sampled.fault.onset_s != onset || (c != 0 && d.sampled.case_number != c) ||
@@ -141,6 +141,17 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
             g.goals_met += o.t_omega_conv_s && o.t_q_conv_s ? 1 : 0;
             const campaign::FdiReport& f = o.fdi;
             if (!f.fault_first_commanded_s) ++g.not_commanded;
+            // Detected: the first window above the no-fault bound after onset, or the first
+            // confirmation if that came first (F14 confirms from the identifier's fault torque).
+            std::optional<double> detected = f.fault_detected_s;
+            if (f.first_confirmation_s && *f.first_confirmation_s >= onset &&
+                (!detected || *f.first_confirmation_s < *detected)) {
+              detected = f.first_confirmation_s;
+            }
+            if (detected) {
+              ++g.detected;
+              det.push_back(*detected - onset);
+            }
             if (f.confirmations == 0) {
               ++g.none;
             } else if (f.confirmations == 1 && f.thruster == d.sampled.fault.thruster &&
@@ -149,6 +160,10 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
               lat.push_back(*f.first_confirmation_s - onset);
               cmd.push_back(f.fault_commanded_s);
               imp.push_back(f.fault_commanded_impulse_ns);
+              if (kind == plant::FaultKind::kStuckOn && f.valve_closed_s &&
+                  *f.valve_closed_s >= onset) {
+                valve.push_back(*f.valve_closed_s - onset);
+              }
             } else {
               ++g.wrong;
             }
@@ -158,6 +173,10 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
           if (g.runs == 0) continue;
           g.latency_s = percentiles(lat);
           if (!lat.empty()) g.latency_max_s = *std::max_element(lat.begin(), lat.end());
+          g.detection_s = percentiles(det);
+          if (!det.empty()) g.detection_max_s = *std::max_element(det.begin(), det.end());
+          g.valve_s = percentiles(valve);
+          if (!valve.empty()) g.valve_max_s = *std::max_element(valve.begin(), valve.end());
           g.commanded_to_isolation_s = percentiles(cmd);
           g.commanded_impulse_to_isolation_ns = percentiles(imp);
           if (!cmd.empty()) g.commanded_to_isolation_max_s = *std::max_element(cmd.begin(), cmd.end());
@@ -533,6 +552,11 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                       {"none", g.none},
                       {"latency_s", pct_json(g.latency_s)},
                       {"latency_max_s", opt_json(g.latency_max_s)},
+                      {"detected", g.detected},
+                      {"detection_s", pct_json(g.detection_s)},
+                      {"detection_max_s", opt_json(g.detection_max_s)},
+                      {"valve_s", pct_json(g.valve_s)},
+                      {"valve_max_s", opt_json(g.valve_max_s)},
                       {"fuel_penalty_kg", pct_json(g.penalty_kg)},
                       {"fuel_penalty_max_kg", opt_json(g.penalty_max_kg)},
                       {"not_commanded", g.not_commanded},
@@ -830,6 +854,28 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
           }
         }
         md << "\n";
+      }
+    }
+    bool any_stuck_on = false;
+    for (const FaultGroupStats& g : s.faults) {
+      any_stuck_on = any_stuck_on || (g.kind == "stuck_on" && g.case_number != 0);
+    }
+    if (any_stuck_on) {
+      md << "\nStuck-on jets per case, from onset: detected (the first window above the no-fault "
+            "bound at or after onset, or the first confirmation if it came first; over the runs "
+            "that had one), the pod's latch valve closed and "
+            "the jet isolated (over the isolated runs), p50 / p95 / max (s).\n\n| strategy | onset "
+            "(s) | case | runs | detected | detection | valve closed | isolated | isolation |\n"
+            "|---|---:|---:|---:|---:|---|---|---:|---|\n";
+      auto three = [](const Percentiles& q, const std::optional<double>& mx) {
+        return nc(q.p50, "%.1f") + " / " + nc(q.p95, "%.1f") + " / " + nc(mx, "%.1f");
+      };
+      for (const FaultGroupStats& g : s.faults) {
+        if (g.kind != "stuck_on" || g.case_number == 0) continue;
+        md << "| `" << g.strategy << "` | " << fmt("%.0f", g.onset_s) << " | " << g.case_number
+           << " | " << g.runs << " | " << g.detected << " | " << three(g.detection_s, g.detection_max_s)
+           << " | " << three(g.valve_s, g.valve_max_s) << " | " << g.isolated << " | "
+           << three(g.latency_s, g.latency_max_s) << " |\n";
       }
     }
     if (!s.references.empty()) {

@@ -114,6 +114,12 @@ struct FaultGroupStats {
   int none{0};         // no confirmation
   Percentiles latency_s;  // isolated runs: first confirmation minus onset
   std::optional<double> latency_max_s;
+  int detected{0};           // runs with a window above the no-fault bound at or after onset,
+                             // or a confirmation after onset
+  Percentiles detection_s;   // ... the first of them minus onset
+  std::optional<double> detection_max_s;
+  Percentiles valve_s;       // isolated stuck-on runs: the pod's valve closed, minus onset
+  std::optional<double> valve_max_s;
   Percentiles penalty_kg;  // total fuel minus the reference's (draws and reference both flew)
   std::optional<double> penalty_max_kg;
   // The faulty jet as the flight commanded it after onset (campaign FdiReport): runs in which it

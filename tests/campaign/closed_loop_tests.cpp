@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gnc/fdi/fault_detector.hpp"
 #include "ground/campaign/estimation_report.hpp"
 #include "ground/campaign/fsw_flight_side.hpp"
 #include "ground/campaign/runner.hpp"
@@ -247,6 +248,52 @@ TEST(ClosedLoop, EachThrustersStrengthIsScored600sAfterItsFirstCommandedFiring) 
     EXPECT_EQ(back.strengths[i].confident, r.estimation.strengths[i].confident);
     EXPECT_EQ(back.strengths[i].impulse_ns, r.estimation.strengths[i].impulse_ns);
   }
+}
+
+// The detection the dispersion report gives for a stuck-on jet (the first window above the no-fault
+// bound at or after onset), against the per-tick series: thruster 0 stuck on at 3000 s in case 1.
+// With the window's own test only (F33 off), the window's chi-square shows in the telemetry on the
+// first of its evaluation steps and the suspicion is counted on its decision, kEvaluationSteps - 1
+// updates later. With gnc.yaml's early detection, sooner: within the window the fault starts in.
+TEST(ClosedLoop, AStuckOnJetsDetectionIsTheFirstWindowAboveTheBoundAfterOnset) {
+  std::optional<double> detected[2];
+  for (int early = 0; early < 2; ++early) {
+    config::RunSetup s = load(1);
+    ASSERT_GT(s.flight.fdi.detect_early_ticks, 0) << "gnc.yaml's early detection";
+    if (early == 0) s.flight.fdi.detect_early_ticks = 0;
+    plant::ThrusterFault f;
+    f.thruster = 0;
+    f.kind = plant::FaultKind::kStuckOn;
+    f.onset_s = 3000.0;
+    s.truth.faults.push_back(f);
+    const double dt = s.flight.dt;
+    const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", dt, 3060.0);
+    ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
+    ASSERT_TRUE(r.fdi.fault_detected_s.has_value());
+    ASSERT_TRUE(r.fdi.first_confirmation_s.has_value());
+    EXPECT_EQ(r.fdi.thruster, 0);
+    EXPECT_LE(*r.fdi.fault_detected_s, *r.fdi.first_confirmation_s);
+    EXPECT_GE(*r.fdi.fault_detected_s, f.onset_s);
+    detected[early] = r.fdi.fault_detected_s;
+    if (early == 0) {
+      std::optional<double> shown;
+      for (const TimeRow& row : r.series) {
+        if (row.t >= f.onset_s - 1e-9 && row.fdi_chi2 > s.flight.fdi.suspect_chi2) {
+          shown = row.t;
+          break;
+        }
+      }
+      ASSERT_TRUE(shown.has_value()) << "no window above the bound after onset";
+      EXPECT_GE(*r.fdi.fault_detected_s, *shown - 1e-9);
+      EXPECT_LE(*r.fdi.fault_detected_s,
+                *shown + (gnc::FaultDetector::kEvaluationSteps - 1) * dt + 1e-9);
+    } else {
+      EXPECT_LT(*r.fdi.fault_detected_s - f.onset_s, s.flight.fdi.window_ticks * dt);
+    }
+    const FdiReport back = fdi_from_json(fdi_json(r.fdi));
+    EXPECT_EQ(back.fault_detected_s, r.fdi.fault_detected_s);
+  }
+  EXPECT_LT(*detected[1], *detected[0]);
 }
 
 }  // namespace

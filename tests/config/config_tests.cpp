@@ -295,6 +295,24 @@ TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
                           });
 }
 
+// (F33) Early detection: gnc.yaml's 3 samples at chi-square(3) 1 - 1e-7, off (0) when the key is
+// absent, and a bad value named by file and key.
+TEST(ConfigShipped, EarlyDetectionIsReadAndOptional) {
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.detect_early_ticks, 3);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.detect_early_chi2, 35.41);
+  expect_optional_fdi_key("  detect_early_ticks: 3", "detect_early_ticks",
+                          "  detect_early_ticks: -1", "must be in [0, 1000]",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.detect_early_ticks,
+                                      0);
+                          });
+  expect_optional_fdi_key("  detect_early_chi2: 35.41", "detect_early_chi2",
+                          "  detect_early_chi2: -2", "", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.detect_early_chi2,
+                                      gnc::FaultDetectorParams{}.detect_early_chi2);
+                          });
+}
+
 // (F30) The window sized by the case's gyro noise, against a brute-force count: for each case, the
 // weakest jet's acceleration from the table's model, column by column, and the slope statistic's
 // sum of squared sample times written out; the window is the first n from window_ticks whose

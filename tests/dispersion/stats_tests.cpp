@@ -194,6 +194,12 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
     o.fdi.thruster = r.confirmed_thruster;
     o.fdi.kind = r.confirmed_kind;
     if (r.confirmations > 0) o.fdi.first_confirmation_s = r.confirmed_at;
+    // Detection one second before each confirmation (draw 3: never detected); a stuck-on
+    // confirmation closes its valve half a second before it (draw 2: before onset, not counted).
+    if (r.confirmations > 0 && d.index != 3) o.fdi.fault_detected_s = r.confirmed_at - 1.0;
+    if (r.kind == plant::FaultKind::kStuckOn && r.confirmations > 0) {
+      o.fdi.valve_closed_s = d.index == 2 ? 50.0 : r.confirmed_at - 0.5;
+    }
     d.runs = {o};
     draws.push_back(d);
   }
@@ -220,6 +226,14 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
   EXPECT_EQ(on->none, 0);
   EXPECT_NEAR(*on->latency_s.p50, 6.0, 1e-12);  // 2 s and 10 s
   EXPECT_NEAR(*on->latency_max_s, 10.0, 1e-12);
+  // Detected in draws 0, 1, 2 (1, 0 and 9 s after onset), and in draw 3 by its confirmation (4 s:
+  // no window above the bound), over every run, isolated or not.
+  EXPECT_EQ(on->detected, 4);
+  EXPECT_NEAR(*on->detection_s.p50, 2.5, 1e-12);
+  EXPECT_NEAR(*on->detection_max_s, 9.0, 1e-12);
+  // The valve over the isolated runs closed after onset: draw 0 only (1.5 s).
+  EXPECT_EQ(on->valve_s.n, 1);
+  EXPECT_NEAR(*on->valve_max_s, 1.5, 1e-12);
   // Penalties: 10, 20 (case 1, reference 100) and 40, 50 (case 5, reference 90).
   EXPECT_NEAR(*on->penalty_kg.p50, 30.0, 1e-12);
   EXPECT_NEAR(*on->penalty_max_kg, 50.0, 1e-12);

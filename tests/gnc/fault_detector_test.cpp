@@ -288,6 +288,97 @@ TEST(FaultDetector, TheWindowAFaultStartsInIsNotScoredAndNoJetOfAnotherPodIsConf
               wrong_scored, latency_scored / 80.0, latency_skipped / 80.0);
 }
 
+// (F33) Early detection. Every jet stuck on at every phase of a 10-tick window, under HOLD's
+// few-newton firing (WeakFiring) with case 5's gyro: the first suspicion after onset with the window so far tested each
+// update, against the same flight with the window's own test only. Scores and decisions are the
+// window's in both, so every confirmation is the same thruster on the same tick.
+struct Detection {
+  int detected_at{-1};  // first update after onset raising a suspicion
+  RunResult r;
+  std::uint32_t early{0};
+};
+
+Detection fly_detection(int jet, int onset, int early_ticks) {
+  Truth t;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
+  p.detect_early_ticks = early_ticks;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  d.set_model(identified_model(t));
+  WeakFiring firing(11);
+  Vec16 prev = Vec16::Zero();
+  Detection out;
+  for (int k = 0; k < onset + 100; ++k) {
+    if (k == onset) t.stuck_on = jet;
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    in.valve_open = t.valve;
+    const FaultEvents e = d.update(in);
+    if (e.suspected && k >= onset && out.detected_at < 0) out.detected_at = k;
+    if (e.confirmed && out.r.confirmed_at < 0) {
+      out.r.confirmed_at = k;
+      out.r.thruster = e.thruster;
+      out.r.kind = e.kind;
+    }
+    if (d.confirmed_on() != 0) t.valve[static_cast<std::size_t>(jet / 4)] = false;
+    const Vec16 cmd = firing.next(k);
+    t.advance(cmd);
+    prev = cmd;
+  }
+  out.early = d.status().early_detections;
+  return out;
+}
+
+TEST(FaultDetector, AStuckOnJetIsDetectedBeforeItsWindowCloses) {
+  int sooner = 0, runs = 0;
+  double sum_early = 0.0, sum_window = 0.0;
+  for (int jet = 0; jet < 16; ++jet) {
+    for (int phase = 0; phase < 10; ++phase) {
+      const int onset = 200 + phase;
+      const Detection window = fly_detection(jet, onset, 0);
+      const Detection early = fly_detection(jet, onset, 3);
+      ++runs;
+      ASSERT_GE(window.detected_at, 0) << "jet " << jet << " phase " << phase;
+      ASSERT_GE(early.detected_at, 0) << "jet " << jet << " phase " << phase;
+      EXPECT_LE(early.detected_at, window.detected_at) << "jet " << jet << " phase " << phase;
+      if (early.detected_at < window.detected_at) {
+        ++sooner;
+        EXPECT_GE(early.early, 1u) << "sooner without an early detection";
+      }
+      sum_early += early.detected_at - onset;
+      sum_window += window.detected_at - onset;
+      // The isolation is the window's: the same thruster and kind on the same update.
+      EXPECT_EQ(early.r.confirmed_at, window.r.confirmed_at) << "jet " << jet << " phase " << phase;
+      EXPECT_EQ(early.r.thruster, window.r.thruster);
+      EXPECT_EQ(early.r.kind, window.r.kind);
+      EXPECT_EQ(window.early, 0u);
+    }
+  }
+  std::printf("early detection: %d of %d runs sooner; mean %.1f ticks after onset (window's test "
+              "only: %.1f)\n", sooner, runs, sum_early / runs, sum_window / runs);
+  EXPECT_GT(sooner, runs / 2);
+  EXPECT_LT(sum_early, 0.8 * sum_window);
+}
+
+// (F33) Healthy random firing at two noise levels, 2000 s each: no suspicion, early or not.
+TEST(FaultDetector, HealthyFiringRaisesNoEarlyDetection) {
+  for (const double sigma : {3.1623e-6, 3.1623e-5}) {
+    Truth t;
+    t.gyro_sigma = sigma;
+    FaultDetectorParams p = bank_params(sigma);
+    p.detect_early_ticks = 3;
+    FaultDetector d;
+    d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+    d.set_model(identified_model(t));
+    const RunResult r = fly(t, d, 20000, -1, -1, -1);
+    EXPECT_LT(r.confirmed_at, 0);
+    EXPECT_EQ(d.status().suspicions, 0u) << "gyro sigma " << sigma;
+    EXPECT_EQ(d.status().early_detections, 0u);
+  }
+}
+
 TEST(FaultDetector, AStuckOffJetCommandedAtAFewPercentIsIsolatedFromPooledWindows) {
   for (int i : {1, 6, 11, 13}) {  // tangential and axial jets on every pod
     Truth t;

@@ -134,6 +134,59 @@ TEST(GncFdi, StuckOnIsConfirmedIsolatedByItsValveAndTheDespinGoesOn) {
   EXPECT_EQ(gnc.mode(), Mode::kDetumble);
 }
 
+// (F33) The tick's events with early detection on: the stuck-on jet of the test above raises a
+// suspicion before the window it starts in has closed, evented with no leader (no hypothesis is
+// ranked on an open window), and before the confirmation. Without it the first event of the fault
+// is the window's evaluation (here its confirmation, which comes with it), later; the confirmation
+// is on the same tick either way.
+TEST(GncFdi, AnEarlyDetectionIsEventedBeforeItsWindowClosesWithNoLeader) {
+  int first_event[2] = {-1, -1};
+  int early_suspicion = -1;
+  int confirmed[2] = {-1, -1};
+  for (int early = 0; early < 2; ++early) {
+    GncParams p = fdi_params();
+    p.fdi.detect_early_ticks = early != 0 ? 3 : 0;
+    Truth truth(p);
+    Gnc gnc;
+    ASSERT_TRUE(gnc.init(p).ok);
+    GncOutput out;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    double t = 0.0;
+    for (int k = 0; k < 1200; ++k) {
+      if (k == 1000) truth.stuck_on = 4;
+      gnc.step(truth.sample(t), k == 0 ? c : GncCommands{}, out);
+      for (int i = 0; i < out.events.count; ++i) {
+        const ModeEvent& e = out.events.items[i];
+        const bool suspected = e.id == EventId::kFaultSuspected;
+        if ((suspected || e.id == EventId::kFaultConfirmed) && k >= 1000 && first_event[early] < 0) {
+          first_event[early] = k;
+        }
+        if (suspected && early != 0 && k >= 1000 && early_suspicion < 0) {
+          early_suspicion = k;
+          EXPECT_EQ(e.arg0, -1) << "an early detection names no leader";
+          EXPECT_EQ(gnc.fault_detector().status().early_detections, 1u);
+        }
+        if (e.id == EventId::kFaultConfirmed && confirmed[early] < 0) confirmed[early] = k;
+      }
+      if (early == 0 || k < 1000) {  // nothing early without it, nor before the fault
+        EXPECT_EQ(gnc.fault_detector().status().early_detections, 0u) << "tick " << k;
+      }
+      truth.advance(out.command, p.dt);
+      t += p.dt;
+    }
+  }
+  ASSERT_GE(first_event[0], 1000);
+  ASSERT_GE(early_suspicion, 1000);
+  EXPECT_EQ(first_event[1], early_suspicion);
+  EXPECT_LT(early_suspicion, first_event[0]);
+  EXPECT_LT(early_suspicion - 1000, fdi_params().fdi.window_ticks) << "within one window";
+  ASSERT_GE(confirmed[1], 0);
+  EXPECT_LT(early_suspicion, confirmed[1]);
+  EXPECT_EQ(confirmed[1], confirmed[0]) << "the isolation is the window's";
+}
+
 // An axial jet whose mirror on the opposite pod looks alike (gnc/fdi/README.md): with the centre
 // of mass known to 10 cm only, the scores cannot tell thruster 6 (pod 1, +z) from 15 (pod 3, -z);
 // the detector's isolation test closes pod 1 for a few windows in the commanded valves (nothing
