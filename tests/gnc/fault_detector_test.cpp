@@ -930,8 +930,10 @@ TEST(FaultDetector, AnAlignedTestOfOneWindowIsFlownClosedThroughoutAndRead) {
 // their force) one window of the stuck jet stands far above the noise, but the mirror jet 11 still
 // explains it within the model's error (F8), so a test closes pod 0. The motion was there before
 // the closure and gone behind it, where 11, behind its open valve, would have fired: the trap's
-// jet is confirmed when the test's closed window ends, pod 0 is never reopened from its first
-// closure on, and the confirmation comes at least one window before the reopened window's (F15).
+// jet is confirmed when the deciding test's closed window ends (the first test on x86-64; under
+// aarch64's rounding a test of the mirror's pod 2 comes first, as with the reopened window's
+// verdict), pod 0 is not reopened
+// after it, and the confirmation comes at least one window before the reopened window's (F15).
 TEST(FaultDetector, AStuckOnJetDecidedBehindItsClosedValveNeverFiresAgain) {
   constexpr double kLightFiring = 0.1;
   FaultDetectorParams p;
@@ -947,12 +949,17 @@ TEST(FaultDetector, AStuckOnJetDecidedBehindItsClosedValveNeverFiresAgain) {
   ASSERT_GE(run.r.confirmed_at, 0) << "not isolated";
   EXPECT_EQ(run.r.thruster, 2);
   EXPECT_EQ(run.r.kind, FaultKind::kStuckOn);
-  ASSERT_EQ(run.probe_pods.size(), 1u) << "one test of one window decides";
-  EXPECT_EQ(run.probe_pods.front(), 0);
-  ASSERT_EQ(run.probe_ends.size(), 1u);
-  // The test ends on the update that confirms: the confirmation's valve takes over from the test's.
-  EXPECT_EQ(run.r.confirmed_at, run.probe_ends.front());
-  EXPECT_EQ(run.probe_windows_closed, 10 + FaultDetector::kEvaluationSteps);
+  std::printf("closed-window verdict: confirmed at tick %d after %zu tests (reopened window's: %d "
+              "after %zu)\n", run.r.confirmed_at, run.probe_ends.size(), reopened.r.confirmed_at,
+              reopened.probe_ends.size());
+  ASSERT_FALSE(run.probe_ends.empty());
+  EXPECT_EQ(run.probe_pods.back(), 0) << "decided by a test of the stuck jet's pod";
+  EXPECT_LE(run.probe_ends.size(), reopened.probe_ends.size());
+  // The deciding test ends on the update that confirms: the confirmation's valve takes over from
+  // the test's, so the pod is not reopened after it.
+  EXPECT_EQ(run.r.confirmed_at, run.probe_ends.back());
+  EXPECT_EQ(run.probe_windows_closed,
+            (10 + FaultDetector::kEvaluationSteps) * static_cast<int>(run.probe_ends.size()));
   EXPECT_LE(run.r.confirmed_at + 10, reopened.r.confirmed_at)
       << "read on the closed window, at least one window before the reopened one";
 }
