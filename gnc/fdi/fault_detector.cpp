@@ -1417,6 +1417,11 @@ void FaultDetector::update_check() {
       sweeping()) {
     return;
   }
+  // (F34) A check is for evidence that builds up over many windows of weak firing; a window above
+  // the no-fault bound is an evident fault, which the bank and the isolation test decide. A jet
+  // stuck on makes its channel partner's stuck-off score jump in that window (the same direction),
+  // and a check of the partner then fires against the stuck jet. A check starts on a quiet window.
+  if (p_.check_quiet_start && suspicious) return;
   // A stuck-on leader is the isolation test's (F9): no jet check meanwhile.
   if (st_.best >= 0 && st_.best < kThrusters && st_.best_llr > 0.5 * p_.confirm_llr) return;
   const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);

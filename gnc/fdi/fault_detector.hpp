@@ -141,6 +141,9 @@ struct FaultDetectorParams {
   // stuck-off evidence that a stuck-on jet's first window raised kept the bank from scoring the
   // stuck-on jet for the check's windows. false: as before.
   bool check_fit_on_suspicion{false};
+  // (F34) No check starts on a window whose no-fault chi-square exceeded suspect_chi2 (a jet whose
+  // evidence is real still has it on the next quiet window). false: as before.
+  bool check_quiet_start{false};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
   // window flown so far (the no-fault slope statistic with the noise of F5 on those samples)
   // against detect_early_chi2, and the first crossing raises the window's suspicion there and

@@ -366,19 +366,20 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
   });
 }
 
-// (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival
-// and (F32) the test read on its closed windows: gnc.yaml true, the former behaviour (false) when
+// (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
+// (F32) the test read on its closed windows and (F34) checks started on quiet windows: gnc.yaml true, the former behaviour (false) when
 // a key is absent, and a value that is not a boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
-  for (const char* key :
-       {"probe_aligned", "centred_gyro_noise", "probe_partial_rival", "probe_read_closed"}) {
+  for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival",
+                          "probe_read_closed", "check_quiet_start"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
       return k == "probe_aligned"         ? f.probe_aligned
              : k == "centred_gyro_noise"  ? f.centred_gyro_noise
              : k == "probe_partial_rival" ? f.probe_partial_rival
-                                          : f.probe_read_closed;
+             : k == "probe_read_closed"   ? f.probe_read_closed
+                                          : f.check_quiet_start;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(6)).flight.fdi)) << key;

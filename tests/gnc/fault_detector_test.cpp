@@ -1333,14 +1333,16 @@ struct StuckDuringCheck {
   // above suspect_chi2) for a jet whose signature (the truth's b_i = J^-1 (p_i + r) x e_i) is more
   // than 30 degrees off that window's unexplained rate change.
   int misaligned_starts{0};
+  int suspicious_starts{0};  // (F34) checks started on the decision after a suspicious window
 };
 StuckDuringCheck fly_stuck_during_check(bool fit_on_suspicion, int stuck, int onset,
-                                        std::uint64_t seed) {
+                                        std::uint64_t seed, bool quiet_start = false) {
   Truth t;
   FaultDetectorParams p = bank_params(t.gyro_sigma);
   p.degraded_min_loss = 0.1;
   p.check_llr = 0.5;
   p.check_fit_on_suspicion = fit_on_suspicion;
+  p.check_quiet_start = quiet_start;
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
   d.set_model(identified_model(t));
@@ -1359,6 +1361,7 @@ StuckDuringCheck fly_stuck_during_check(bool fit_on_suspicion, int stuck, int on
     out.run.note(d.update(in), k);
     const int jet = d.check_jet();
     if (jet >= 0 && jet != checking && d.status().chi2 > p.suspect_chi2) {
+      ++out.suspicious_starts;
       const auto i = static_cast<std::size_t>(jet);
       const V3 b = t.body.j.inverse() * (t.pos[i] + t.r).cross(t.dir[i]);
       const V3 m = d.status().residual;
@@ -1423,6 +1426,47 @@ TEST(FaultDetector, NoCheckStartsForAnEvidentFaultThatIsNotItsJet) {
   // 127 -> 97 ticks), not under aarch64's rounding, where no misaligned check starts either way.
   if (misaligned_before > 0) {
     EXPECT_GE(given_way, 1) << "a misaligned check started and held the confirmation back";
+  }
+}
+
+// (F34) The same 160 runs with checks started only on quiet windows (F31 on in both): no check
+// starts after a suspicious window at all, and every stuck jet is confirmed to itself, never later
+// and with no more check firing than with (F31) alone. Where (F31) started one (a jet the
+// suspicious window's motion lies along: the stuck jet's channel partner, whose stuck-off has the
+// same direction), the stuck jet is confirmed at least a window sooner without it.
+TEST(FaultDetector, NoCheckStartsOnASuspiciousWindow) {
+  Truth t0;
+  FaultDetector d0 = make_checking_detector(t0, 0.5);
+  const CheckRun healthy = fly_checked(t0, d0, 40000, 5);
+  ASSERT_FALSE(healthy.checked.empty());
+  const int start = healthy.check_ticks[0];
+  int suspicious_before = 0, suspicious_after = 0, sooner = 0;
+  for (int stuck = 0; stuck < 16; ++stuck) {
+    for (int off : {-200, -50, 1, 3, 5, 7, 9, 100, 400, 1000}) {
+      const int onset = start + off;
+      const std::string what = "thruster " + std::to_string(stuck) + " stuck on at tick " +
+                               std::to_string(onset);
+      const StuckDuringCheck before = fly_stuck_during_check(true, stuck, onset, 5, false);
+      const StuckDuringCheck after = fly_stuck_during_check(true, stuck, onset, 5, true);
+      ASSERT_GE(after.run.r.confirmed_at, onset) << what;
+      EXPECT_EQ(after.run.r.thruster, stuck) << what;
+      EXPECT_EQ(after.run.r.kind, FaultKind::kStuckOn) << what;
+      EXPECT_EQ(after.run.confirmations, 1) << what;
+      EXPECT_LE(after.run.r.confirmed_at, before.run.r.confirmed_at) << what;
+      EXPECT_LE(after.checked_ticks_to_confirmation, before.checked_ticks_to_confirmation) << what;
+      suspicious_before += before.suspicious_starts;
+      suspicious_after += after.suspicious_starts;
+      if (before.suspicious_starts > 0 &&
+          after.run.r.confirmed_at + 10 <= before.run.r.confirmed_at) {
+        ++sooner;
+      }
+    }
+  }
+  std::printf("checks started on a suspicious window: %d with F31 alone, %d with F34; %d stuck "
+              "jets confirmed a window or more sooner\n", suspicious_before, suspicious_after, sooner);
+  EXPECT_EQ(suspicious_after, 0);
+  if (suspicious_before > 0) {
+    EXPECT_GE(sooner, 1);
   }
 }
 
