@@ -1162,6 +1162,30 @@ FaultDetector::SweepLeader FaultDetector::sweep_leader() const {
   return r;
 }
 
+int FaultDetector::tested_pod_leader(const std::array<double, kHypotheses>& llr,
+                                     double& best_llr) const {
+  // (F15) The hypothesis a test's summed LLR names: a stuck-on jet of the tested pod, ahead of
+  // zero and of every other hypothesis by margin_llr; -1 otherwise.
+  int best = -1;
+  double second = -1e300;
+  best_llr = -1e300;
+  for (int h = 0; h < kHypotheses; ++h) {
+    const double l = llr[static_cast<std::size_t>(h)];
+    if (l > best_llr) {
+      second = best_llr;
+      best_llr = l;
+      best = h;
+    } else if (l > second) {
+      second = l;
+    }
+  }
+  if (best < 0 || best >= kThrusters || pod_[static_cast<std::size_t>(best)] != probe_tested_pod_) {
+    return -1;
+  }
+  if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  return best;
+}
+
 int FaultDetector::probe_verdict() const {
   // (F15) The unexplained motion followed the tested pod's valve: gone in every window flown with
   // the valve closed (at least one), back in the first window with it open. A stuck-off jet shows
@@ -1178,23 +1202,9 @@ int FaultDetector::probe_verdict() const {
   // sigma per window in cases 6-7) is decided over several consecutive tests of its pod. At least
   // one window must have been flown with the pod closed throughout.
   if (probe_closed_ == 0) return -1;
-  int best = -1;
-  double best_llr = -1e300;
-  double second = -1e300;
-  for (int h = 0; h < kHypotheses; ++h) {
-    const double l = probe_llr_[static_cast<std::size_t>(h)];
-    if (l > best_llr) {
-      second = best_llr;
-      best_llr = l;
-      best = h;
-    } else if (l > second) {
-      second = l;
-    }
-  }
-  if (best < 0 || best >= kThrusters || pod_[static_cast<std::size_t>(best)] != probe_tested_pod_) {
-    return -1;
-  }
-  if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  double best_llr = 0.0;
+  const int best = tested_pod_leader(probe_llr_, best_llr);
+  if (best < 0) return -1;
   if (p_.probe_partial_rival) {
     // (F29) A jet that lost part of its thrust leaves that part of its stuck-off signature, which
     // no hypothesis of the bank explains at full amplitude: over the test's windows its fitted
@@ -1223,27 +1233,11 @@ int FaultDetector::closed_probe_verdict() const {
   // start window alone cannot tell from the leader by margin_llr. Anything else waits for the
   // reopened window (F15).
   if (probe_closed_ == 0 || probe_tested_pod_ < 0) return -1;
-  const auto sum = [this](int h) {
-    const auto k = static_cast<std::size_t>(h);
-    return trigger_llr_[k] + closed_llr_[k];
-  };
-  int best = -1;
-  double best_llr = -1e300;
-  double second = -1e300;
-  for (int h = 0; h < kHypotheses; ++h) {
-    const double l = sum(h);
-    if (l > best_llr) {
-      second = best_llr;
-      best_llr = l;
-      best = h;
-    } else if (l > second) {
-      second = l;
-    }
-  }
-  if (best < 0 || best >= kThrusters || pod_[static_cast<std::size_t>(best)] != probe_tested_pod_) {
-    return -1;
-  }
-  if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  std::array<double, kHypotheses> sum{};
+  for (std::size_t k = 0; k < sum.size(); ++k) sum[k] = trigger_llr_[k] + closed_llr_[k];
+  double best_llr = 0.0;
+  const int best = tested_pod_leader(sum, best_llr);
+  if (best < 0) return -1;
   const auto contradicted = [this](int g) {
     return closed_llr_[static_cast<std::size_t>(g)] < -p_.margin_llr;
   };

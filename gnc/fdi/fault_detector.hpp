@@ -492,6 +492,7 @@ class FaultDetector {
   }
   // (F15) The stuck-on hypothesis confirmed by a test's outcome, or -1.
   int probe_verdict() const;
+  int tested_pod_leader(const std::array<double, kHypotheses>& llr, double& best_llr) const;
   // (F16) The tests' likelihood: each hypothesis's LLR summed over every window flown during the
   // isolation tests of one pod (closed windows and reopened ones, consecutive tests of that pod
   // adding up), and the pod (-1 none). A stuck-on jet of another pod loses ½E in each quiet closed
