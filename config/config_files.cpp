@@ -286,6 +286,7 @@ GncConfig load_gnc(const std::string& path) {
     }
     if (r.has("check_min_llr")) fd.check_min_llr = r.non_negative("check_min_llr");  // (F24)
     if (r.has("check_quiet_start")) fd.check_quiet_start = r.boolean("check_quiet_start");  // (F34)
+    if (r.has("check_score_unfit")) fd.check_score_unfit = r.boolean("check_score_unfit");  // (F35)
     if (r.has("check_fit_on_suspicion")) {  // (F31)
       fd.check_fit_on_suspicion = r.boolean("check_fit_on_suspicion");
     }

@@ -208,6 +208,7 @@ int firmware_main() {
     g_params.fdi.check_min_llr = 5.0;          // (F24) ... when the check can move the evidence
     g_params.fdi.check_fit_on_suspicion = true;  // (F31) ... and not for an evident fault elsewhere
     g_params.fdi.check_quiet_start = true;       // (F34) ... nor on a suspicious window
+    g_params.fdi.check_score_unfit = true;       // (F35) an unfit check window is scored
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
     g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
     g_params.fdi.probe_windows = 1;            // isolation tests of one window ...

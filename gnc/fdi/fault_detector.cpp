@@ -221,6 +221,7 @@ void FaultDetector::apply_model(const FaultModel& m) {
     const auto k = static_cast<std::size_t>(i);
     // (F1): the rate change per newton-second of thruster i.
     b_[k] = j_inv_ * (m.k(i) * (pos_[k] + m.r).cross(dir_[k]));
+    b_norm_[k] = b_[k].norm();
   }
 }
 
@@ -414,6 +415,20 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   acc.motion += (thrust_norm + 2.0 * j_inv_norm_ * j_norm_ * w.squaredNorm()) * dt_;
   // (the relative 1 sigma multiplies this: ||dJ||_2 = rel ||J||_2)
   acc.thrust_motion += thrust_norm * dt_;
+  // (F35) Each jet's torque magnitude, where it can differ from their net: on the updates whose
+  // thrust a check commanded (the thrust of this update was commanded while check_prev_ ran).
+  double gross_rate = thrust_norm;
+  if (check_prev_ >= 0) {
+    gross_rate = 0.0;
+    for (int i = 0; i < kThrusters; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (!in.valve_open[static_cast<std::size_t>(pod_[k])]) continue;
+      const bool latched_on = ((st_.confirmed_on >> i) & 1u) != 0;
+      const bool latched_off = ((st_.confirmed_off >> i) & 1u) != 0;
+      gross_rate += b_norm_[k] * (latched_on ? u_max_ : latched_off ? 0.0 : in.thrust(i));
+    }
+  }
+  acc.gross_motion += gross_rate * dt_;
   acc.force_impulse += in.thrust.sum() * dt_;
   ++n_;
   const Vec3 r = in.omega - omega_start_ - predicted_;  // (F3) residual of sample j
@@ -537,6 +552,7 @@ void FaultDetector::start_window(const Vec3& omega) {
   w.motion = 0.0;
   w.force_impulse = 0.0;
   w.thrust_motion = 0.0;
+  w.gross_motion = 0.0;
   w.live = 0;
   w.check_jet = -1;
   w.early_suspected = false;
@@ -604,21 +620,24 @@ void FaultDetector::evaluate_step() {
   }
 }
 
-double FaultDetector::window_var(const WindowSums& w, double n) const {
+double FaultDetector::window_var(const WindowSums& w, double n, bool gross) const {
   // (F5) noise of a residual sample: the gyro (start and sample), the disturbance over the window,
   // and the model's relative uncertainty times the motion it predicts.
   const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
   const double j_inv_f = j_inv_.norm();
   const double dist = p_.disturbance_sigma * j_inv_f * n * dt_;
+  // (F35) gross: each jet's torque is in error by its own share, whatever their net.
+  const double thrust_motion = gross ? w.gross_motion : w.thrust_motion;
+  const double motion = w.motion - w.thrust_motion + thrust_motion;
   // (F22) With the floor on the thrust's term only: rel of the thrust's motion, the identifier's
   // own 1 sigma of the gyroscopic term's bound (the rest of the motion).
   const double model = p_.model_floor_gyroscopic
-                           ? rel * w.motion
-                           : rel * w.thrust_motion + m_.j_rel_sigma * (w.motion - w.thrust_motion);
+                           ? rel * motion
+                           : rel * thrust_motion + m_.j_rel_sigma * (motion - thrust_motion);
   // The centre of mass and the strengths as uncertain as the identifier says: a torque error of
   // r_sigma times the jets' force, and k_sigma times their torque.
   const double offset = r_sigma_ * j_inv_f * w.force_impulse;
-  const double strength = m_.k_sigma * w.thrust_motion;
+  const double strength = m_.k_sigma * thrust_motion;
   const double gyro_var = (p_.centred_gyro_noise ? 1.0 : 2.0) * p_.gyro_sigma * p_.gyro_sigma;
   return gyro_var + dist * dist + model * model + offset * offset + strength * strength + 1e-30;
 }
@@ -662,8 +681,13 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   if (w.check_jet >= 0) {
     const Vec3& b = b_[static_cast<std::size_t>(w.check_jet)];
     if (check_normal_chi2(b, slope, stt, var) > p_.check_fit_chi2) {
-      eval_unfit_ = true;
       ++st_.checks_unfit;
+      if (p_.check_score_unfit) {
+        // (F35) Scored, with the model's error of every jet the check fired.
+        eval_var_ = window_var(w, n, true);
+      } else {
+        eval_unfit_ = true;
+      }
     }
   }
   ++st_.windows;

@@ -144,6 +144,12 @@ struct FaultDetectorParams {
   // (F34) No check starts on a window whose no-fault chi-square exceeded suspect_chi2 (a jet whose
   // evidence is real still has it on the next quiet window). false: as before.
   bool check_quiet_start{false};
+  // (F35) A check window whose motion does not lie along the checked jet's signature (unfit,
+  // check_fit_chi2) is scored like any window, with the model's error of every jet the check
+  // fired (the sum of their torques' magnitudes, not of their net torque, which the check's null
+  // space makes small): the jets fired beside the checked one are commanded firmly there, and a
+  // stuck-off one among them shows. false: an unfit window is not scored (F19).
+  bool check_score_unfit{false};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
   // window flown so far (the no-fault slope statistic with the noise of F5 on those samples)
   // against detect_early_chi2, and the first crossing raises the window's suspicion there and
@@ -397,6 +403,7 @@ class FaultDetector {
     double motion{0.0};         // cumulative |predicted terms| * dt (model-uncertainty scale)
     double force_impulse{0.0};  // cumulative sum of thrust * dt over the jets, N s
     double thrust_motion{0.0};  // cumulative |thrust rate change| * dt
+    double gross_motion{0.0};   // (F35) thrust_motion with sum |b_i| f_i on the checked updates
     Vec3 sum_r{Vec3::Zero()};   // sum of residuals r_j
     double sum_t{0.0};          // sum of j (sample index), for the slope test
     double sum_tt{0.0};
@@ -427,7 +434,8 @@ class FaultDetector {
   void evaluate_noise(const WindowSums& w);
   // (F5) The variance of a residual sample over the window's first n samples, and (F33) the
   // no-fault slope statistic of those samples.
-  double window_var(const WindowSums& w, double n) const;
+  // gross: (F35) the thrust's share of the model's error from every jet's torque, not the net.
+  double window_var(const WindowSums& w, double n, bool gross = false) const;
   double early_chi2(const WindowSums& w, double n) const;
   void evaluate_scores(const WindowSums& w, int first, int last);
   void rank_hypotheses();
@@ -449,6 +457,7 @@ class FaultDetector {
   std::array<Vec3, kHypotheses> sig_{};  // b c of the last window, for signature()
   // (F1) J^-1 k_i (p_i + r) x e_i: rate change per N s of thruster i.
   std::array<Vec3, kThrusters> b_{};
+  std::array<double, kThrusters> b_norm_{};  // |b_i| (F35)
 
   std::array<double, kHypotheses> score_{};
   // (F11) Windows in which a hypothesis's signature was too weak to score on its own are pooled:

@@ -367,11 +367,12 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
 }
 
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
-// (F32) the test read on its closed windows and (F34) checks started on quiet windows: gnc.yaml true, the former behaviour (false) when
+// (F32) the test read on its closed windows, (F34) checks started on quiet windows and (F35) unfit
+// check windows scored: gnc.yaml true, the former behaviour (false) when
 // a key is absent, and a value that is not a boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
   for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival",
-                          "probe_read_closed", "check_quiet_start"}) {
+                          "probe_read_closed", "check_quiet_start", "check_score_unfit"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -379,7 +380,8 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "centred_gyro_noise"  ? f.centred_gyro_noise
              : k == "probe_partial_rival" ? f.probe_partial_rival
              : k == "probe_read_closed"   ? f.probe_read_closed
-                                          : f.check_quiet_start;
+             : k == "check_quiet_start"   ? f.check_quiet_start
+                                          : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(6)).flight.fdi)) << key;

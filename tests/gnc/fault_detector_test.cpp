@@ -1470,6 +1470,99 @@ TEST(FaultDetector, NoCheckStartsOnASuspiciousWindow) {
   }
 }
 
+// (F35) The flight fires a check in the null space of B_hat, so jets beside the checked one fire
+// firmly too. Here every check of a jet also fires `partner` at the check force (the truth is the
+// detector's model, so the extra torque is predicted). The partner is stuck off from shortly
+// before the first check: the check window's motion is the partner's missing torque, normal to
+// the checked jet's signature, so the window is unfit (F19). Unscored (F35 off), it teaches the
+// bank nothing and the partner waits for its own evidence; scored with the model's error of every
+// jet fired (F35 on), it confirms the partner stuck off from the check's windows.
+struct PartnerRun {
+  DegradedRun run;
+  int first_check{-1};  // tick the first check started
+  int first_checked{-1};
+  std::uint32_t unfit{0};
+};
+
+PartnerRun fly_check_with_partner(bool score_unfit, int partner, int onset, std::uint64_t seed,
+                                  int ticks) {
+  Truth t;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
+  p.degraded_min_loss = 0.1;
+  p.check_llr = 0.5;  // healthy jets' weak evidence starts checks (as the tests above)
+  p.check_force_n = kUmax;  // the partner's missing torque well above the gyro's noise
+  p.check_score_unfit = score_unfit;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  d.set_model(identified_model(t));
+  WeakFiring firing(seed);
+  Vec16 prev = Vec16::Zero();
+  PartnerRun out;
+  for (int k = 0; k < ticks; ++k) {
+    if (k == onset) t.stuck_off = partner;
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    in.valve_open = t.valve;
+    const int before = d.check_jet();
+    out.run.note(d.update(in), k);
+    if (d.check_jet() >= 0 && d.check_jet() != before && out.first_check < 0) {
+      out.first_check = k;
+      out.first_checked = d.check_jet();
+    }
+    Vec16 cmd = firing.next(k);
+    if (d.check_jet() >= 0) {
+      cmd(d.check_jet()) += d.check_force();
+      if (d.check_jet() != partner) cmd(partner) += d.check_force();
+    }
+    t.advance(cmd);
+    prev = cmd;
+  }
+  out.unfit = d.status().checks_unfit;
+  return out;
+}
+
+TEST(FaultDetector, AStuckOffJetFiredBesideACheckedJetIsConfirmedFromTheCheckWindow) {
+  // Where the first check starts in this healthy firing, and of which jet.
+  const PartnerRun healthy = fly_check_with_partner(true, 0, 1 << 30, 5, 40000);
+  ASSERT_GE(healthy.first_check, 0);
+  EXPECT_EQ(healthy.run.confirmations, 0);  // a healthy partner: nothing confirmed
+  const int start = healthy.first_check;
+  const FaultDetectorParams defaults;
+  // The check's windows, the one after (the first may start mid-window) and the evaluation.
+  const int bound = start + (defaults.check_windows + 2) * 10 + FaultDetector::kEvaluationSteps;
+  int tested = 0;
+  int sooner = 0;
+  for (int partner = 0; partner < 16; ++partner) {
+    if (partner == healthy.first_checked) continue;
+    const std::string what = "partner " + std::to_string(partner);
+    // Stuck off 5 s before the first check: its weak firing meanwhile (4-15 N) does not reach the
+    // check level, so the same jet is checked first.
+    const PartnerRun with = fly_check_with_partner(true, partner, start - 50, 5, start + 3000);
+    const PartnerRun without = fly_check_with_partner(false, partner, start - 50, 5, start + 3000);
+    // The same check first, and a window it made unfit (a partner whose signature is nearly
+    // along the checked jet's leaves fit windows, scored either way).
+    if (with.first_check != start || without.first_check != start || without.unfit == 0) continue;
+    ++tested;
+    EXPECT_GE(with.unfit, 1u) << what;
+    ASSERT_GE(with.run.r.confirmed_at, start) << what;
+    EXPECT_LE(with.run.r.confirmed_at, bound) << what;
+    EXPECT_EQ(with.run.r.thruster, partner) << what;
+    EXPECT_EQ(with.run.r.kind, FaultKind::kStuckOff) << what;
+    EXPECT_EQ(with.run.confirmations, 1) << what;
+    // Without (F35) only the check's fit windows teach the bank: never sooner.
+    ASSERT_GE(without.run.r.confirmed_at, start) << what;
+    EXPECT_EQ(without.run.r.thruster, partner) << what;
+    EXPECT_LE(with.run.r.confirmed_at, without.run.r.confirmed_at) << what;
+    if (with.run.r.confirmed_at + 10 <= without.run.r.confirmed_at) ++sooner;
+  }
+  std::printf("partners stuck off behind an unfit check window: %d, confirmed a window or more "
+              "sooner with F35: %d\n", tested, sooner);
+  EXPECT_GE(tested, 5);
+  EXPECT_GE(2 * sooner, tested);
+}
+
 // Healthy jets checked (the check level set low enough that weak firing's noise starts checks):
 // each check exonerates the jet and nothing is confirmed; a jet is checked again only after
 // check_interval_s, and its third check only after twice that.
