@@ -173,6 +173,9 @@ GncConfig load_gnc(const std::string& path) {
     }
     id.adopt_interval_s = r.positive("adopt_interval_s");
     if (r.has("adopt_sigmas")) id.adopt_sigmas = r.non_negative("adopt_sigmas");
+    if (r.has("keep_model_after_fault")) {  // (I27)
+      id.keep_model_after_fault = r.boolean("keep_model_after_fault");
+    }
     gnc::IdentifierConfig& ic = id.config;
     const std::string mode = r.text("mode");
     if (mode == "joint") {

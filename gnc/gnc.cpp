@@ -518,6 +518,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     // (gnc/fdi/README.md (F10)).
     const bool fdi_busy = params_.fdi.enabled && fdi_.heavy_step_next();
     const bool reinflating = reinflate_pending_;
+    // (I27) The window open at the confirmation holds the fault unmodelled (a stuck-on jet's
+    // torque until its valve closed, a stuck-off jet's missing thrust until it was latched):
+    // with the model kept, that window is dropped (the next sample opens a clean one).
+    if (reinflating && params_.identification.keep_model_after_fault) in.force_valid = false;
     // The tick after a re-inflation the identifier's block is the rewrite of its covariance
     // (Identifier::reinflate_all); the detector's model refresh waits for the tick after that.
     const bool rewriting = ident_.covariance_rewrite_pending() && !fdi_busy && !reinflating;
@@ -525,6 +529,11 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     const bool linearising = ident_.heavy_block_next() && !fdi_busy && !reinflating;
     if (reinflating) {  // a fault confirmed on the last tick (step 1c)
       reinflate_pending_ = false;
+      // (I27) The identifier's model as it stood, for a restart from it below.
+      const IdentifierEstimate kept = ident_.estimate();
+      const double kept_j_rel =
+          std::sqrt(ident_.inertia_covariance().diagonal().maxCoeff()) / kept.j.norm();
+      const Mat3 kept_r_cov = ident_.offset_covariance();
       ident_.reinflate_all();
       // (F12) The detector held the model from before the identifier's gate refused the fault's
       // windows; the identifier fitted the unmodelled fault since. The fault is modelled now
@@ -537,6 +546,17 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
           fault_model_given_.j_rel_sigma <= params_.identification.config.j_confident_rel) {
         const FaultModel& h = fault_model_given_;
         ident_.restart_at(h.j, h.j_rel_sigma * h.j.norm(), h.r, h.r_cov, h.k, h.k_sigma);
+      } else if (params_.identification.keep_model_after_fault &&
+                 kept_j_rel <= params_.identification.config.j_confident_rel) {
+        // (I27) The body did not change and the fault is latched from now on; what J and r
+        // absorbed of it before the confirmation is taken to be within the floors below.
+        // Re-learnt from the prior, they were re-fitted on the windows of a late despin and of
+        // HOLD (weak, and in HOLD correlated with the disturbance): J 17-26 % off at 30 000 s at
+        // the median of the runs with a confirmation (gnc/estimation/README.md I.9).
+        const IdentifierConfig& ic = params_.identification.config;
+        const double j_sigma = std::fmax(kept_j_rel, ic.j_confident_rel) * kept.j.norm();
+        const Mat3 r_cov = kept_r_cov + ic.r_confident * ic.r_confident * Mat3::Identity();
+        ident_.restart_at(kept.j, j_sigma, kept.r, r_cov, kept.k, kept.k_sigma.maxCoeff());
       }
       release_fault_model();
       fault_model_stale_ = true;  // the detector takes the re-inflated model on a later tick

@@ -516,6 +516,13 @@ struct IdentificationParams {
   // but never below this (rad/s): the MEKF's bias sigma at convergence understates its error,
   // and the identifier takes the residual bias afresh each window (README I17).
   double mekf_bias_sigma_floor{3e-6};
+  // (I27) After a confirmed fault that the identifier does not restart from the detector's held
+  // model (a stuck-on jet, or no model held), it restarts from its own estimate of the tick
+  // before, if that was confident, with J's 1 sigma at least j_confident_rel of |J|, r's
+  // covariance plus r_confident^2 per axis and the strengths' 1 sigma their largest before,
+  // instead of all three groups at their prior; the window open at the confirmation is dropped.
+  // false: at their prior (README I.9: measured, not adopted).
+  bool keep_model_after_fault{false};
   // The identifier's tuning. Its dt, thruster geometry and priors (j0, r0, k0) are not read from
   // here: they are the active table's dt, rcs and mass_hat, filled in by build_identifier_config.
   IdentifierConfig config{};

@@ -237,8 +237,26 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
     EXPECT_EQ(f.adopt_interval_s, y.adopt_interval_s);
     EXPECT_EQ(f.adopt_sigmas, y.adopt_sigmas);
     EXPECT_EQ(f.mekf_bias_sigma_floor, y.mekf_bias_sigma_floor);
+    EXPECT_EQ(f.keep_model_after_fault, y.keep_model_after_fault);
   }
   EXPECT_GT(load_run(kMission, kGnc, case_file(6)).flight.identification.config.gyro_sigma, 0.0);
+}
+
+// (I27) keep_model_after_fault: gnc.yaml false (measured, not adopted), true when set, false when
+// the key is absent, and a value that is not a boolean names the file and key.
+TEST(ConfigShipped, KeepingTheModelAfterAFaultIsReadAndOptional) {
+  const std::string line =
+      "  keep_model_after_fault: false # (I27) true: after a confirmed fault, restart from the "
+      "confident model of the tick before (floored 1 sigma), not from the prior (measured, not "
+      "adopted: estimation README I.9)";
+  EXPECT_FALSE(load_run(kMission, kGnc, case_file(1)).flight.identification.keep_model_after_fault);
+  TempFile on("gnc.yaml", replaced(read(kGnc), line, "  keep_model_after_fault: true"));
+  EXPECT_TRUE(load_run(kMission, on.path(), case_file(6)).flight.identification.keep_model_after_fault);
+  TempFile absent("gnc.yaml", replaced(read(kGnc), line, ""));
+  EXPECT_FALSE(load_gnc(absent.path()).params.identification.keep_model_after_fault);
+  TempFile bad("gnc.yaml", replaced(read(kGnc), line, "  keep_model_after_fault: 3"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "identification.keep_model_after_fault",
+               "expected true or false");
 }
 
 // An optional switch of the detector's section: gnc.yaml names it with `shipped`, which is also

@@ -815,5 +815,100 @@ TEST(GncFdiIdentified, AHealthyIdentificationNeverConfirms) {
   EXPECT_LT(run.max_chi2_zero, identified_params(true).fdi.identified_zero_chi2);
 }
 
+// (I27) After a confirmed fault the identifier restarts from the confident model it had, with
+// its 1 sigma floored at the confidence bounds, not from the prior (`keep_model_after_fault`).
+// The flight starts from the wrong table of the tests above, identifies the body for 1500 s of
+// despin, and then a jet sticks on. On the tick after the confirmation (step 1b) the identifier's
+// J and r are those of the tick before, J's 1 sigma is max(its own, 1 %) of |J|, and the window
+// open at the confirmation (the fault unmodelled in it) is dropped; without (I27) the estimate is
+// kept too, J's 1 sigma is the prior's (1e7 kg m^2 per parameter) and the window goes on. The same
+// restart is refused when the model was not confident (the jet stuck from the first tick above,
+// GncFdiIdentified: those runs confirm as before).
+struct KeptRun {
+  int confirmed_tick{-1};
+  Mat3 j_before{Mat3::Zero()};
+  Vec3 r_before{Vec3::Zero()};
+  double j_sigma_rel_before{0.0};
+  Mat3 j_after{Mat3::Zero()};
+  Vec3 r_after{Vec3::Zero()};
+  double j_sigma_after{0.0};  // max 1 sigma of the six inertia parameters, kg m^2
+  double j_err_end{0.0};      // |J_hat - J| / |J| at the end
+  Mat3 j_true{Mat3::Zero()};
+  std::uint32_t discarded_before{0};  // the identifier's discarded windows, at the confirmation
+  std::uint32_t discarded_after{0};   // ... and on the tick after
+};
+
+KeptRun fly_kept(bool keep, int ticks) {
+  GncParams truth_params = identified_params(true);
+  truth_params.identification.keep_model_after_fault = keep;
+  Truth truth(truth_params);
+  truth.body.omega = V3(0.012, -0.018, 0.025);
+  Mat3 j_table = total_inertia(truth_params.mass_hat);
+  j_table(0, 0) *= 1.1;
+  j_table(1, 1) *= 0.9;
+  const GncParams p = with_model(truth_params, j_table,
+                                 truth_params.mass_hat.r_so_bcm + Vec3(0.3, -0.2, 0.2),
+                                 truth_params.rcs.strength);
+  auto* gnc = new Gnc;
+  KeptRun run;
+  run.j_true = truth.body.j;
+  EXPECT_TRUE(gnc->init(p).ok);
+  GncOutput out;
+  GncCommands c;
+  c.has_mode_request = true;
+  c.mode_request = Mode::kDetumble;
+  double t = 0.0;
+  for (int k = 0; k < ticks; ++k) {
+    if (k == 15000) truth.stuck_on = 4;
+    gnc->step(truth.sample(t), k == 0 ? c : GncCommands{}, out);
+    const Identifier& id = gnc->identifier();
+    if (run.confirmed_tick >= 0 && k == run.confirmed_tick + 1) {
+      run.j_after = id.estimate().j;
+      run.r_after = id.estimate().r;
+      run.j_sigma_after = std::sqrt(id.inertia_covariance().diagonal().maxCoeff());
+      run.discarded_after = id.counters().windows_discarded;
+    }
+    if (count(out, EventId::kFaultConfirmed) > 0 && run.confirmed_tick < 0) {
+      run.confirmed_tick = k;
+      run.j_before = id.estimate().j;
+      run.r_before = id.estimate().r;
+      run.j_sigma_rel_before =
+          std::sqrt(id.inertia_covariance().diagonal().maxCoeff()) / id.estimate().j.norm();
+      run.discarded_before = id.counters().windows_discarded;
+    }
+    truth.advance(out.command, p.dt);
+    t += p.dt;
+  }
+  run.j_err_end = (gnc->identifier().estimate().j - run.j_true).norm() / run.j_true.norm();
+  delete gnc;
+  return run;
+}
+
+TEST(GncIdentification, AfterAConfirmedFaultTheIdentifierRestartsFromItsConfidentModel) {
+  constexpr int kTicks = 25000;  // 1500 s healthy, the fault, 1000 s after
+  const KeptRun kept = fly_kept(true, kTicks);
+  const KeptRun prior = fly_kept(false, kTicks);
+  const double vj = identified_params(true).identification.config.j_prior_sigma;
+  for (const KeptRun* r : {&kept, &prior}) {
+    ASSERT_GE(r->confirmed_tick, 15000);
+    // The model was identified and confident before the fault.
+    EXPECT_LE(r->j_sigma_rel_before, 0.01);
+    EXPECT_LT((r->j_before - r->j_true).norm() / r->j_true.norm(), 0.01);
+    // The estimate is kept either way.
+    EXPECT_LT((r->j_after - r->j_before).norm(), 1e-9 * r->j_before.norm());
+    EXPECT_LT((r->r_after - r->r_before).norm(), 1e-12);
+  }
+  // (I27) J's 1 sigma: max(its own, 1 %) of |J|; without it, the prior's.
+  EXPECT_NEAR(kept.j_sigma_after, std::fmax(kept.j_sigma_rel_before, 0.01) * kept.j_before.norm(),
+              1e-6 * kept.j_before.norm());
+  EXPECT_DOUBLE_EQ(prior.j_sigma_after, vj);
+  // ... and the window open at the confirmation, which holds the fault unmodelled, is dropped.
+  EXPECT_EQ(kept.discarded_after, kept.discarded_before + 1);
+  EXPECT_EQ(prior.discarded_after, prior.discarded_before);
+  std::printf("J error 1000 s after the confirmation: %.4f kept, %.4f from the prior\n",
+              kept.j_err_end, prior.j_err_end);
+  EXPECT_LT(kept.j_err_end, 0.02);
+}
+
 }  // namespace
 }  // namespace rocksteady::gnc
