@@ -529,11 +529,13 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     const bool linearising = ident_.heavy_block_next() && !fdi_busy && !reinflating;
     if (reinflating) {  // a fault confirmed on the last tick (step 1c)
       reinflate_pending_ = false;
-      // (I27) The identifier's model as it stood, for a restart from it below.
-      const IdentifierEstimate kept = ident_.estimate();
+      // (I27) The identifier's model as it stood, for a restart from it below (when asked).
+      const bool keep = params_.identification.keep_model_after_fault;
+      const IdentifierEstimate kept = keep ? ident_.estimate() : IdentifierEstimate{};
       const double kept_j_rel =
-          std::sqrt(ident_.inertia_covariance().diagonal().maxCoeff()) / kept.j.norm();
-      const Mat3 kept_r_cov = ident_.offset_covariance();
+          keep ? std::sqrt(ident_.inertia_covariance().diagonal().maxCoeff()) / kept.j.norm()
+               : 0.0;
+      const Mat3 kept_r_cov = keep ? ident_.offset_covariance() : Mat3::Zero();
       ident_.reinflate_all();
       // (F12) The detector held the model from before the identifier's gate refused the fault's
       // windows; the identifier fitted the unmodelled fault since. The fault is modelled now
@@ -546,8 +548,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
           fault_model_given_.j_rel_sigma <= params_.identification.config.j_confident_rel) {
         const FaultModel& h = fault_model_given_;
         ident_.restart_at(h.j, h.j_rel_sigma * h.j.norm(), h.r, h.r_cov, h.k, h.k_sigma);
-      } else if (params_.identification.keep_model_after_fault &&
-                 kept_j_rel <= params_.identification.config.j_confident_rel) {
+      } else if (keep && kept_j_rel <= params_.identification.config.j_confident_rel) {
         // (I27) The body did not change and the fault is latched from now on; what J and r
         // absorbed of it before the confirmation is taken to be within the floors below.
         // Re-learnt from the prior, they were re-fitted on the windows of a late despin and of

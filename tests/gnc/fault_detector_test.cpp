@@ -97,15 +97,28 @@ FaultDetectorParams bank_params(double gyro_sigma, int window_ticks = 10) {
   return p;
 }
 
+FaultDetector make_detector(const Truth& t, const FaultDetectorParams& p) {
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  d.set_model(identified_model(t));
+  return d;
+}
+
+// The check rig of (F31), (F34), (F35): partial losses on, and a check level low enough that the
+// weak firing's noise starts checks of healthy jets.
+FaultDetectorParams check_rig_params(const Truth& t) {
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
+  p.degraded_min_loss = 0.1;
+  p.check_llr = 0.5;
+  return p;
+}
+
 FaultDetector make_detector(const Truth& t, double gyro_sigma, double degraded_min_loss = 0.0,
                             double check_llr = 0.0) {
   FaultDetectorParams p = bank_params(gyro_sigma);
   p.degraded_min_loss = degraded_min_loss;
   p.check_llr = check_llr;  // (F19) jet checks, off unless asked
-  FaultDetector d;
-  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  d.set_model(identified_model(t));
-  return d;
+  return make_detector(t, p);
 }
 
 // A firing pattern that keeps every thruster busy part of the time (as a despin does): each
@@ -1338,14 +1351,10 @@ struct StuckDuringCheck {
 StuckDuringCheck fly_stuck_during_check(bool fit_on_suspicion, int stuck, int onset,
                                         std::uint64_t seed, bool quiet_start = false) {
   Truth t;
-  FaultDetectorParams p = bank_params(t.gyro_sigma);
-  p.degraded_min_loss = 0.1;
-  p.check_llr = 0.5;
+  FaultDetectorParams p = check_rig_params(t);
   p.check_fit_on_suspicion = fit_on_suspicion;
   p.check_quiet_start = quiet_start;
-  FaultDetector d;
-  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  d.set_model(identified_model(t));
+  FaultDetector d = make_detector(t, p);
   WeakFiring firing(seed);
   Vec16 prev = Vec16::Zero();
   StuckDuringCheck out;
@@ -1487,14 +1496,10 @@ struct PartnerRun {
 PartnerRun fly_check_with_partner(bool score_unfit, int partner, int onset, std::uint64_t seed,
                                   int ticks) {
   Truth t;
-  FaultDetectorParams p = bank_params(t.gyro_sigma);
-  p.degraded_min_loss = 0.1;
-  p.check_llr = 0.5;  // healthy jets' weak evidence starts checks (as the tests above)
+  FaultDetectorParams p = check_rig_params(t);
   p.check_force_n = kUmax;  // the partner's missing torque well above the gyro's noise
   p.check_score_unfit = score_unfit;
-  FaultDetector d;
-  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  d.set_model(identified_model(t));
+  FaultDetector d = make_detector(t, p);
   WeakFiring firing(seed);
   Vec16 prev = Vec16::Zero();
   PartnerRun out;

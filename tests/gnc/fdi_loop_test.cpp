@@ -735,17 +735,21 @@ GncParams identified_params(bool identified_isolation) {
   return p;
 }
 
+// The flight's table against the truth's (truth_params): J 10 % off about two axes, r 0.4 m off.
+GncParams wrong_table(const GncParams& truth_params) {
+  Mat3 j_table = total_inertia(truth_params.mass_hat);
+  j_table(0, 0) *= 1.1;
+  j_table(1, 1) *= 0.9;
+  return with_model(truth_params, j_table, truth_params.mass_hat.r_so_bcm + Vec3(0.3, -0.2, 0.2),
+                    truth_params.rcs.strength);
+}
+
 IdentifiedRun fly_identified(int stuck_on, bool identified_isolation, int ticks) {
   const GncParams truth_params = identified_params(identified_isolation);
   Truth truth(truth_params);
   truth.body.omega = V3(0.012, -0.018, 0.025);
   truth.stuck_on = stuck_on;  // from the first tick: before anything is identified
-  Mat3 j_table = total_inertia(truth_params.mass_hat);
-  j_table(0, 0) *= 1.1;
-  j_table(1, 1) *= 0.9;
-  const GncParams p = with_model(truth_params, j_table,
-                                 truth_params.mass_hat.r_so_bcm + Vec3(0.3, -0.2, 0.2),
-                                 truth_params.rcs.strength);
+  const GncParams p = wrong_table(truth_params);
   auto* gnc = new Gnc;  // (large: off the test's stack)
   IdentifiedRun run;
   EXPECT_TRUE(gnc->init(p).ok);
@@ -843,12 +847,7 @@ KeptRun fly_kept(bool keep, int ticks) {
   truth_params.identification.keep_model_after_fault = keep;
   Truth truth(truth_params);
   truth.body.omega = V3(0.012, -0.018, 0.025);
-  Mat3 j_table = total_inertia(truth_params.mass_hat);
-  j_table(0, 0) *= 1.1;
-  j_table(1, 1) *= 0.9;
-  const GncParams p = with_model(truth_params, j_table,
-                                 truth_params.mass_hat.r_so_bcm + Vec3(0.3, -0.2, 0.2),
-                                 truth_params.rcs.strength);
+  const GncParams p = wrong_table(truth_params);
   auto* gnc = new Gnc;
   KeptRun run;
   run.j_true = truth.body.j;
