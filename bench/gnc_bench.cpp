@@ -179,6 +179,8 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.check_fit_on_suspicion = fdi;         // (F31) ... and not for an evident fault elsewhere
   p.fdi.check_quiet_start = fdi;              // (F34) ... nor on a suspicious window
   p.fdi.check_score_unfit = fdi;              // (F35) an unfit check window is scored
+  p.fdi.check_blocker = fdi;                  // (F37) the jet blocking a stuck-off leader checked
+  p.fdi.episode_restart_stale = fdi;          // (F38) a stale episode restarted
   p.fdi.model_rel_floor = 0.005;              // the model's relative error floor, as flown
   p.fdi.model_floor_gyroscopic = true;        // (F22) ... on both terms, as flown
   p.fdi.probe_windows = 1;                    // isolation tests of one window ...

@@ -290,6 +290,20 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("check_min_llr")) fd.check_min_llr = r.non_negative("check_min_llr");  // (F24)
     if (r.has("check_quiet_start")) fd.check_quiet_start = r.boolean("check_quiet_start");  // (F34)
     if (r.has("check_score_unfit")) fd.check_score_unfit = r.boolean("check_score_unfit");  // (F35)
+    if (r.has("survey_interval_s")) {  // (F36), off when absent
+      fd.survey_interval_s = r.non_negative("survey_interval_s");
+    }
+    if (r.has("episode_restart_stale")) {  // (F38)
+      fd.episode_restart_stale = r.boolean("episode_restart_stale");
+    }
+    if (r.has("check_blocker")) fd.check_blocker = r.boolean("check_blocker");  // (F37)
+    if (r.has("survey_energy")) fd.survey_energy = r.positive("survey_energy");
+    if (r.has("survey_max_windows")) {
+      fd.survey_max_windows = r.integer("survey_max_windows");
+      if (fd.survey_max_windows < 1 || fd.survey_max_windows > 1000) {
+        r.fail("survey_max_windows", "must be in [1, 1000]");
+      }
+    }
     if (r.has("check_fit_on_suspicion")) {  // (F31)
       fd.check_fit_on_suspicion = r.boolean("check_fit_on_suspicion");
     }

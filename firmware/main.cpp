@@ -21,6 +21,9 @@
 //   degraded=N    thruster N delivers half of what is commanded from onset=T s: the partial-loss
 //                 confirmation (gnc/fdi/README.md F18) runs on the counted ticks; success then also
 //                 needs that thruster, and only it, confirmed degraded
+//   survey=S      with modules=all: the jet survey (gnc/fdi/README.md F36; an option, off in
+//                 gnc.yaml) every S s, so that its checks run on the counted ticks (over the
+//                 budget in HOLD: DEVELOPERS.md)
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -62,6 +65,7 @@ struct Options {
   int degraded{-1};             // thruster at half strength (-1: none)
   bool pinv{false};             // modules=all with the pseudoinverse allocator
   std::uint32_t onset_s{1000};  // ... from this simulated time
+  std::uint32_t survey_s{0};    // (F36) jet survey interval, 0 off
 };
 
 // Parses "key=value" tokens of the semihosting command line (unknown tokens are ignored).
@@ -99,6 +103,7 @@ Options parse_options() {
       o.degraded = n < 16U ? static_cast<int>(n) : -1;
     }
     if (const char* v = value_of("onset=")) o.onset_s = to_u32(v);
+    if (const char* v = value_of("survey=")) o.survey_s = to_u32(v);
   }
   return o;
 }
@@ -209,6 +214,9 @@ int firmware_main() {
     g_params.fdi.check_fit_on_suspicion = true;  // (F31) ... and not for an evident fault elsewhere
     g_params.fdi.check_quiet_start = true;       // (F34) ... nor on a suspicious window
     g_params.fdi.check_score_unfit = true;       // (F35) an unfit check window is scored
+    g_params.fdi.check_blocker = true;           // (F37) the jet blocking a stuck-off leader checked
+    g_params.fdi.episode_restart_stale = true;   // (F38) a stale episode restarted
+    g_params.fdi.survey_interval_s = static_cast<double>(opt.survey_s);  // (F36) 0: off, as flown
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
     g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
     g_params.fdi.probe_windows = 1;            // isolation tests of one window ...

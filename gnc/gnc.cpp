@@ -780,6 +780,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   f.check_jet = static_cast<std::int8_t>(check_jet_);
   f.checks = fs.checks;
   f.checks_unfit = fs.checks_unfit;
+  f.surveys = fs.surveys;
+  f.unverified = fs.unverified;
 }
 
 void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {

@@ -206,6 +206,8 @@ struct FdiTelemetry {
   std::int8_t check_jet{-1};    // (F19) thruster fired for a jet check this tick, -1 none
   std::uint32_t checks{0};      // jet checks started
   std::uint32_t checks_unfit{0};  // check windows not scored: they showed a model error
+  std::uint32_t surveys{0};       // (F36) of the checks, those the jet survey started
+  std::uint16_t unverified{0};    // (F36) bit i: thruster i commanded and not verified since
 };
 
 struct GncTelemetry {

@@ -1,6 +1,7 @@
 #include "gnc/fdi/fault_detector.hpp"
 #include "gnc/fdi/jet_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -79,6 +80,13 @@ Check validate(const FaultDetectorParams& p) {
   }
   if (!(p.check_min_llr >= 0.0) || !std::isfinite(p.check_min_llr)) {
     return bad("fdi.check_min_llr", "must not be negative");
+  }
+  if (!finite_non_negative(p.survey_interval_s)) {
+    return bad("fdi.survey_interval_s", "must be >= 0 and finite");
+  }
+  if (!finite_positive(p.survey_energy)) return bad("fdi.survey_energy", "must be positive");
+  if (p.survey_max_windows < 1 || p.survey_max_windows > 1000) {
+    return bad("fdi.survey_max_windows", "must be in [1, 1000]");
   }
   return Check{};
 }
@@ -175,6 +183,9 @@ void FaultDetector::reset() {
   end_check();
   last_check_.fill(0);
   check_backoff_.fill(0);
+  survey_e_.fill(0.0);
+  survey_from_.fill(st_.windows);
+  st_.unverified = 0;
   check_prev_ = -1;
   quiet_var_ = 0.0;
   eval_unfit_ = false;
@@ -587,7 +598,14 @@ void FaultDetector::evaluate_step() {
       // (in HOLD an idle jet's stuck-off score can stay above zero for the rest of the flight,
       // and the episode used to restart only with every score at zero). A leader that was
       // already leading keeps the evidence it gathered below the suspicion level.
-      if (p_.episode_restart && suspecting_ && !was_suspecting && st_.best != was_best) {
+      // (F38) So does a suspicion whose leader's episode sum trails its score by more than
+      // margin_llr: its CUSUM restarted after the episode did (the change came later), and the
+      // episode holds the healthy windows before it (in HOLD no window is suspicious, so the
+      // episode can hold hours, a jet's healthy checks among them).
+      const bool stale = p_.episode_restart_stale && st_.best >= 0 &&
+                         lambda(static_cast<std::size_t>(st_.best)) < st_.best_llr - p_.margin_llr;
+      if (p_.episode_restart && suspecting_ && !was_suspecting &&
+          (st_.best != was_best || stale)) {
         restart_episode_with_window();
       }
       evaluate_cross(w);
@@ -1427,6 +1445,7 @@ void FaultDetector::update_check() {
   // a healthy jet loses about half of it from each hypothesis (exonerated within a window), a
   // failed one gains it (confirmed by F6 / F13 / F18 as before). Nothing here decides anything.
   const bool suspicious = st_.chi2 > p_.suspect_chi2;  // the window just evaluated
+  update_survey();
   if (check_left_ > 0) {
     if (--check_left_ == 0) end_check();
     return;
@@ -1448,6 +1467,20 @@ void FaultDetector::update_check() {
       static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s));
   int jet = -1;
   double evidence = p_.check_llr;
+  if (p_.check_blocker && st_.best >= kThrusters && st_.best_llr > p_.confirm_llr &&
+      st_.ambiguous_with >= kThrusters) {
+    // (F37) The stuck-off jet that blocks a stuck-off leader is checked, evidence or not.
+    const int g = st_.ambiguous_with - kThrusters;
+    const auto k = static_cast<std::size_t>(g);
+    if (((latched >> g) & 1u) == 0 &&
+        (last_check_[k] == 0 ||
+         st_.windows + 1 - last_check_[k] >= (interval << check_backoff_[k])) &&
+        signature_rel_error(g) <= p_.check_max_model_error &&
+        (!(p_.check_min_llr > 0.0) || expected_check_llr(g) >= p_.check_min_llr)) {
+      jet = g;
+      evidence = 1e300;  // no evidence outranks it
+    }
+  }
   for (int i = 0; i < kThrusters; ++i) {
     if (((latched >> i) & 1u) != 0) continue;
     const auto k = static_cast<std::size_t>(i);
@@ -1472,9 +1505,18 @@ void FaultDetector::update_check() {
       jet = i;
     }
   }
-  if (jet < 0) return;
+  int windows = p_.check_windows;
+  if (jet < 0) {
+    jet = survey_candidate(windows);
+    if (jet < 0) return;
+    ++st_.surveys;
+    const auto ks = static_cast<std::size_t>(jet);
+    survey_e_[ks] = 0.0;  // its survey clock restarts with the check (verified or not)
+    survey_from_[ks] = st_.windows;
+    st_.unverified = static_cast<std::uint16_t>(st_.unverified & ~(1u << jet));
+  }
   st_.check_jet = jet;
-  check_left_ = p_.check_windows;
+  check_left_ = windows;
   const auto kj = static_cast<std::size_t>(jet);
   if (last_check_[kj] != 0 && check_backoff_[kj] < 2) ++check_backoff_[kj];
   last_check_[kj] = st_.windows + 1;
@@ -1490,7 +1532,69 @@ double FaultDetector::signature_rel_error(int i) const {
   return (kk > 0.0 ? m_.k_sigma / kk : 1.0) + m_.j_rel_sigma + (arm > 0.0 ? r_sigma_ / arm : 1.0);
 }
 
+void FaultDetector::update_survey() {
+  // (F36) The stuck-off energy E of each jet's last window (F6: a total loss of the jet would
+  // have added E / 2 to its score on average) summed since the jet was last verified. A jet whose
+  // sum reaches survey_energy is verified: had it failed, the bank would have seen it. A jet the
+  // window commanded (E > 0) and that is not verified yet is marked unverified.
+  if (!(p_.survey_interval_s > 0.0)) return;
+  const std::uint16_t latched = static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off);
+  for (int i = 0; i < kThrusters; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto bit = static_cast<std::uint16_t>(1u << i);
+    if ((latched & bit) != 0) {
+      survey_e_[k] = 0.0;
+      survey_from_[k] = st_.windows;
+      st_.unverified = static_cast<std::uint16_t>(st_.unverified & ~bit);
+      continue;
+    }
+    const double e = window_energy_[k];
+    if (!(e > 0.0)) continue;
+    survey_e_[k] += e;
+    if (survey_e_[k] >= p_.survey_energy) {
+      survey_e_[k] = 0.0;
+      survey_from_[k] = st_.windows;
+      st_.unverified = static_cast<std::uint16_t>(st_.unverified & ~bit);
+    } else {
+      st_.unverified = static_cast<std::uint16_t>(st_.unverified | bit);
+    }
+  }
+}
+
+int FaultDetector::survey_candidate(int& windows) const {
+  // (F36) Of the jets unverified for survey_interval_s, the one unverified longest whose check
+  // passes the check gates (F19 model error, F24 expected LLR), its check sized so that its
+  // expected energy reaches survey_energy.
+  if (!(p_.survey_interval_s > 0.0) || st_.unverified == 0) return -1;
+  const double window_s = static_cast<double>(p_.window_ticks) * dt_;
+  const auto interval = static_cast<std::uint32_t>(std::ceil(p_.survey_interval_s / window_s));
+  int jet = -1;
+  std::uint32_t oldest = 0;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (((st_.unverified >> i) & 1u) == 0) continue;
+    const auto k = static_cast<std::size_t>(i);
+    const std::uint32_t age = st_.windows - survey_from_[k];
+    if (age < interval || (jet >= 0 && age <= oldest)) continue;
+    if (signature_rel_error(i) > p_.check_max_model_error) continue;
+    const double e = expected_check_energy(i);
+    if (!(e > 0.0)) continue;
+    const int lo = p_.check_windows;
+    const int hi = std::max(lo, p_.survey_max_windows);
+    const double need = std::ceil(p_.survey_energy / e);
+    const int n = need >= static_cast<double>(hi) ? hi : std::max(lo, static_cast<int>(need));
+    if (p_.check_min_llr > 0.0 && 0.5 * e * static_cast<double>(n) < p_.check_min_llr) continue;
+    jet = i;
+    oldest = age;
+    windows = n;
+  }
+  return jet;
+}
+
 double FaultDetector::expected_check_llr(int i) const {
+  return 0.5 * expected_check_energy(i) * static_cast<double>(p_.check_windows);
+}
+
+double FaultDetector::expected_check_energy(int i) const {
   // (F24) A check fires thruster i at f = check_force_n, compensated in the null space of the
   // channels' torque matrix B (Gnc::apply_jet_check: du = e_c - B^T (B B^T)^-1 B e_c, scaled to
   // move channel c by f), so every channel fires: the check's force is f_tot = f sum |du| / |du_c|.
@@ -1515,8 +1619,7 @@ double FaultDetector::expected_check_llr(int i) const {
   const double offset = r_sigma_ * j_inv_.norm() * f * (sum / own) * n * dt_;
   const double var = quiet_var_ + offset * offset + 1e-30;
   const double step = b_[k].norm() * f * dt_;
-  const double e = step * step * n * (n * n - 1.0) / 12.0 / var;
-  return 0.5 * e * static_cast<double>(p_.check_windows);
+  return step * step * n * (n * n - 1.0) / 12.0 / var;
 }
 
 double FaultDetector::degraded_llr(int g) const {

@@ -150,6 +150,25 @@ struct FaultDetectorParams {
   // space makes small): the jets fired beside the checked one are commanded firmly there, and a
   // stuck-off one among them shows. false: an unfit window is not scored (F19).
   bool check_score_unfit{false};
+  // (F36) Jet survey: a jet the flight keeps commanding so lightly that its loss could not show
+  // (in HOLD the controller asks mN of it: tens of N s over 10^4 s, against a 200 N jet) is
+  // checked anyway. Each jet's stuck-off energy E (what a total loss of it would have put into
+  // the score, F6) is summed from the last time it was verified; E reaching survey_energy
+  // verifies it. A jet commanded since then but not verified for survey_interval_s is checked
+  // (F19), the check's length sized so that its expected E reaches survey_energy (at least
+  // check_windows, at most survey_max_windows windows). The check gates (model error, F24) hold.
+  // 0: off.
+  double survey_interval_s{0.0};
+  // (F37) A stuck-off leader past confirm_llr that (F8) cannot tell from another jet's stuck-off
+  // (twin jets, nearly parallel signatures, a model a few percent off) waits for evidence that
+  // more of the same firing cannot give; a check of the blocking jet (F19: its interval and
+  // gates) fires it alone, and exonerates or confirms it. false: as before.
+  bool check_blocker{false};
+  // (F38) A suspicion that starts with a leader whose episode sum trails its score by margin_llr
+  // restarts the episode too (F25 restarts it for a new leader only). false: as before.
+  bool episode_restart_stale{false};
+  double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
+  int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
   // window flown so far (the no-fault slope statistic with the noise of F5 on those samples)
   // against detect_early_chi2, and the first crossing raises the window's suspicion there and
@@ -229,6 +248,8 @@ struct FaultDetectorStatus {
   int check_jet{-1};                          // (F19) the jet being checked, -1 none
   std::uint32_t checks{0};                    // (F19) jet checks started
   std::uint32_t checks_unfit{0};              // (F19) check windows not scored (model error)
+  std::uint32_t surveys{0};                   // (F36) of the checks, those started by the survey
+  std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
 };
 
@@ -338,6 +359,12 @@ class FaultDetector {
   double signature_rel_error(int i) const;
   // (F24) The stuck-off LLR a check of thruster i is expected to move, E / 2 over its windows.
   double expected_check_llr(int i) const;
+  // (F24, F36) The stuck-off energy E one window of a check of thruster i is expected to have.
+  double expected_check_energy(int i) const;
+  // (F36) Each jet's stuck-off energy since it was last verified, after each decision.
+  void update_survey();
+  // (F36) The jet the survey checks now (-1 none) and the check's windows.
+  int survey_candidate(int& windows) const;
   // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
   double degraded_llr(int g) const;
   // (F18) The jet to confirm degraded now (and its fitted loss), or -1.
@@ -360,6 +387,8 @@ class FaultDetector {
   bool last_suspicious_{false};  // (F21) the window before it exceeded suspect_chi2
   std::array<std::uint32_t, kThrusters> last_check_{};  // window count at each jet's last check, +1
   std::array<std::uint8_t, kThrusters> check_backoff_{};  // doublings of each jet's interval (0..2)
+  std::array<double, kThrusters> survey_e_{};  // (F36) stuck-off energy since last verified
+  std::array<std::uint32_t, kThrusters> survey_from_{};  // (F36) window count when last verified
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
   bool deg_suspecting_{false};  // (F18) a partial loss past half the confirmation level

@@ -84,6 +84,7 @@ nlohmann::json fdi_json(const FdiReport& f) {
           {"suspicions", f.suspicions},
           {"checks", f.checks},
           {"checks_unfit", f.checks_unfit},
+          {"surveys", f.surveys},
           {"fault_detected_s", opt(f.fault_detected_s)},
           {"fault_first_commanded_s", opt(f.fault_first_commanded_s)},
           {"fault_commanded_s", f.fault_commanded_s},
@@ -106,6 +107,7 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
     f.checks = j.at("checks").get<std::uint32_t>();
     f.checks_unfit = j.at("checks_unfit").get<std::uint32_t>();
   }
+  if (j.contains("surveys")) f.surveys = j.at("surveys").get<std::uint32_t>();  // (F36)
   // Absent from draws written before these were measured.
   if (j.contains("confirmed_degraded")) {
     f.confirmed_degraded = j.at("confirmed_degraded").get<std::uint16_t>();

@@ -308,6 +308,7 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       d.suspicions = f.suspicions;
       d.checks = f.checks;
       d.checks_unfit = f.checks_unfit;
+      d.surveys = f.surveys;
       if (!setup.truth.faults.empty()) {
         // The first injected fault's jet, commanded by the flight this tick (held over it).
         const plant::ThrusterFault& inj = setup.truth.faults.front();

@@ -313,6 +313,32 @@ TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
                           });
 }
 
+// (F36) The jet survey: off (0) in gnc.yaml and when the key is absent; its energy and its
+// longest check read (the struct's values when absent); bad values named by file and key.
+TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOffInGncYaml) {
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.survey_interval_s, 0.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.survey_energy, 10.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.survey_max_windows, 8);
+  expect_optional_fdi_key("  survey_interval_s: 0.0", "survey_interval_s",
+                          "  survey_interval_s: -5", "", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_interval_s,
+                                      0.0);
+                          });
+  TempFile on("gnc.yaml", replaced(read(kGnc), "  survey_interval_s: 0.0", "  survey_interval_s: 20000"));
+  EXPECT_EQ(load_run(kMission, on.path(), case_file(1)).flight.fdi.survey_interval_s, 20000.0);
+  expect_optional_fdi_key("  survey_energy: 10.0", "survey_energy", "  survey_energy: 0", "",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_energy,
+                                      gnc::FaultDetectorParams{}.survey_energy);
+                          });
+  expect_optional_fdi_key("  survey_max_windows: 8", "survey_max_windows",
+                          "  survey_max_windows: 0", "must be in [1, 1000]",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_max_windows,
+                                      gnc::FaultDetectorParams{}.survey_max_windows);
+                          });
+}
+
 // (F33) Early detection: gnc.yaml's 3 samples at chi-square(3) 1 - 1e-7, off (0) when the key is
 // absent, and a bad value named by file and key.
 TEST(ConfigShipped, EarlyDetectionIsReadAndOptional) {
@@ -390,7 +416,8 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
 // a key is absent, and a value that is not a boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
   for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival",
-                          "probe_read_closed", "check_quiet_start", "check_score_unfit"}) {
+                          "probe_read_closed", "check_quiet_start", "check_score_unfit",
+                          "check_blocker", "episode_restart_stale"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -399,6 +426,8 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "probe_partial_rival" ? f.probe_partial_rival
              : k == "probe_read_closed"   ? f.probe_read_closed
              : k == "check_quiet_start"   ? f.check_quiet_start
+             : k == "check_blocker"       ? f.check_blocker
+             : k == "episode_restart_stale" ? f.episode_restart_stale
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;

@@ -496,6 +496,50 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
   delete loop;
 }
 
+// gnc/fdi/README.md (F36)-(F38): the jet survey's bookkeeping and its checks, with the stale
+// episode's restart and the blocker's check on; no evidence check (check_llr out of reach), a
+// survey every 20 s and a verification level no firing reaches: no heap.
+TEST(ZeroAllocation, NoHeapInAJetSurvey) {
+  GncParams p = test::small_vehicle_params();
+  p.law = LawId::kNtcl;
+  p.allocator = AllocatorKind::kL1;
+  p.fdi.enabled = true;
+  p.fdi.window_ticks = 10;
+  p.fdi.gyro_sigma = 1e-4;
+  p.fdi.degraded_min_loss = 0.1;
+  p.fdi.check_llr = 1e6;
+  p.fdi.check_force_n = 0.5;  // the small vehicle's channels reach 2 N
+  p.fdi.check_max_model_error = 1e3;
+  p.fdi.survey_interval_s = 20.0;
+  p.fdi.survey_energy = 1e12;
+  p.fdi.check_blocker = true;
+  p.fdi.episode_restart_stale = true;
+  p.fdi_table_rel_sigma = 1e-4;
+  auto* loop = new test::SmallLoop(p);
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, p.fdi.gyro_sigma);
+  long counted = -1;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    for (int k = 0; k < 3000; ++k) {
+      SensorSample s = loop->sample();
+      s.gyro_rate += Vec3(noise(rng), noise(rng), noise(rng));
+      loop->gnc.step(s, k == 0 ? c : GncCommands{}, loop->out);
+      loop->body.step(p.dt, loop->b_true * loop->out.command.force);
+      loop->t += p.dt;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(loop->gnc.fault_detector().status().surveys, 2u);
+  EXPECT_EQ(loop->out.telemetry.fdi.surveys, loop->gnc.fault_detector().status().surveys);
+  delete loop;
+}
+
 TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {
   GncParams truth = test::small_vehicle_params();
   auto* loop = new test::SmallLoop(truth);
