@@ -1738,10 +1738,12 @@ TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNo
 // the episode still starts before the fault when the next survey raises the jet's score past
 // confirm_llr: its loss fitted over the episode is a partial one (F13) and nothing is confirmed.
 // Restarting the episode when the leader's episode sum trails its score by margin_llr confirms
-// it stuck off on that survey's evidence (x86-64: jet 13 at 652 s instead of 1 258 s; jets 3 and 6
-// at the same time either way, their episodes restarted by a new leader, F25).
-TEST(FaultDetector, AJetSurveyedHealthyThenDeadIsConfirmedFromTheEpisodeSinceItsFault) {
-  int restarted = 0;
+// it stuck off on that survey's evidence. Whether the rig's episode is stale at the suspicion
+// depends on the run (x86-64: jet 13 at 652 s instead of 1 258 s, jets 3 and 6 at the same time
+// either way, their episodes restarted by a new leader, F25; the aarch64 build: all three at the
+// same time), so the sooner confirmation is asserted to come with a restart of its own, not to
+// happen; the dispersion measures how often it does (README "The jet survey").
+TEST(FaultDetector, AJetSurveyedHealthyThenDeadIsConfirmedStuckOffWithTheStaleEpisodeRestart) {
   for (int i : {3, 6, 13}) {
     const std::string what = "thruster " + std::to_string(i);
     const auto fly = [&](bool stale, SurveyRun& run) {
@@ -1766,11 +1768,11 @@ TEST(FaultDetector, AJetSurveyedHealthyThenDeadIsConfirmedFromTheEpisodeSinceIts
     EXPECT_EQ(run.r.kind, FaultKind::kStuckOff) << what;
     EXPECT_EQ(run.confirmations, 1) << what;
     if (old_run.r.confirmed_at < 0 || old_run.r.confirmed_at > run.r.confirmed_at) {
-      ++restarted;
       EXPECT_GT(after, before) << what << ": sooner without a restart of its own";
     }
+    EXPECT_FALSE(old_run.r.confirmed_at >= 0 && old_run.r.confirmed_at < run.r.confirmed_at)
+        << what << ": the restart delayed the confirmation";
   }
-  EXPECT_GE(restarted, 1) << "the stale episode never delayed a confirmation: the test shows nothing";
 }
 
 // A check is only as good as the model it is flown against: with the inertia known to 10 %
