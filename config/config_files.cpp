@@ -293,6 +293,7 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("survey_interval_s")) {  // (F36), off when absent
       fd.survey_interval_s = r.non_negative("survey_interval_s");
     }
+    if (r.has("probe_chain")) fd.probe_chain = r.boolean("probe_chain");  // (F39)
     if (r.has("episode_restart_stale")) {  // (F38)
       fd.episode_restart_stale = r.boolean("episode_restart_stale");
     }

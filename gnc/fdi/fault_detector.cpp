@@ -901,6 +901,13 @@ void FaultDetector::decide() {
         pending_.kind = FaultKind::kStuckOn;
         return;
       }
+      // (F39) The motion went on with the pod closed: the leader is a stuck-on jet of another pod
+      // that the closed windows favour. The next test (of the leader's pod) starts now instead of
+      // after the reopened window.
+      if (p_.probe_chain && closed_leads_elsewhere()) {
+        end_probe_verdict();
+        probe_ended = false;
+      }
     }
   } else if (verdict_pending_ && eval_open_fraction_ >= 0.5) {
     // (F15) The first window flown mostly with the tested pod open again.
@@ -1261,6 +1268,27 @@ int FaultDetector::probe_verdict() const {
     }
   }
   return best;
+}
+
+bool FaultDetector::closed_leads_elsewhere() const {
+  // (F39) The bank's leader after the closed windows is a stuck-on jet of another pod, and the
+  // closed windows alone favour it: above zero (a jet of another pod fired on while the tested
+  // one was closed) and above every stuck-on jet of the tested pod. Under a stuck-on jet of the
+  // tested pod the closed windows are quiet: its hypothesis gains nothing there (it predicts no
+  // torque behind the closed valve, as no fault does) and every jet of another pod loses E / 2.
+  if (probe_closed_ == 0 || probe_tested_pod_ < 0) return false;
+  const int h = st_.best;
+  if (h < 0 || h >= kThrusters || pod_[static_cast<std::size_t>(h)] == probe_tested_pod_) {
+    return false;
+  }
+  const double lh = closed_llr_[static_cast<std::size_t>(h)];
+  if (!(lh > 0.0)) return false;
+  for (int g = 0; g < kThrusters; ++g) {
+    if (pod_[static_cast<std::size_t>(g)] != probe_tested_pod_) continue;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> g) & 1u) != 0) continue;
+    if (closed_llr_[static_cast<std::size_t>(g)] >= lh) return false;
+  }
+  return true;
 }
 
 int FaultDetector::closed_probe_verdict() const {

@@ -167,6 +167,10 @@ struct FaultDetectorParams {
   // (F38) A suspicion that starts with a leader whose episode sum trails its score by margin_llr
   // restarts the episode too (F25 restarts it for a new leader only). false: as before.
   bool episode_restart_stale{false};
+  // (F39) An isolation test after whose closed windows the leader is a stuck-on jet of another
+  // pod, favoured by those windows, is not read on its reopened window: the next test may start
+  // on the update its closure ends. false: as before.
+  bool probe_chain{false};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -530,6 +534,9 @@ class FaultDetector {
   }
   // (F15) The stuck-on hypothesis confirmed by a test's outcome, or -1.
   int probe_verdict() const;
+  // (F39) After a test's closed windows, the leader is a stuck-on jet of another pod that they
+  // favour.
+  bool closed_leads_elsewhere() const;
   int tested_pod_leader(const std::array<double, kHypotheses>& llr, double& best_llr) const;
   // (F16) The tests' likelihood: each hypothesis's LLR summed over every window flown during the
   // isolation tests of one pod (closed windows and reopened ones, consecutive tests of that pod

@@ -282,6 +282,11 @@ TEST(ConfigShipped, TheGyroscopicFloorSwitchIsReadAndOptional) {
                              &gnc::FaultDetectorParams::model_floor_gyroscopic);
 }
 
+TEST(ConfigShipped, TheChainedIsolationTestIsReadAndOptional) {
+  // (F39): false, measured and not adopted.
+  expect_optional_fdi_switch("probe_chain", false, &gnc::FaultDetectorParams::probe_chain);
+}
+
 TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
   // (F21): false, the onset window scored.
   expect_optional_fdi_switch("skip_onset_window", false,

@@ -792,6 +792,7 @@ struct AmbiguousRun {
   int probe_windows_closed{0};  // ticks with a pod closed for the test
   std::vector<int> probe_ends;  // ticks at which an isolation test reopened its pod
   std::vector<int> probe_pods;  // the pod of each test
+  std::vector<int> probe_starts;  // the tick each test closed its pod
 };
 
 // The trap's truth r and the detector flying against its mirror: the model's r has its xy part
@@ -820,6 +821,7 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p, double firing_scale = 1.0) {
   Vec16 prev = Vec16::Zero();
   std::array<bool, 4> prev_valve = t.valve;
   AmbiguousRun out;
+  int last_pod = -1;
   for (int k = 0; k < 2000; ++k) {
     if (k == 50) t.stuck_on = 2;
     FaultDetectorInput in;
@@ -840,12 +842,19 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p, double firing_scale = 1.0) {
         if ((d.confirmed_on() >> i) & 1u) t.valve[static_cast<std::size_t>(i / 4)] = false;
       }
     }
-    if (d.probe_pod() >= 0) {
-      t.valve[static_cast<std::size_t>(d.probe_pod())] = false;
+    // A test ends when its pod reopens or another test closes another pod on the same update.
+    const int pp = d.probe_pod();
+    if (pp != last_pod) {
+      if (last_pod >= 0) out.probe_ends.push_back(k);
+      if (pp >= 0) {
+        out.probe_pods.push_back(pp);
+        out.probe_starts.push_back(k);
+      }
+      last_pod = pp;
+    }
+    if (pp >= 0) {
+      t.valve[static_cast<std::size_t>(pp)] = false;
       ++out.probe_windows_closed;
-      if (out.probe_pods.size() == out.probe_ends.size()) out.probe_pods.push_back(d.probe_pod());
-    } else if (out.probe_pods.size() > out.probe_ends.size()) {
-      out.probe_ends.push_back(k);
     }
     Vec16 cmd = random_firing(rng) * firing_scale;
     cmd(2) = cmd(3) = cmd(10) = cmd(11) = 0.0;  // channels 1 and 5 never commanded
@@ -883,6 +892,37 @@ TEST(FaultDetector, OppositePodAxialJetsAreNotConfusedWhenOnlyTheModelErrorSepar
   EXPECT_EQ(now.r.kind, FaultKind::kStuckOn);
   EXPECT_GE(now.probes, 1u);
   EXPECT_GT(now.probe_windows_closed, 0);
+}
+
+// (F39) The trap's first test closes the mirror jet's pod (2): jet 2 goes on firing behind pod 0's
+// open valve, and the closed window shows it, led by a stuck-on jet off pod 2. The reopened window
+// could not name a jet of pod 2 then; with (F39) the test of pod 0 starts on the update the first
+// test's closure ends, not a window later, and jet 2 is confirmed sooner.
+TEST(FaultDetector, ATestWhoseClosedWindowShowsTheMotionIsFollowedAtOnceByTheNext) {
+  FaultDetectorParams p;
+  p.probe_windows = 1;  // gnc.yaml's
+  p.probe_aligned = true;
+  p.probe_read_closed = true;
+  p.probe_partial_rival = true;
+  p.centred_gyro_noise = true;
+  const AmbiguousRun wait = fly_ambiguous(p);
+  p.probe_chain = true;
+  const AmbiguousRun chain = fly_ambiguous(p);
+  for (const AmbiguousRun* run : {&wait, &chain}) {
+    ASSERT_GE(run->r.confirmed_at, 0);
+    EXPECT_EQ(run->r.thruster, 2);
+    EXPECT_EQ(run->r.kind, FaultKind::kStuckOn);
+  }
+  ASSERT_GE(wait.probe_pods.size(), 2u);
+  ASSERT_GE(chain.probe_pods.size(), 2u);
+  EXPECT_EQ(wait.probe_pods[0], 2) << "the trap: the first test is of the mirror jet's pod";
+  EXPECT_EQ(chain.probe_pods[0], 2);
+  EXPECT_EQ(chain.probe_pods[1], 0);
+  // Without (F39) the next test waits for the reopened window (10 ticks and its evaluation); with
+  // it the pod is closed again on the update the first closure ended.
+  EXPECT_GE(wait.probe_starts[1] - wait.probe_ends[0], 10);
+  EXPECT_LE(chain.probe_starts[1] - chain.probe_ends[0], 1);
+  EXPECT_LT(chain.r.confirmed_at, wait.r.confirmed_at);
 }
 
 // (F16) The tests are read on the likelihood of all their windows. In a reopened window alone the
