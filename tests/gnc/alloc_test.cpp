@@ -450,7 +450,8 @@ TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
 // gnc/fdi/README.md (F19): jet checks started by the detector and flown by the Gnc (the null
 // space of B_hat, the channels' box, the event): thruster 0 at 70 % of its thrust, the check level
 // set so low that the first partial-loss evidence starts one: no heap.
-TEST(ZeroAllocation, NoHeapInAJetCheck) {
+// The small vehicle under L1 with fault detection and jet checks it can fly.
+GncParams small_vehicle_checking() {
   GncParams p = test::small_vehicle_params();
   p.law = LawId::kNtcl;
   p.allocator = AllocatorKind::kL1;
@@ -458,12 +459,17 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
   p.fdi.window_ticks = 10;
   p.fdi.gyro_sigma = 1e-4;
   p.fdi.degraded_min_loss = 0.1;
-  p.fdi.check_llr = 1e-3;
   p.fdi.check_force_n = 0.5;  // the small vehicle's channels reach 2 N
   p.fdi.check_max_model_error = 1e3;  // (the guard is tested with the detector)
+  p.fdi_table_rel_sigma = 1e-4;
+  return p;
+}
+
+TEST(ZeroAllocation, NoHeapInAJetCheck) {
+  GncParams p = small_vehicle_checking();
+  p.fdi.check_llr = 1e-3;
   p.fdi.check_interval_s = 10.0;
   p.fdi.skip_onset_window = true;  // (F21)
-  p.fdi_table_rel_sigma = 1e-4;
   auto* loop = new test::SmallLoop(p);
   ASSERT_TRUE(loop->gnc.init(p).ok);
   std::mt19937_64 rng(5);
@@ -500,21 +506,12 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
 // episode's restart and the blocker's check on; no evidence check (check_llr out of reach), a
 // survey every 20 s and a verification level no firing reaches: no heap.
 TEST(ZeroAllocation, NoHeapInAJetSurvey) {
-  GncParams p = test::small_vehicle_params();
-  p.law = LawId::kNtcl;
-  p.allocator = AllocatorKind::kL1;
-  p.fdi.enabled = true;
-  p.fdi.window_ticks = 10;
-  p.fdi.gyro_sigma = 1e-4;
-  p.fdi.degraded_min_loss = 0.1;
+  GncParams p = small_vehicle_checking();
   p.fdi.check_llr = 1e6;
-  p.fdi.check_force_n = 0.5;  // the small vehicle's channels reach 2 N
-  p.fdi.check_max_model_error = 1e3;
   p.fdi.survey_interval_s = 20.0;
   p.fdi.survey_energy = 1e12;
   p.fdi.check_blocker = true;
   p.fdi.episode_restart_stale = true;
-  p.fdi_table_rel_sigma = 1e-4;
   auto* loop = new test::SmallLoop(p);
   ASSERT_TRUE(loop->gnc.init(p).ok);
   std::mt19937_64 rng(5);

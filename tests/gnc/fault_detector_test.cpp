@@ -1274,24 +1274,31 @@ TEST(FaultDetector, AClosedWindowIsScoredOverTheNextTicksWithTheModelItWasPredic
 struct CheckRun : DegradedRun {
   std::vector<int> checked;       // the jet of each check, in order
   std::vector<int> check_ticks;   // the tick each check started
+  std::vector<bool> surveyed;     // per check: started by the survey (F36)
   int checked_ticks{0};           // ticks flown with a check
 };
 
-CheckRun fly_checked(Truth& t, FaultDetector& d, int ticks, std::uint64_t seed) {
-  WeakFiring firing(seed);
+// Flies the detector's checks on top of `firing` (its next(tick) gives the commanded thrust);
+// thruster stuck_off dies at tick onset (-1: as the truth was given).
+template <class Firing>
+CheckRun fly_checks(Truth& t, FaultDetector& d, Firing firing, int ticks, int onset = -1,
+                    int stuck_off = -1) {
   Vec16 prev = Vec16::Zero();
   CheckRun run;
   for (int k = 0; k < ticks; ++k) {
+    if (k == onset) t.stuck_off = stuck_off;
     FaultDetectorInput in;
     in.omega = t.gyro();
     in.omega_valid = true;
     in.thrust = prev;
     in.valve_open = t.valve;
     const int before = d.check_jet();
+    const std::uint32_t surveys = d.status().surveys;
     run.note(d.update(in), k);
     if (d.check_jet() >= 0 && d.check_jet() != before) {
       run.checked.push_back(d.check_jet());
       run.check_ticks.push_back(k);
+      run.surveyed.push_back(d.status().surveys == surveys + 1);
     }
     Vec16 cmd = firing.next(k);
     if (d.check_jet() >= 0) {
@@ -1302,6 +1309,10 @@ CheckRun fly_checked(Truth& t, FaultDetector& d, int ticks, std::uint64_t seed) 
     prev = cmd;
   }
   return run;
+}
+
+CheckRun fly_checked(Truth& t, FaultDetector& d, int ticks, std::uint64_t seed) {
+  return fly_checks(t, d, WeakFiring(seed), ticks);
 }
 
 FaultDetector make_checking_detector(const Truth& t, double check_llr) {
@@ -1664,39 +1675,11 @@ struct HoldFiring {
   }
 };
 
-struct SurveyRun : CheckRun {
-  std::vector<bool> surveyed;  // per check: started by the survey
-};
+using SurveyRun = CheckRun;
 
 SurveyRun fly_hold(Truth& t, FaultDetector& d, int ticks, int onset, int stuck_off,
                    std::uint64_t seed) {
-  HoldFiring firing(seed);
-  Vec16 prev = Vec16::Zero();
-  SurveyRun run;
-  for (int k = 0; k < ticks; ++k) {
-    if (k == onset) t.stuck_off = stuck_off;
-    FaultDetectorInput in;
-    in.omega = t.gyro();
-    in.omega_valid = true;
-    in.thrust = prev;
-    in.valve_open = t.valve;
-    const int before = d.check_jet();
-    const std::uint32_t surveys = d.status().surveys;
-    run.note(d.update(in), k);
-    if (d.check_jet() >= 0 && d.check_jet() != before) {
-      run.checked.push_back(d.check_jet());
-      run.check_ticks.push_back(k);
-      run.surveyed.push_back(d.status().surveys == surveys + 1);
-    }
-    Vec16 cmd = firing.next(k);
-    if (d.check_jet() >= 0) {
-      cmd(d.check_jet()) += d.check_force();
-      ++run.checked_ticks;
-    }
-    t.advance(cmd);
-    prev = cmd;
-  }
-  return run;
+  return fly_checks(t, d, HoldFiring(seed), ticks, onset, stuck_off);
 }
 
 FaultDetectorParams survey_params(const Truth& t, double interval_s) {
