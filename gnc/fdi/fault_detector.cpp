@@ -1589,10 +1589,13 @@ void FaultDetector::update_survey() {
   }
 }
 
-int FaultDetector::survey_candidate(int& windows) const {
-  // (F36) Of the jets unverified for survey_interval_s, the one unverified longest whose check
-  // passes the check gates (F19 model error, F24 expected LLR), its check sized so that its
-  // expected energy reaches survey_energy.
+int FaultDetector::survey_candidate(int& windows) {
+  // (F36) Of the jets unverified for survey_interval_s, the one unverified longest (the first such
+  // on a tie), its check sized so that its expected energy reaches survey_energy. Only that jet is
+  // rated against the check gates (F19 model error, F24 expected LLR), one jet per decision (the
+  // rating is a null-space move of B; rating every due jet on each decision took the decision's
+  // tick over the Cortex-M7 budget): a jet that fails them is rated again check_interval_s later,
+  // so the next decision rates the next jet.
   if (!(p_.survey_interval_s > 0.0) || st_.unverified == 0) return -1;
   const double window_s = static_cast<double>(p_.window_ticks) * dt_;
   const auto interval = static_cast<std::uint32_t>(std::ceil(p_.survey_interval_s / window_s));
@@ -1600,21 +1603,27 @@ int FaultDetector::survey_candidate(int& windows) const {
   std::uint32_t oldest = 0;
   for (int i = 0; i < kThrusters; ++i) {
     if (((st_.unverified >> i) & 1u) == 0) continue;
-    const auto k = static_cast<std::size_t>(i);
-    const std::uint32_t age = st_.windows - survey_from_[k];
+    const std::uint32_t age = st_.windows - survey_from_[static_cast<std::size_t>(i)];
     if (age < interval || (jet >= 0 && age <= oldest)) continue;
-    if (signature_rel_error(i) > p_.check_max_model_error) continue;
-    const double e = expected_check_energy(i);
-    if (!(e > 0.0)) continue;
-    const int lo = p_.check_windows;
-    const int hi = std::max(lo, p_.survey_max_windows);
-    const double need = std::ceil(p_.survey_energy / e);
-    const int n = need >= static_cast<double>(hi) ? hi : std::max(lo, static_cast<int>(need));
-    if (p_.check_min_llr > 0.0 && 0.5 * e * static_cast<double>(n) < p_.check_min_llr) continue;
     jet = i;
     oldest = age;
-    windows = n;
   }
+  if (jet < 0) return -1;
+  ++st_.survey_ratings;
+  const double e =
+      signature_rel_error(jet) > p_.check_max_model_error ? 0.0 : expected_check_energy(jet);
+  const int lo = p_.check_windows;
+  const int hi = std::max(lo, p_.survey_max_windows);
+  const double need = e > 0.0 ? std::ceil(p_.survey_energy / e) : 0.0;
+  const int n = need >= static_cast<double>(hi) ? hi : std::max(lo, static_cast<int>(need));
+  if (!(e > 0.0) || (p_.check_min_llr > 0.0 && 0.5 * e * static_cast<double>(n) < p_.check_min_llr)) {
+    // Not checkable now: due again one check interval from now.
+    const auto retry = std::min(
+        interval, static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s)));
+    survey_from_[static_cast<std::size_t>(jet)] = st_.windows - (interval - retry);
+    return -1;
+  }
+  windows = n;
   return jet;
 }
 

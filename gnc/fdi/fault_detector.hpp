@@ -253,6 +253,7 @@ struct FaultDetectorStatus {
   std::uint32_t checks{0};                    // (F19) jet checks started
   std::uint32_t checks_unfit{0};              // (F19) check windows not scored (model error)
   std::uint32_t surveys{0};                   // (F36) of the checks, those started by the survey
+  std::uint32_t survey_ratings{0};  // (F36) due jets rated against the check gates (<= 1 a decision)
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
 };
@@ -367,8 +368,9 @@ class FaultDetector {
   double expected_check_energy(int i) const;
   // (F36) Each jet's stuck-off energy since it was last verified, after each decision.
   void update_survey();
-  // (F36) The jet the survey checks now (-1 none) and the check's windows.
-  int survey_candidate(int& windows) const;
+  // (F36) The jet the survey checks now (-1 none) and the check's windows; a due jet that cannot
+  // be checked now is put back by check_interval_s.
+  int survey_candidate(int& windows);
   // (F18) Thruster g's partial-loss LLR over its CUSUM's segment, its loss fitted (0: no segment).
   double degraded_llr(int g) const;
   // (F18) The jet to confirm degraded now (and its fitted loss), or -1.

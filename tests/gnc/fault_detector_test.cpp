@@ -1758,6 +1758,37 @@ TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNo
   }
 }
 
+// (F36) A due jet the survey cannot check (here: every jet, the check gate on the model's error
+// closed) is rated once and put back by check_interval_s, so each decision rates at most one jet:
+// rating every due jet on every decision took the decision's tick over the Cortex-M7 budget
+// (gnc/fdi/README.md "The jet survey"). Counted: the ratings, against the windows and against
+// once per due jet per check interval.
+TEST(FaultDetector, ADueJetTheSurveyCannotCheckIsRatedOncePerCheckInterval) {
+  Truth t;
+  FaultDetectorParams p = survey_params(t, 300.0);
+  p.check_interval_s = 100.0;
+  p.check_max_model_error = 1e-9;  // no jet's signature is known that well: nothing is checkable
+  FaultDetector d = make_detector(t, p);
+  const SurveyRun run = fly_hold(t, d, 12000, -1, -1, 23);  // 1 200 s of 1 s windows
+  EXPECT_LT(run.r.confirmed_at, 0);
+  EXPECT_TRUE(run.checked.empty());
+  EXPECT_EQ(d.status().checks, 0u);
+  EXPECT_EQ(d.status().surveys, 0u);
+  // Jets 2-15 are commanded and unverified (TheSurveyChecksEachUnverifiedJet... above): each is
+  // due from 300 s and then rated at most once per 100 s, ten times in the 900 s after.
+  const std::uint32_t ratings = d.status().survey_ratings;
+  EXPECT_GE(ratings, 12u) << "the due jets were not rated";
+  EXPECT_LE(ratings, 14u * 10u) << "a jet rated more than once per check interval";
+  EXPECT_LT(ratings, d.status().windows - 300u) << "more than one rating per decision";
+  // With the gate open the same flight checks them (the ratings were the survey's, not idle).
+  Truth t2;
+  FaultDetector open = make_detector(t2, survey_params(t2, 300.0));
+  const SurveyRun checked = fly_hold(t2, open, 12000, -1, -1, 23);
+  EXPECT_GE(open.status().surveys, 12u);
+  EXPECT_EQ(checked.checked.size(), open.status().checks);
+  EXPECT_GE(open.status().survey_ratings, open.status().surveys);
+}
+
 // (F38) A jet surveyed healthy, then dead. The survey's first check of it put its stuck-off
 // evidence well below zero in the episode's sums (F8), and in HOLD no window is suspicious, so
 // the episode still starts before the fault when the next survey raises the jet's score past
