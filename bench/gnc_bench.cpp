@@ -181,12 +181,14 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.check_score_unfit = fdi;              // (F35) an unfit check window is scored
   p.fdi.check_blocker = fdi;                  // (F37) the jet blocking a stuck-off leader checked
   p.fdi.episode_restart_stale = fdi;          // (F38) a stale episode restarted
+  p.fdi.episode_restart_leader = fdi;         // (F41) ... and one a new leader's fault postdates
   p.fdi.model_rel_floor = 0.005;              // the model's relative error floor, as flown
   p.fdi.model_floor_gyroscopic = true;        // (F22) ... on both terms, as flown
   p.fdi.probe_windows = 1;                    // isolation tests of one window ...
   p.fdi.probe_aligned = true;                 // (F27) ... flown closed throughout, as flown
   p.fdi.probe_partial_rival = true;           // (F29) ... read against partial losses
   p.fdi.probe_read_closed = true;             // (F32) ... and first on the closed window
+  p.fdi.probe_read_elsewhere = true;          // (F40) ... which may name another pod's jet
   p.fdi.centred_gyro_noise = true;            // (F28) the gyro's variance sigma_g^2, as flown
   p.fdi.suspect_chi2 = 30.66;                 // ... and the suspicion at 1 - 1e-6, as flown
   p.fdi.detect_early_ticks = fdi ? 3 : 0;     // (F33) early detection, as flown

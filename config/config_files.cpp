@@ -294,6 +294,8 @@ GncConfig load_gnc(const std::string& path) {
       fd.survey_interval_s = r.non_negative("survey_interval_s");
     }
     if (r.has("probe_chain")) fd.probe_chain = r.boolean("probe_chain");  // (F39)
+    if (r.has("probe_read_elsewhere")) fd.probe_read_elsewhere = r.boolean("probe_read_elsewhere");  // (F40)
+    if (r.has("episode_restart_leader")) fd.episode_restart_leader = r.boolean("episode_restart_leader");  // (F41)
     if (r.has("episode_restart_stale")) {  // (F38)
       fd.episode_restart_stale = r.boolean("episode_restart_stale");
     }

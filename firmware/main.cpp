@@ -216,6 +216,7 @@ int firmware_main() {
     g_params.fdi.check_score_unfit = true;       // (F35) an unfit check window is scored
     g_params.fdi.check_blocker = true;           // (F37) the jet blocking a stuck-off leader checked
     g_params.fdi.episode_restart_stale = true;   // (F38) a stale episode restarted
+    g_params.fdi.episode_restart_leader = true;  // (F41) ... and one a new leader's fault postdates
     g_params.fdi.survey_interval_s = static_cast<double>(opt.survey_s);  // (F36) 0: off, as flown
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
     g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
@@ -223,6 +224,7 @@ int firmware_main() {
     g_params.fdi.probe_aligned = true;         // (F27) ... flown closed throughout, as flown
     g_params.fdi.probe_partial_rival = true;   // (F29) ... read against partial losses
     g_params.fdi.probe_read_closed = true;     // (F32) ... and first on the closed window
+    g_params.fdi.probe_read_elsewhere = true;  // (F40) ... which may name another pod's jet
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown

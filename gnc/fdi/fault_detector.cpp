@@ -604,8 +604,21 @@ void FaultDetector::evaluate_step() {
       // episode can hold hours, a jet's healthy checks among them).
       const bool stale = p_.episode_restart_stale && st_.best >= 0 &&
                          lambda(static_cast<std::size_t>(st_.best)) < st_.best_llr - p_.margin_llr;
-      if (p_.episode_restart && suspecting_ && !was_suspecting &&
-          (st_.best != was_best || stale)) {
+      // (F41) ... and so does a new leader, while suspecting, whose episode sum trails its score
+      // by more than margin_llr: the episode began with a window that showed the fault (a
+      // suspicion, with another leader) but that this leader's fault did not fill. A jet stuck on
+      // one tick before a window closed leaves that window a one-tick ramp, and against it the
+      // jet's hypothesis (the whole window's ramp) loses almost its next window's gain: (F8) then
+      // reads the leader's lead over every alternative through that one window.
+      // Only a leader whose whole score is this window's (its CUSUM was at zero before it): the
+      // episode restarted with this window is then exactly the leader's run of evidence.
+      const bool fresh_leader =
+          st_.best >= 0 &&
+          st_.best_llr <= window_llr_[static_cast<std::size_t>(st_.best)] + p_.margin_llr;
+      const bool new_stale_leader = p_.episode_restart_leader && suspecting_ && was_suspecting &&
+                                    st_.best != was_best && stale && fresh_leader;
+      if (p_.episode_restart && suspecting_ &&
+          ((!was_suspecting && (st_.best != was_best || stale)) || new_stale_leader)) {
         restart_episode_with_window();
       }
       evaluate_cross(w);
@@ -898,6 +911,18 @@ void FaultDetector::decide() {
         declare(h, FaultKind::kStuckOn);
         pending_.confirmed = true;
         pending_.thruster = h;
+        pending_.kind = FaultKind::kStuckOn;
+        return;
+      }
+      // (F40) ... or on the stuck-on jet of another pod that the motion behind the closed valve
+      // shows; its pod is closed by the confirmation, the tested one reopens.
+      const int e = p_.probe_read_elsewhere ? closed_verdict_elsewhere() : -1;
+      if (e >= 0) {
+        end_probe_verdict();
+        ++st_.elsewhere_verdicts;
+        declare(e, FaultKind::kStuckOn);
+        pending_.confirmed = true;
+        pending_.thruster = e;
         pending_.kind = FaultKind::kStuckOn;
         return;
       }
@@ -1332,6 +1357,68 @@ int FaultDetector::closed_probe_verdict() const {
     }
   }
   return best;
+}
+
+int FaultDetector::closed_verdict_elsewhere() const {
+  // (F40) Read when the test's closed windows end and (F32) named no jet of the tested pod. The
+  // motion went on behind the closed valve: every hypothesis of the tested pod predicts nothing
+  // there (a stuck-on jet behind a closed valve has no signature, F4, and its stuck-off or partial
+  // loss is not commanded), so the closed windows' LLR of a stuck-on jet h of another pod, which
+  // fires through its open valve whatever is commanded, is its lead over all of them. The start
+  // window could not tell h from the tested pod's jet (the mirror pair of F8: an axial jet and the
+  // opposite pod's, 2 r_xy x e_z apart); the closed windows can, on the physics, not on the model's
+  // fine print. h is named when
+  //   - over the start window and the closed ones it leads every hypothesis by margin_llr;
+  //   - on the closed windows alone it leads every hypothesis of the tested pod by margin_llr;
+  //   - every other alternative (another open pod, any kind) is told from h by the start window
+  //     alone (its lead there above margin_llr) or contradicted by the closed windows (their LLR
+  //     below -margin_llr), as (F32) asks of the tested pod's jet;
+  //   - with (F29), it beats every jet's fitted partial loss over the same windows.
+  // The closed windows compare h with another open pod's jet on the model, so a pair the start
+  // window could not separate is not separated here either.
+  if (probe_closed_ == 0 || probe_tested_pod_ < 0) return -1;
+  std::array<double, kHypotheses> sum{};
+  for (std::size_t k = 0; k < sum.size(); ++k) sum[k] = trigger_llr_[k] + closed_llr_[k];
+  int h = -1;
+  double best_llr = -1e300;
+  double second = -1e300;
+  for (int g = 0; g < kHypotheses; ++g) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> (g % kThrusters)) & 1u) != 0) continue;
+    const double l = sum[static_cast<std::size_t>(g)];
+    if (l > best_llr) {
+      second = best_llr;
+      best_llr = l;
+      h = g;
+    } else if (l > second) {
+      second = l;
+    }
+  }
+  if (h < 0 || h >= kThrusters || pod_[static_cast<std::size_t>(h)] == probe_tested_pod_) return -1;
+  if (best_llr <= p_.margin_llr || best_llr - second <= p_.margin_llr) return -1;
+  const double closed_h = closed_llr_[static_cast<std::size_t>(h)];
+  const double start_h = trigger_llr_[static_cast<std::size_t>(h)];
+  for (int g = 0; g < kHypotheses; ++g) {
+    if (g == h) continue;
+    const int tg = g % kThrusters;
+    if ((((st_.confirmed_on | st_.confirmed_off) >> tg) & 1u) != 0) continue;
+    const auto kg = static_cast<std::size_t>(g);
+    if (pod_[static_cast<std::size_t>(tg)] == probe_tested_pod_) {
+      if (closed_h - closed_llr_[kg] <= p_.margin_llr) return -1;
+    } else if (start_h - trigger_llr_[kg] <= p_.margin_llr && closed_llr_[kg] >= -p_.margin_llr) {
+      return -1;
+    }
+  }
+  if (p_.probe_partial_rival) {  // (F29) over the same windows
+    for (int i = 0; i < kThrusters; ++i) {
+      if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+      const auto k = static_cast<std::size_t>(i);
+      const auto ko = k + static_cast<std::size_t>(kThrusters);
+      const double partial = fitted_loss_llr(trigger_llr_[ko] + closed_llr_[ko],
+                                             trigger_energy_[k] + closed_energy_[k]);
+      if (best_llr - partial <= p_.margin_llr) return -1;
+    }
+  }
+  return h;
 }
 
 double FaultDetector::cross(int h, int g) const {

@@ -167,10 +167,21 @@ struct FaultDetectorParams {
   // (F38) A suspicion that starts with a leader whose episode sum trails its score by margin_llr
   // restarts the episode too (F25 restarts it for a new leader only). false: as before.
   bool episode_restart_stale{false};
+  // (F41) A new leader, while a suspicion goes on, whose episode sum trails its score by
+  // margin_llr restarts the episode too (its fault began after the window that started it).
+  // false: as before.
+  bool episode_restart_leader{false};
   // (F39) An isolation test after whose closed windows the leader is a stuck-on jet of another
   // pod, favoured by those windows, is not read on its reopened window: the next test may start
   // on the update its closure ends. false: as before.
   bool probe_chain{false};
+  // (F40) An isolation test whose closed windows show the motion going on names the stuck-on jet
+  // of another pod that explains the start window and the closed ones: ahead of every hypothesis
+  // by margin_llr over them, ahead of every hypothesis of the tested pod by margin_llr on the
+  // closed windows alone, and every other alternative told from it by the start window or
+  // contradicted by the closed ones (as F32 reads the tested pod's jet). false: such a test is read
+  // on its reopened window, and the leader's pod needs a test of its own.
+  bool probe_read_elsewhere{false};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -256,6 +267,7 @@ struct FaultDetectorStatus {
   std::uint32_t survey_ratings{0};  // (F36) due jets rated against the check gates (<= 1 a decision)
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
+  std::uint32_t elsewhere_verdicts{0};  // (F40) tests whose closed windows named another pod's jet
 };
 
 // Raised by update(); the caller turns them into events.
@@ -557,6 +569,7 @@ class FaultDetector {
   std::array<double, kThrusters> closed_energy_{};
   int probe_blocker_{-1};
   int closed_probe_verdict() const;
+  int closed_verdict_elsewhere() const;
   void reset_probe_llr() {
     probe_llr_.fill(0.0);
     probe_energy_.fill(0.0);

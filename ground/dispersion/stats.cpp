@@ -128,7 +128,7 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
           g.kind = plant::to_string(kind);
           g.onset_s = onset;
           g.case_number = c;
-          std::vector<double> lat, pen, cmd, imp, det, valve;
+          std::vector<double> lat, pen, cmd, imp, fire, det, valve;
           for (const DrawResult& d : draws) {
             if (!d.sampled.has_fault || d.sampled.fault.kind != kind ||
                 d.sampled.fault.onset_s != onset || (c != 0 && d.sampled.case_number != c) ||
@@ -160,6 +160,9 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
               lat.push_back(*f.first_confirmation_s - onset);
               cmd.push_back(f.fault_commanded_s);
               imp.push_back(f.fault_commanded_impulse_ns);
+              if (d.flown && d.flown->u_max_true_n > 0.0) {
+                fire.push_back(f.fault_commanded_impulse_ns / d.flown->u_max_true_n);
+              }
               if (kind == plant::FaultKind::kStuckOn && f.valve_closed_s &&
                   *f.valve_closed_s >= onset) {
                 valve.push_back(*f.valve_closed_s - onset);
@@ -179,6 +182,8 @@ void summarize_faults(const DispersionSpec& spec, const std::vector<DrawResult>&
           if (!valve.empty()) g.valve_max_s = *std::max_element(valve.begin(), valve.end());
           g.commanded_to_isolation_s = percentiles(cmd);
           g.commanded_impulse_to_isolation_ns = percentiles(imp);
+          g.firing_to_isolation_s = percentiles(fire);
+          if (!fire.empty()) g.firing_to_isolation_max_s = *std::max_element(fire.begin(), fire.end());
           if (!cmd.empty()) g.commanded_to_isolation_max_s = *std::max_element(cmd.begin(), cmd.end());
           g.penalty_kg = percentiles(pen);
           if (!pen.empty()) g.penalty_max_kg = *std::max_element(pen.begin(), pen.end());
@@ -563,7 +568,9 @@ json summary_json(const Summary& s, const std::string& reproduce) {
                       {"commanded_to_isolation_s", pct_json(g.commanded_to_isolation_s)},
                       {"commanded_to_isolation_max_s", opt_json(g.commanded_to_isolation_max_s)},
                       {"commanded_impulse_to_isolation_ns",
-                       pct_json(g.commanded_impulse_to_isolation_ns)}});
+                       pct_json(g.commanded_impulse_to_isolation_ns)},
+                      {"firing_to_isolation_s", pct_json(g.firing_to_isolation_s)},
+                      {"firing_to_isolation_max_s", opt_json(g.firing_to_isolation_max_s)}});
   }
   json refs = json::array();
   for (const ReferenceRow& r : s.references) {
@@ -813,9 +820,11 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
             "flight never commanded the jet after onset (its half of the channel, its pod's valve "
             "open), and over the isolated runs the time it was commanded from onset to the "
             "confirmation (and the impulse asked of it meanwhile; u_max for one second is 200 N s in the "
-            "study's cases).\n\n| strategy | fault | onset (s) | runs | never commanded | isolated | "
-            "commanded before isolation p50 / p95 / max (s) | impulse p50 / p95 (N s) |\n"
-            "|---|---|---:|---:|---:|---:|---|---|\n";
+            "study's cases), and that impulse as seconds of firing at u_max (the draw's true u_max), "
+            "the seconds an on/off jet would have fired.\n\n| strategy | fault | onset (s) | runs | "
+            "never commanded | isolated | commanded before isolation p50 / p95 / max (s) | impulse "
+            "p50 / p95 (N s) | firing at u_max p50 / p95 / max (s) |\n"
+            "|---|---|---:|---:|---:|---:|---|---|---|\n";
       for (const FaultGroupStats& g : s.faults) {
         if (g.case_number != 0 || g.kind == "stuck_on") continue;
         md << "| `" << g.strategy << "` | " << g.kind << " | " << fmt("%.0f", g.onset_s) << " | "
@@ -824,7 +833,31 @@ OutputPaths write_outputs(const std::string& dir, const DispersionSpec& spec,
            << nc(g.commanded_to_isolation_s.p95, "%.1f") << " / "
            << nc(g.commanded_to_isolation_max_s, "%.1f") << " | "
            << nc(g.commanded_impulse_to_isolation_ns.p50, "%.0f") << " / "
-           << nc(g.commanded_impulse_to_isolation_ns.p95, "%.0f") << " |\n";
+           << nc(g.commanded_impulse_to_isolation_ns.p95, "%.0f") << " | "
+           << nc(g.firing_to_isolation_s.p50, "%.2f") << " / "
+           << nc(g.firing_to_isolation_s.p95, "%.2f") << " / "
+           << nc(g.firing_to_isolation_max_s, "%.2f") << " |\n";
+      }
+      if (!spec.faults.case_numbers.empty()) {
+        md << "\nPer case, the same firing at u_max before isolation: isolated / runs, p50 / max "
+              "(s).\n\n| strategy | fault | onset (s) |";
+        for (int c : spec.faults.case_numbers) md << " case " << c << " |";
+        md << "\n|---|---|---:|";
+        for (std::size_t c = 0; c < spec.faults.case_numbers.size(); ++c) md << "---|";
+        md << "\n";
+        for (const FaultGroupStats& g : s.faults) {
+          if (g.case_number != 0 || g.kind == "stuck_on") continue;
+          md << "| `" << g.strategy << "` | " << g.kind << " | " << fmt("%.0f", g.onset_s) << " |";
+          for (const FaultGroupStats& h : s.faults) {
+            if (h.case_number == 0 || h.strategy != g.strategy || h.kind != g.kind ||
+                h.onset_s != g.onset_s) {
+              continue;
+            }
+            md << " " << h.isolated << "/" << h.runs << " (" << nc(h.firing_to_isolation_s.p50, "%.2f")
+               << " / " << nc(h.firing_to_isolation_max_s, "%.2f") << ") |";
+          }
+          md << "\n";
+        }
       }
     }
     if (!spec.faults.case_numbers.empty()) {

@@ -130,6 +130,11 @@ struct FaultGroupStats {
   Percentiles commanded_to_isolation_s;
   std::optional<double> commanded_to_isolation_max_s;
   Percentiles commanded_impulse_to_isolation_ns;  // the same, as commanded impulse (N s)
+  // ... and as firing at full thrust: that impulse over the draw's true u_max (s). A jet commanded
+  // at a few newtons for seconds shows nothing; this is the "seconds of commanded firing" of an
+  // on/off thruster.
+  Percentiles firing_to_isolation_s;
+  std::optional<double> firing_to_isolation_max_s;
 };
 
 struct ReferenceRow {

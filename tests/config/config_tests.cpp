@@ -416,13 +416,16 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
 }
 
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
-// (F32) the test read on its closed windows, (F34) checks started on quiet windows and (F35) unfit
-// check windows scored: gnc.yaml true, the former behaviour (false) when
-// a key is absent, and a value that is not a boolean names the file and key.
+// (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
+// check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)
+// another pod's jet named by a test's closed windows and (F41) the episode restarted for a new
+// leader: gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is
+// not a boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
   for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival",
                           "probe_read_closed", "check_quiet_start", "check_score_unfit",
-                          "check_blocker", "episode_restart_stale"}) {
+                          "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
+                          "episode_restart_leader"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -433,6 +436,8 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "check_quiet_start"   ? f.check_quiet_start
              : k == "check_blocker"       ? f.check_blocker
              : k == "episode_restart_stale" ? f.episode_restart_stale
+             : k == "probe_read_elsewhere" ? f.probe_read_elsewhere
+             : k == "episode_restart_leader" ? f.episode_restart_leader
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "ground/dispersion/stats.hpp"
 
@@ -260,6 +261,65 @@ TEST(Summary, FaultsCountedAgainstTheInjectedFaultWithThePenaltyAgainstTheRefere
       EXPECT_EQ(g.isolated, 2);
     }
   }
+}
+
+// The faulty jet's firing before isolation at full thrust: its commanded impulse over the draw's
+// true u_max, over the isolated runs only (a jet asked 300 N s of a 200 N jet fired 1.5 s; 100 N s
+// of a 1 000 N jet, 0.1 s), per case and over every case.
+TEST(Summary, AStuckOffJetsFiringBeforeIsolationIsItsImpulseAtFullThrust) {
+  DispersionSpec spec;
+  spec.name = "firing";
+  spec.strategies = {*campaign::parse_strategy("ntcl+dpd_ref")};
+  spec.faults.enabled = true;
+  spec.faults.kinds = {plant::FaultKind::kStuckOff};
+  spec.faults.onsets_s = {3000.0};
+  spec.faults.case_numbers = {1, 4};
+  spec.faults.case_files = {"case1.yaml", "case4.yaml"};
+  struct Row {
+    int case_number;
+    double u_max;
+    double impulse;
+    bool isolated;
+  };
+  const Row rows[] = {{1, 200.0, 300.0, true}, {4, 1000.0, 100.0, true}, {1, 200.0, 5000.0, false}};
+  std::vector<DrawResult> draws;
+  int i = 0;
+  for (const Row& r : rows) {
+    DrawResult d;
+    d.index = i++;
+    d.sampled.case_number = r.case_number;
+    d.sampled.has_fault = true;
+    d.sampled.fault.kind = plant::FaultKind::kStuckOff;
+    d.sampled.fault.thruster = 2;
+    d.sampled.fault.onset_s = 3000.0;
+    d.flown = Readback{};
+    d.flown->u_max_true_n = r.u_max;
+    StrategyOutcome o = ok("ntcl+dpd_ref", 100.0, true);
+    o.fdi.enabled = true;
+    o.fdi.fault_first_commanded_s = 3000.0;
+    o.fdi.fault_commanded_s = 40.0;
+    o.fdi.fault_commanded_impulse_ns = r.impulse;
+    if (r.isolated) {
+      o.fdi.confirmations = 1;
+      o.fdi.thruster = 2;
+      o.fdi.kind = "stuck-off";
+      o.fdi.first_confirmation_s = 3100.0;
+    }
+    d.runs = {o};
+    draws.push_back(d);
+  }
+  const Summary s = summarize(spec, draws, {});
+  std::map<int, const FaultGroupStats*> by_case;
+  for (const FaultGroupStats& g : s.faults) by_case[g.case_number] = &g;
+  ASSERT_EQ(by_case.size(), 3u);
+  const FaultGroupStats& all = *by_case.at(0);
+  EXPECT_EQ(all.isolated, 2);
+  EXPECT_EQ(all.firing_to_isolation_s.n, 2);
+  EXPECT_NEAR(*all.firing_to_isolation_s.p50, 0.8, 1e-12);
+  EXPECT_NEAR(*all.firing_to_isolation_max_s, 1.5, 1e-12);
+  EXPECT_NEAR(*all.commanded_to_isolation_max_s, 40.0, 1e-12);  // ticks commanded at any force
+  EXPECT_NEAR(*by_case.at(1)->firing_to_isolation_max_s, 1.5, 1e-12);
+  EXPECT_NEAR(*by_case.at(4)->firing_to_isolation_s.p50, 0.1, 1e-12);
 }
 
 }  // namespace

@@ -301,6 +301,88 @@ TEST(FaultDetector, TheWindowAFaultStartsInIsNotScoredAndNoJetOfAnotherPodIsConf
               wrong_scored, latency_scored / 80.0, latency_skipped / 80.0);
 }
 
+// (F41) A jet stuck on at the last tick of a 10-tick window, under HOLD's few-newton firing
+// (WeakFiring), a quiet gyro and a model known as the identifier knows it mid-flight (its centre
+// of mass to 3 cm, its strengths to 1 %). The window that closes one tick after onset carries a
+// one-tick ramp; every signature (F4) spans the window, so the faulty jet's hypothesis loses
+// almost what the next window gives it, and another hypothesis leads the suspicion that this
+// window starts, with the episode (F25). In the next window the jet leads, with an episode sum
+// that trails its score by that loss.
+struct OnsetLeaderRun {
+  RunResult r;
+  std::uint32_t restarts{0};
+  std::uint32_t probes{0};
+};
+
+OnsetLeaderRun fly_onset_leader(int jet, bool restart_leader, int onset = 509) {
+  Truth t;
+  t.gyro_sigma = 1e-7;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
+  p.episode_restart = true;
+  p.episode_restart_stale = true;
+  p.episode_restart_leader = restart_leader;
+  p.probe_windows = 1;
+  p.probe_aligned = true;
+  p.probe_read_closed = true;
+  p.probe_partial_rival = true;
+  p.probe_read_elsewhere = true;
+  p.centred_gyro_noise = true;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  m.r_cov = Mat3::Identity() * (0.03 * 0.03);
+  m.k_sigma = 0.01;
+  d.set_model(m);
+  OnsetLeaderRun out;
+  out.r = fly_weak(t, d, onset + 200, onset, -1, 31, jet);
+  if (out.r.confirmed_at >= 0) out.r.confirmed_at -= onset;
+  out.restarts = d.status().episode_restarts;
+  out.probes = d.status().probes;
+  return out;
+}
+
+TEST(FaultDetector, ANewLeaderWhoseFaultBeganAfterTheEpisodeStartedRestartsIt) {
+  int confirmed_before = 0, confirmed_now = 0, changed = 0, wrong_before = 0, wrong_now = 0;
+  double latency_before = 0.0, latency_now = 0.0;  // over the runs right in both
+  for (int jet = 0; jet < 16; ++jet) {
+    for (int onset = 500; onset < 510; ++onset) {  // every phase of the window
+      const OnsetLeaderRun before = fly_onset_leader(jet, false, onset);
+      const OnsetLeaderRun now = fly_onset_leader(jet, true, onset);
+      const bool right_before = before.r.confirmed_at >= 0 && before.r.thruster == jet &&
+                                before.r.kind == FaultKind::kStuckOn;
+      const bool right_now = now.r.confirmed_at >= 0 && now.r.thruster == jet &&
+                             now.r.kind == FaultKind::kStuckOn;
+      if (before.r.confirmed_at >= 0) ++confirmed_before;
+      if (now.r.confirmed_at >= 0) ++confirmed_now;
+      wrong_before += before.r.confirmed_at >= 0 && !right_before ? 1 : 0;
+      wrong_now += now.r.confirmed_at >= 0 && !right_now ? 1 : 0;
+      // The restart never turns a right isolation wrong, nor loses one.
+      if (right_before) {
+        EXPECT_TRUE(right_now) << "jet " << jet << " onset " << onset << ": thruster "
+                               << now.r.thruster << " at " << now.r.confirmed_at;
+      }
+      if (right_before && right_now) {
+        latency_before += before.r.confirmed_at;
+        latency_now += now.r.confirmed_at;
+      }
+      // Only a run whose episode (F41) restarted flies differently.
+      if (now.r.confirmed_at != before.r.confirmed_at) {
+        ++changed;
+        EXPECT_GT(now.restarts, before.restarts) << "jet " << jet << " onset " << onset;
+      }
+    }
+  }
+  std::printf("stuck on at every phase of a window: confirmed %d -> %d of 160 (wrong %d -> %d), "
+              "%d changed, latency %.0f -> %.0f ticks over the runs right in both\n",
+              confirmed_before, confirmed_now, wrong_before, wrong_now, changed, latency_before,
+              latency_now);
+  // Wrong isolations of the onset window scored (F21's trap, gnc.yaml scores it) are not F41's.
+  EXPECT_LE(wrong_now, wrong_before);
+  EXPECT_GT(changed, 0) << "the trap: no leader changed after the onset window";
+  EXPECT_LT(confirmed_before, confirmed_now) << "the trap: runs never confirmed in 200 ticks";
+  EXPECT_LT(latency_now, latency_before);
+}
+
 // (F33) Early detection. Every jet stuck on at every phase of a 10-tick window, under HOLD's
 // few-newton firing (WeakFiring) with case 5's gyro: the first suspicion after onset with the window so far tested each
 // update, against the same flight with the window's own test only. Scores and decisions are the
