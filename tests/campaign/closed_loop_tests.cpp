@@ -400,12 +400,15 @@ TEST(ClosedLoop, AThrusterStuckOnInHoldIsConfirmedByTheIsolationTest) {
 // (F40) Case 5, thruster 2 (pod 0, +z) stuck on mid-despin. Its mirror on the opposite pod,
 // thruster 11 (pod 2, -z), pushes the body the same way up to the centre of mass's xy offset, and
 // the first window after onset leads with the mirror: the isolation test closes pod 2. Thruster
-// 2 fires on through pod 0's open valve, and that closed window names it (gnc.yaml): confirmed on
+// 2 fires on through pod 0's open valve, and that closed window names it (F40): confirmed on
 // the update the test's closure ends, within the 3 s. Read only on the reopened window
 // (F40 off), the test is followed by a test of pod 0 and the confirmation comes seconds later.
 TEST(ClosedLoop, AStuckOnJetSeenFiringBehindAnotherPodsClosedValveIsNamedByThatTest) {
   config::RunSetup s = load(5);
   ASSERT_TRUE(s.flight.fdi.probe_read_elsewhere) << "gnc.yaml flies (F40)";
+  // With the onset window scored (F21 off), as the dispersion measured it; with gnc.yaml's F21 the
+  // first test starts a window later and (F40) saves the same reopened window (3.8 s against 4.8).
+  s.flight.fdi.skip_onset_window = false;
   plant::ThrusterFault f;
   f.thruster = 2;
   f.kind = plant::FaultKind::kStuckOn;
@@ -427,15 +430,18 @@ TEST(ClosedLoop, AStuckOnJetSeenFiringBehindAnotherPodsClosedValveIsNamedByThatT
   EXPECT_GT(t_reopened, t_named + 1.0) << "the trap: without (F40) pod 0 is tested too";
 }
 
-// (F41) Case 4, thruster 7 (pod 1, -z) stuck on at 10 000 s, one tick before a window closes. That
-// window is suspicious with a stuck-off jet leading, and the episode (F25) starts with it; the jet
-// leads the next window, but its episode sum carries the one-tick window's loss and (F8) finds it
-// blocked by a stuck-off jet of its own pod, which no test separates. With the episode restarted
-// for the new leader (gnc.yaml) the next decision tests pod 1 and the closed window names the jet
-// within the 3 s; without, a window later.
+// (F41) Case 4, thruster 7 (pod 1, -z) stuck on at 10 000 s, one tick before a window closes, the
+// onset window scored (F21 off). That window is suspicious with a stuck-off jet leading, and the
+// episode (F25) starts with it; the jet leads the next window, but its episode sum carries the
+// one-tick window's loss and (F8) finds it blocked by a stuck-off jet of its own pod, which no test
+// separates. With the episode restarted for the new leader the next decision tests pod 1 and the
+// closed window names the jet within the 3 s; without, a window later.
 TEST(ClosedLoop, AJetStuckOnJustBeforeAWindowClosesIsIsolatedWithinThreeSeconds) {
   config::RunSetup s = load(4);
   ASSERT_TRUE(s.flight.fdi.episode_restart_leader) << "gnc.yaml flies (F41)";
+  // With the onset window scored: gnc.yaml does not score it (F21), and then the one-tick window
+  // starts no episode at all.
+  s.flight.fdi.skip_onset_window = false;
   plant::ThrusterFault f;
   f.thruster = 7;
   f.kind = plant::FaultKind::kStuckOn;

@@ -287,12 +287,6 @@ TEST(ConfigShipped, TheChainedIsolationTestIsReadAndOptional) {
   expect_optional_fdi_switch("probe_chain", false, &gnc::FaultDetectorParams::probe_chain);
 }
 
-TEST(ConfigShipped, TheOnsetWindowRuleIsReadAndOptional) {
-  // (F21): false, the onset window scored.
-  expect_optional_fdi_switch("skip_onset_window", false,
-                             &gnc::FaultDetectorParams::skip_onset_window);
-}
-
 // (F24) The jet checks' information gate: gnc.yaml's value, off (0) when the key is absent, and a
 // negative value names the file and key.
 // An optional fdi key shipped in gnc.yaml as `line`: `absent` checks a run whose gnc.yaml lacks the
@@ -418,14 +412,14 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
 // (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)
-// another pod's jet named by a test's closed windows and (F41) the episode restarted for a new
-// leader: gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is
+// another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader
+// and (F21) the onset window not scored: gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is
 // not a boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
   for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival",
                           "probe_read_closed", "check_quiet_start", "check_score_unfit",
                           "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
-                          "episode_restart_leader"}) {
+                          "episode_restart_leader", "skip_onset_window"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -438,6 +432,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "episode_restart_stale" ? f.episode_restart_stale
              : k == "probe_read_elsewhere" ? f.probe_read_elsewhere
              : k == "episode_restart_leader" ? f.episode_restart_leader
+             : k == "skip_onset_window"     ? f.skip_onset_window
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;
