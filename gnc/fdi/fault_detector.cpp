@@ -1346,17 +1346,23 @@ int FaultDetector::closed_probe_verdict() const {
     const double lead = lead_start - trigger_llr_[static_cast<std::size_t>(g)];
     if (lead <= p_.margin_llr && !contradicted(g)) return -1;
   }
-  if (p_.probe_partial_rival) {  // (F29) over the same windows
-    for (int i = 0; i < kThrusters; ++i) {
-      if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
-      const auto k = static_cast<std::size_t>(i);
-      const auto ko = k + static_cast<std::size_t>(kThrusters);
-      const double partial = fitted_loss_llr(trigger_llr_[ko] + closed_llr_[ko],
-                                             trigger_energy_[k] + closed_energy_[k]);
-      if (best_llr - partial <= p_.margin_llr) return -1;
-    }
-  }
+  if (!beats_closed_partial_losses(best_llr)) return -1;  // (F29) over the same windows
   return best;
+}
+
+bool FaultDetector::beats_closed_partial_losses(double llr) const {
+  // (F29) A verdict read on the start window and the closed ones beats, over the same windows,
+  // every unlatched jet's fitted partial loss (F13) by margin_llr.
+  if (!p_.probe_partial_rival) return true;
+  for (int i = 0; i < kThrusters; ++i) {
+    if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
+    const auto k = static_cast<std::size_t>(i);
+    const auto ko = k + static_cast<std::size_t>(kThrusters);
+    const double partial = fitted_loss_llr(trigger_llr_[ko] + closed_llr_[ko],
+                                           trigger_energy_[k] + closed_energy_[k]);
+    if (llr - partial <= p_.margin_llr) return false;
+  }
+  return true;
 }
 
 int FaultDetector::closed_verdict_elsewhere() const {
@@ -1408,16 +1414,7 @@ int FaultDetector::closed_verdict_elsewhere() const {
       return -1;
     }
   }
-  if (p_.probe_partial_rival) {  // (F29) over the same windows
-    for (int i = 0; i < kThrusters; ++i) {
-      if ((((st_.confirmed_on | st_.confirmed_off) >> i) & 1u) != 0) continue;
-      const auto k = static_cast<std::size_t>(i);
-      const auto ko = k + static_cast<std::size_t>(kThrusters);
-      const double partial = fitted_loss_llr(trigger_llr_[ko] + closed_llr_[ko],
-                                             trigger_energy_[k] + closed_energy_[k]);
-      if (best_llr - partial <= p_.margin_llr) return -1;
-    }
-  }
+  if (!beats_closed_partial_losses(best_llr)) return -1;  // (F29) over the same windows
   return h;
 }
 

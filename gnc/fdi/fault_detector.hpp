@@ -570,6 +570,7 @@ class FaultDetector {
   int probe_blocker_{-1};
   int closed_probe_verdict() const;
   int closed_verdict_elsewhere() const;
+  bool beats_closed_partial_losses(double llr) const;
   void reset_probe_llr() {
     probe_llr_.fill(0.0);
     probe_energy_.fill(0.0);

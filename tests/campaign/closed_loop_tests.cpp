@@ -5,6 +5,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -397,69 +398,64 @@ TEST(ClosedLoop, AThrusterStuckOnInHoldIsConfirmedByTheIsolationTest) {
   EXPECT_LT(r.total_fuel_kg - healthy.total_fuel_kg, 2.0);
 }
 
+// A study case with `thruster` stuck on at 10 000 s and the onset window scored (F21 off), flown
+// 20 s with one detector switch on (gnc.yaml) and off: each run confirms that jet stuck on, once;
+// returns the two latencies from onset (switch on, switch off).
+std::pair<double, double> stuck_on_latency_with_and_without(int case_number, int thruster,
+                                                            bool gnc::FaultDetectorParams::*sw) {
+  config::RunSetup s = load(case_number);
+  EXPECT_TRUE(s.flight.fdi.*sw) << "gnc.yaml flies it";
+  s.flight.fdi.skip_onset_window = false;
+  plant::ThrusterFault f;
+  f.thruster = thruster;
+  f.kind = plant::FaultKind::kStuckOn;
+  f.onset_s = 10000.0;
+  s.truth.faults.push_back(f);
+  s.flight.fdi.*sw = true;
+  const RunResult on = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
+  s.flight.fdi.*sw = false;
+  const RunResult off = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
+  double latency[2] = {1e9, 1e9};
+  int i = 0;
+  for (const RunResult* r : {&on, &off}) {
+    EXPECT_EQ(r->status, RunStatus::kOk) << r->note;
+    EXPECT_TRUE(r->fdi.first_confirmation_s.has_value()) << "never confirmed";
+    EXPECT_EQ(r->fdi.thruster, thruster);
+    EXPECT_EQ(r->fdi.kind, "stuck-on");
+    EXPECT_EQ(r->fdi.confirmations, 1);
+    if (r->fdi.first_confirmation_s) latency[i] = *r->fdi.first_confirmation_s - f.onset_s;
+    ++i;
+  }
+  return {latency[0], latency[1]};
+}
+
 // (F40) Case 5, thruster 2 (pod 0, +z) stuck on mid-despin. Its mirror on the opposite pod,
 // thruster 11 (pod 2, -z), pushes the body the same way up to the centre of mass's xy offset, and
 // the first window after onset leads with the mirror: the isolation test closes pod 2. Thruster
 // 2 fires on through pod 0's open valve, and that closed window names it (F40): confirmed on
 // the update the test's closure ends, within the 3 s. Read only on the reopened window
 // (F40 off), the test is followed by a test of pod 0 and the confirmation comes seconds later.
+// The onset window scored (F21 off), as the dispersion measured it; with gnc.yaml's F21 the first
+// test starts a window later and (F40) saves the same reopened window (3.8 s against 4.8).
 TEST(ClosedLoop, AStuckOnJetSeenFiringBehindAnotherPodsClosedValveIsNamedByThatTest) {
-  config::RunSetup s = load(5);
-  ASSERT_TRUE(s.flight.fdi.probe_read_elsewhere) << "gnc.yaml flies (F40)";
-  // With the onset window scored (F21 off), as the dispersion measured it; with gnc.yaml's F21 the
-  // first test starts a window later and (F40) saves the same reopened window (3.8 s against 4.8).
-  s.flight.fdi.skip_onset_window = false;
-  plant::ThrusterFault f;
-  f.thruster = 2;
-  f.kind = plant::FaultKind::kStuckOn;
-  f.onset_s = 10000.0;
-  s.truth.faults.push_back(f);
-  const RunResult named = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
-  s.flight.fdi.probe_read_elsewhere = false;
-  const RunResult reopened = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
-  for (const RunResult* r : {&named, &reopened}) {
-    ASSERT_EQ(r->status, RunStatus::kOk) << r->note;
-    ASSERT_TRUE(r->fdi.first_confirmation_s.has_value()) << "never confirmed";
-    EXPECT_EQ(r->fdi.thruster, 2);
-    EXPECT_EQ(r->fdi.kind, "stuck-on");
-    EXPECT_EQ(r->fdi.confirmations, 1);
-  }
-  const double t_named = *named.fdi.first_confirmation_s - f.onset_s;
-  const double t_reopened = *reopened.fdi.first_confirmation_s - f.onset_s;
-  EXPECT_LE(t_named, 3.0);
-  EXPECT_GT(t_reopened, t_named + 1.0) << "the trap: without (F40) pod 0 is tested too";
+  const auto [named, reopened] =
+      stuck_on_latency_with_and_without(5, 2, &gnc::FaultDetectorParams::probe_read_elsewhere);
+  EXPECT_LE(named, 3.0);
+  EXPECT_GT(reopened, named + 1.0) << "the trap: without (F40) pod 0 is tested too";
 }
 
 // (F41) Case 4, thruster 7 (pod 1, -z) stuck on at 10 000 s, one tick before a window closes, the
-// onset window scored (F21 off). That window is suspicious with a stuck-off jet leading, and the
-// episode (F25) starts with it; the jet leads the next window, but its episode sum carries the
-// one-tick window's loss and (F8) finds it blocked by a stuck-off jet of its own pod, which no test
-// separates. With the episode restarted for the new leader the next decision tests pod 1 and the
-// closed window names the jet within the 3 s; without, a window later.
+// onset window scored (F21 off; with it, the one-tick window starts no episode at all). That
+// window is suspicious with a stuck-off jet leading, and the episode (F25) starts with it; the jet
+// leads the next window, but its episode sum carries the one-tick window's loss and (F8) finds it
+// blocked by a stuck-off jet of its own pod, which no test separates. With the episode restarted
+// for the new leader the next decision tests pod 1 and the closed window names the jet within the
+// issue's 3 s; without, a window later.
 TEST(ClosedLoop, AJetStuckOnJustBeforeAWindowClosesIsIsolatedWithinThreeSeconds) {
-  config::RunSetup s = load(4);
-  ASSERT_TRUE(s.flight.fdi.episode_restart_leader) << "gnc.yaml flies (F41)";
-  // With the onset window scored: gnc.yaml does not score it (F21), and then the one-tick window
-  // starts no episode at all.
-  s.flight.fdi.skip_onset_window = false;
-  plant::ThrusterFault f;
-  f.thruster = 7;
-  f.kind = plant::FaultKind::kStuckOn;
-  f.onset_s = 10000.0;
-  s.truth.faults.push_back(f);
-  const RunResult restarted = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
-  s.flight.fdi.episode_restart_leader = false;
-  const RunResult kept = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
-  for (const RunResult* r : {&restarted, &kept}) {
-    ASSERT_EQ(r->status, RunStatus::kOk) << r->note;
-    ASSERT_TRUE(r->fdi.first_confirmation_s.has_value()) << "never confirmed";
-    EXPECT_EQ(r->fdi.thruster, 7);
-    EXPECT_EQ(r->fdi.kind, "stuck-on");
-    EXPECT_EQ(r->fdi.confirmations, 1);
-  }
-  const double t_restarted = *restarted.fdi.first_confirmation_s - f.onset_s;
-  EXPECT_LE(t_restarted, 3.0);
-  EXPECT_GT(*kept.fdi.first_confirmation_s - f.onset_s, t_restarted + 0.5)
+  const auto [restarted, kept] =
+      stuck_on_latency_with_and_without(4, 7, &gnc::FaultDetectorParams::episode_restart_leader);
+  EXPECT_LE(restarted, 3.0);
+  EXPECT_GT(kept, restarted + 0.5)
       << "the trap: the episode kept, the confirmation comes a window later";
 }
 
