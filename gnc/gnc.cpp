@@ -233,6 +233,7 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
     in.thrust(2 * c + 1) = f < 0.0 ? -f : 0.0;
   }
   in.valve_open = last_valve_;
+  in.survey_allowed = !params_.fdi.survey_hold_only || modes_.mode() == Mode::kHold;  // (F43)
   const FaultEvents fe = fdi_.update(in);
   // (F9) The detector's isolation test closes a pod for a few windows; it is an isolation
   // action, so the ground's inhibit and auto_isolate govern it as they govern the confirmation's.
@@ -299,16 +300,22 @@ void Gnc::apply_jet_check(const AllocatorLimits& lim, Vec8& u) {
   // (F19) Thruster i is the "+" (even) or "-" (odd) half of channel c. The check moves u by
   //   du = s f (e_c - B^T (B B^T)^-1 B e_c) / (e_c - B^T (B B^T)^-1 B e_c)_c,   s = +1 / -1,
   // the minimum-norm change with B du = 0 that moves channel c by s f (the projection of e_c on
-  // the kernel of B_hat), then scales it by the largest gamma in [0, 1] that keeps every channel
-  // in [lo, hi] (as the excitation's X5). A channel in the row space of B_hat (no kernel
+  // the kernel of B), then scales it by the largest gamma in [0, 1] that keeps every channel
+  // in [lo, hi] (as the excitation's X5). A channel in the row space of B (no kernel
   // component) or a jet whose half is unusable (valve closed, latched) is not checked.
+  // B is the detector's model, with the identified centre of mass (F42), latched for the whole
+  // check when it starts; or, without F42, the active table's B_hat.
   const int i = fdi_.check_jet();
   const int c = i / 2;
   const double s = (i % 2 == 0) ? 1.0 : -1.0;
   if ((s > 0.0 && !(lim.hi(c) > 0.0)) || (s < 0.0 && !(lim.lo(c) < 0.0))) return;
-  Vec8 du;
-  if (!jet_check_move(alloc_.b_hat(), c, du)) return;
-  du *= s * fdi_.check_force() / du(c);
+  if (check_move_jet_ != i) {
+    check_move_ok_ = fdi_.check_on_model() ? fdi_.check_move(c, check_move_)
+                                           : jet_check_move(alloc_.b_hat(), c, check_move_);
+    check_move_jet_ = i;
+  }
+  if (!check_move_ok_) return;
+  Vec8 du = check_move_ * (s * fdi_.check_force() / check_move_(c));
   double gamma = 1.0;
   for (int j = 0; j < kChannels; ++j) {
     if (du(j) > 0.0) gamma = std::fmin(gamma, (lim.hi(j) - u(j)) / du(j));
@@ -712,6 +719,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   // 5c. Jet check (gnc/fdi/README.md F19): the detector asks for a jet its evidence suspects of
   // producing less than commanded to be fired firmly, in the null space of B_hat.
   check_jet_ = -1;
+  if (fdi_.check_jet() < 0) check_move_jet_ = -1;  // the next check latches its own move
   if (enabled && params_.fdi.enabled && fdi_.check_jet() >= 0) apply_jet_check(limits, u);
   if (fdi_.confirmed_degraded() != 0) {
     // (F18) A thruster latched degraded produces its factor of its strength: commanded that much

@@ -357,6 +357,7 @@ void FaultDetector::identified_evidence(const StuckOnEvidence& e) {
 FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   pending_ = FaultEvents{};
   if (!p_.enabled) return pending_;
+  survey_allowed_ = in.survey_allowed;
   // (F18) A jet latched degraded delivers its factor of what is commanded: everything (the
   // prediction, the hypotheses' ramps, the sweep's delivered thrust) sees the delivered thrust.
   if (st_.confirmed_degraded == 0) return step(in);
@@ -1680,7 +1681,7 @@ int FaultDetector::survey_candidate(int& windows) {
   // rating is a null-space move of B; rating every due jet on each decision took the decision's
   // tick over the Cortex-M7 budget): a jet that fails them is rated again check_interval_s later,
   // so the next decision rates the next jet.
-  if (!(p_.survey_interval_s > 0.0) || st_.unverified == 0) return -1;
+  if (!(p_.survey_interval_s > 0.0) || st_.unverified == 0 || !survey_allowed_) return -1;
   const double window_s = static_cast<double>(p_.window_ticks) * dt_;
   const auto interval = static_cast<std::uint32_t>(std::ceil(p_.survey_interval_s / window_s));
   int jet = -1;
@@ -1711,6 +1712,15 @@ int FaultDetector::survey_candidate(int& windows) {
   return jet;
 }
 
+bool FaultDetector::check_move(int c, Vec8& du) const {
+  Mat38 b = Mat38::Zero();
+  for (int q = 0; q < kChannels; ++q) {
+    const auto kq = static_cast<std::size_t>(2 * q);
+    b.col(q) = (pos_[kq] + m_.r).cross(dir_[kq]);
+  }
+  return jet_check_move(b, c, du);
+}
+
 double FaultDetector::expected_check_llr(int i) const {
   return 0.5 * expected_check_energy(i) * static_cast<double>(p_.check_windows);
 }
@@ -1726,13 +1736,8 @@ double FaultDetector::expected_check_energy(int i) const {
   // (r_sigma ||J^-1|| f_tot T)^2. (The check adds nothing to the thrust term: B du = 0.)
   const auto k = static_cast<std::size_t>(i);
   const int c = i / 2;
-  Mat38 b = Mat38::Zero();
-  for (int q = 0; q < kChannels; ++q) {
-    const auto kq = static_cast<std::size_t>(2 * q);
-    b.col(q) = (pos_[kq] + m_.r).cross(dir_[kq]);
-  }
   Vec8 du;
-  if (!jet_check_move(b, c, du)) return 0.0;  // channel c has no null-space move: no check
+  if (!check_move(c, du)) return 0.0;  // channel c has no null-space move: no check
   const double sum = du.cwiseAbs().sum();
   const double own = du(c);
   const double n = static_cast<double>(p_.window_ticks);

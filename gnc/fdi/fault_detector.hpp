@@ -182,6 +182,17 @@ struct FaultDetectorParams {
   // contradicted by the closed ones (as F32 reads the tested pod's jet). false: such a test is read
   // on its reopened window, and the leader's pod needs a test of its own.
   bool probe_read_elsewhere{false};
+  // (F42) A jet check's firing is the minimum-norm move in the null space of the detector's own
+  // channel torques, built on the identified centre of mass (check_move), the model it rates the
+  // check with (F24). false: the null space of the active table's B_hat, whose centre of mass is
+  // the a-priori one until a model is adopted (up to 1 m off in the study's cases 3, 4, 6 and 7,
+  // a torque of 1 m x the check's net force on the body).
+  bool check_model_null_space{false};
+  // (F43) The survey checks only in HOLD (the GNC's FaultDetectorInput::survey_allowed): a despin
+  // fires its jets firmly and its evidence checks are the detector's own, while in HOLD the jets
+  // idle at milli-newtons. A despin's tick already carries the identifier's blocks and the
+  // excitation. false: in every mode.
+  bool survey_hold_only{false};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -219,6 +230,8 @@ struct FaultDetectorInput {
   Vec16 thrust{Vec16::Zero()};
   std::array<bool, kPods> valve_open{{true, true, true, true}};
   bool thrust_valid{true};
+  // (F43) A jet survey check may start now (the GNC: only in HOLD when survey_hold_only).
+  bool survey_allowed{true};
 };
 
 // The identified model the predictions use (refreshed when the identifier reports).
@@ -332,6 +345,11 @@ class FaultDetector {
   // force (N, produced).
   int check_jet() const { return st_.check_jet; }
   double check_force() const { return p_.check_force_n; }
+  // (F19, F42) The check's move of the channel forces for channel c, unscaled (du(c) in (0, 1]):
+  // the minimum-norm move with no torque on the detector's model, whose channel torques are
+  // (p + r_hat) x d with the identified centre of mass. False when channel c has no such move.
+  bool check_move(int c, Vec8& du) const;
+  bool check_on_model() const { return p_.check_model_null_space; }
 
   // Rate change signature of hypothesis h over the last window (exposed for tests): 0..15
   // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
@@ -406,6 +424,7 @@ class FaultDetector {
   std::array<std::uint32_t, kThrusters> last_check_{};  // window count at each jet's last check, +1
   std::array<std::uint8_t, kThrusters> check_backoff_{};  // doublings of each jet's interval (0..2)
   std::array<double, kThrusters> survey_e_{};  // (F36) stuck-off energy since last verified
+  bool survey_allowed_{true};  // (F43) this update's FaultDetectorInput::survey_allowed
   std::array<std::uint32_t, kThrusters> survey_from_{};  // (F36) window count when last verified
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window

@@ -412,14 +412,17 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
 // (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)
-// another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader
-// and (F21) the onset window not scored: gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is
-// not a boolean names the file and key.
+// another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader,
+// (F21) the onset window not scored, (F42) checks in the identified model's null space and (F43)
+// the survey in HOLD only:
+// gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is not a
+// boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
   for (const char* key : {"probe_aligned", "centred_gyro_noise", "probe_partial_rival",
                           "probe_read_closed", "check_quiet_start", "check_score_unfit",
                           "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
-                          "episode_restart_leader", "skip_onset_window"}) {
+                          "episode_restart_leader", "skip_onset_window",
+                          "check_model_null_space", "survey_hold_only"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -431,6 +434,8 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "check_blocker"       ? f.check_blocker
              : k == "episode_restart_stale" ? f.episode_restart_stale
              : k == "probe_read_elsewhere" ? f.probe_read_elsewhere
+             : k == "check_model_null_space" ? f.check_model_null_space
+             : k == "survey_hold_only" ? f.survey_hold_only
              : k == "episode_restart_leader" ? f.episode_restart_leader
              : k == "skip_onset_window"     ? f.skip_onset_window
                                           : f.check_score_unfit;

@@ -1364,7 +1364,7 @@ struct CheckRun : DegradedRun {
 // thruster stuck_off dies at tick onset (-1: as the truth was given).
 template <class Firing>
 CheckRun fly_checks(Truth& t, FaultDetector& d, Firing firing, int ticks, int onset = -1,
-                    int stuck_off = -1) {
+                    int stuck_off = -1, int survey_from = 0) {
   Vec16 prev = Vec16::Zero();
   CheckRun run;
   for (int k = 0; k < ticks; ++k) {
@@ -1374,6 +1374,7 @@ CheckRun fly_checks(Truth& t, FaultDetector& d, Firing firing, int ticks, int on
     in.omega_valid = true;
     in.thrust = prev;
     in.valve_open = t.valve;
+    in.survey_allowed = k >= survey_from;  // (F43) the GNC's mode gate
     const int before = d.check_jet();
     const std::uint32_t surveys = d.status().surveys;
     run.note(d.update(in), k);
@@ -1804,6 +1805,28 @@ TEST(FaultDetector, ASurveyChecksAJetTheFlightBarelyCommandsAndIsolatesItStuckOf
     EXPECT_GE(run.r.confirmed_at, run.check_ticks[a]) << what;
     EXPECT_EQ(d.status().unverified & (1u << i), 0u) << what << ": latched, not unverified";
   }
+}
+
+// (F43) The GNC allows a survey check only in HOLD (survey_hold_only): while the input says no,
+// no survey check starts, whatever is due; the bookkeeping goes on, and once allowed the jets
+// that came due meanwhile are surveyed, the one unverified longest first.
+TEST(FaultDetector, NoSurveyCheckStartsWhileTheFlightDisallowsIt) {
+  Truth t;
+  FaultDetector d = make_detector(t, survey_params(t, 300.0));
+  const int allowed_from = 8000;  // 800 s: every jet the firing commands is due from 300 s
+  const SurveyRun run = fly_checks(t, d, HoldFiring(21), 12000, -1, -1, allowed_from);
+  EXPECT_LT(run.r.confirmed_at, 0) << "false alarm: thruster " << run.r.thruster;
+  int surveys = 0;
+  int first = -1;
+  for (std::size_t a = 0; a < run.checked.size(); ++a) {
+    if (!run.surveyed[a]) continue;
+    ++surveys;
+    EXPECT_GE(run.check_ticks[a], allowed_from) << "jet " << run.checked[a] << " surveyed";
+    if (first < 0) first = run.check_ticks[a];
+  }
+  EXPECT_GE(surveys, 10) << "the due jets surveyed once allowed";
+  EXPECT_LE(first, allowed_from + 20) << "the first due jet waits no longer than a decision";
+  EXPECT_EQ(d.status().surveys, static_cast<std::uint32_t>(surveys));
 }
 
 TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNothingWhenHealthy) {
