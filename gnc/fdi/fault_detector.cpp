@@ -85,6 +85,9 @@ Check validate(const FaultDetectorParams& p) {
     return bad("fdi.survey_interval_s", "must be >= 0 and finite");
   }
   if (!finite_positive(p.survey_energy)) return bad("fdi.survey_energy", "must be positive");
+  if (!finite_non_negative(p.survey_max_kick_rad_s)) {
+    return bad("fdi.survey_max_kick_rad_s", "must be >= 0 and finite");
+  }
   if (p.survey_max_windows < 1 || p.survey_max_windows > 1000) {
     return bad("fdi.survey_max_windows", "must be in [1, 1000]");
   }
@@ -1695,13 +1698,20 @@ int FaultDetector::survey_candidate(int& windows) {
   }
   if (jet < 0) return -1;
   ++st_.survey_ratings;
-  const double e =
-      signature_rel_error(jet) > p_.check_max_model_error ? 0.0 : expected_check_energy(jet);
+  double kick_rate = 0.0;
+  const double e = signature_rel_error(jet) > p_.check_max_model_error
+                       ? 0.0
+                       : expected_check_energy(jet, &kick_rate);
   const int lo = p_.check_windows;
   const int hi = std::max(lo, p_.survey_max_windows);
   const double need = e > 0.0 ? std::ceil(p_.survey_energy / e) : 0.0;
   const int n = need >= static_cast<double>(hi) ? hi : std::max(lo, static_cast<int>(need));
-  if (!(e > 0.0) || (p_.check_min_llr > 0.0 && 0.5 * e * static_cast<double>(n) < p_.check_min_llr)) {
+  // (F44) 3 sigma of the rate the check may put on the body, over its n windows.
+  const bool kicks = p_.survey_max_kick_rad_s > 0.0 &&
+                     3.0 * kick_rate * static_cast<double>(n) * window_s > p_.survey_max_kick_rad_s;
+  if (kicks) ++st_.survey_kick_refusals;
+  if (!(e > 0.0) || kicks ||
+      (p_.check_min_llr > 0.0 && 0.5 * e * static_cast<double>(n) < p_.check_min_llr)) {
     // Not checkable now: due again one check interval from now.
     const auto retry = std::min(
         interval, static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s)));
@@ -1725,7 +1735,7 @@ double FaultDetector::expected_check_llr(int i) const {
   return 0.5 * expected_check_energy(i) * static_cast<double>(p_.check_windows);
 }
 
-double FaultDetector::expected_check_energy(int i) const {
+double FaultDetector::expected_check_energy(int i, double* kick_rate) const {
   // (F24) A check fires thruster i at f = check_force_n, compensated in the null space of the
   // channels' torque matrix B (Gnc::apply_jet_check: du = e_c - B^T (B B^T)^-1 B e_c, scaled to
   // move channel c by f), so every channel fires: the check's force is f_tot = f sum |du| / |du_c|.
@@ -1743,6 +1753,25 @@ double FaultDetector::expected_check_energy(int i) const {
   const double n = static_cast<double>(p_.window_ticks);
   const double f = p_.check_force_n;
   const double offset = r_sigma_ * j_inv_.norm() * f * (sum / own) * n * dt_;
+  if (kick_rate != nullptr) {
+    // (F44) The torque the model's error leaves of the move, per unit of du: the centre of mass's
+    // covariance against the net force F (tau = dr x F: S(F) R S(F)^T) and each fired jet's
+    // strength 1 sigma against its torque (independent); through J^-1, the rate's covariance
+    // per second of the check, and its root-mean-square magnitude.
+    Vec3 force = Vec3::Zero();
+    Mat3 torque_cov = Mat3::Zero();
+    for (int q = 0; q < kChannels; ++q) {
+      const auto kq = static_cast<std::size_t>(2 * q);
+      force += du(q) * dir_[kq];
+      const Vec3 tq = (m_.k_sigma * du(q)) * (pos_[kq] + m_.r).cross(dir_[kq]);
+      torque_cov += tq * tq.transpose();
+    }
+    Mat3 sf;
+    sf << 0.0, -force.z(), force.y(), force.z(), 0.0, -force.x(), -force.y(), force.x(), 0.0;
+    torque_cov += sf * m_.r_cov * sf.transpose();
+    const Mat3 rate_cov = j_inv_ * torque_cov * j_inv_.transpose();
+    *kick_rate = (f / own) * std::sqrt(std::fmax(rate_cov.trace(), 0.0));
+  }
   const double var = quiet_var_ + offset * offset + 1e-30;
   const double step = b_[k].norm() * f * dt_;
   return step * step * n * (n * n - 1.0) / 12.0 / var;

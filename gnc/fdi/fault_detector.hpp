@@ -193,6 +193,12 @@ struct FaultDetectorParams {
   // idle at milli-newtons. A despin's tick already carries the identifier's blocks and the
   // excitation. false: in every mode.
   bool survey_hold_only{false};
+  // (F44) A survey check starts only when the rate it may put on the body stays within this, rad/s
+  // (0: off): 3 sigma of the model's error against the check's firing (the centre of mass's 1 sigma
+  // against its net force, each fired jet's strength 1 sigma against its torque) times J^-1 and
+  // the check's length. After a confirmed fault the identifier restarts from its prior (I27 off)
+  // and a survey check against that model kicks the rate out of the SPEC §7 bound in HOLD.
+  double survey_max_kick_rad_s{0.0};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -278,6 +284,7 @@ struct FaultDetectorStatus {
   std::uint32_t checks_unfit{0};              // (F19) check windows not scored (model error)
   std::uint32_t surveys{0};                   // (F36) of the checks, those started by the survey
   std::uint32_t survey_ratings{0};  // (F36) due jets rated against the check gates (<= 1 a decision)
+  std::uint32_t survey_kick_refusals{0};  // (F44) due jets not surveyed: the check would kick the rate
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
   std::uint32_t elsewhere_verdicts{0};  // (F40) tests whose closed windows named another pod's jet
@@ -395,7 +402,9 @@ class FaultDetector {
   // (F24) The stuck-off LLR a check of thruster i is expected to move, E / 2 over its windows.
   double expected_check_llr(int i) const;
   // (F24, F36) The stuck-off energy E one window of a check of thruster i is expected to have.
-  double expected_check_energy(int i) const;
+  // kick_rate (optional): the 1 sigma rate the check's firing puts on the body per second of it
+  // (F44), from the model's error against the check's move.
+  double expected_check_energy(int i, double* kick_rate = nullptr) const;
   // (F36) Each jet's stuck-off energy since it was last verified, after each decision.
   void update_survey();
   // (F36) The jet the survey checks now (-1 none) and the check's windows; a due jet that cannot

@@ -481,6 +481,7 @@ TEST(ClosedLoop, SurveyChecksInTheIdentifiedModelsNullSpaceDoNotKickTheRate) {
   };
   const RunResult quiet = run(s, "ntcl+dpd_ref:id:fdi", 1.0, 45000.0);
   s.flight.fdi.survey_interval_s = 20000.0;
+  s.flight.fdi.survey_max_kick_rad_s = 0.0;  // (F44) off: the move alone
   const RunResult model = run(s, "ntcl+dpd_ref:id:fdi", 1.0, 45000.0);
   s.flight.fdi.check_model_null_space = false;
   const RunResult table = run(s, "ntcl+dpd_ref:id:fdi", 1.0, 45000.0);
@@ -499,6 +500,39 @@ TEST(ClosedLoop, SurveyChecksInTheIdentifiedModelsNullSpaceDoNotKickTheRate) {
   EXPECT_LT(peak(model), 0.25 * bound);
   EXPECT_GT(peak(table), 0.5 * bound)
       << "the trap: checks against the prior's centre of mass kick the rate";
+}
+
+// (F44) Case 1, thruster 4 stuck off at 10 000 s, the jet survey every 20 000 s in HOLD. The fault
+// is confirmed in the despin, and the identifier restarts from its prior (I27 off): in HOLD its
+// centre of mass is metres off. A survey check in that model's null space then puts its error
+// times the check's net force on the body: the rate leaves the SPEC §7 bound late in the flight
+// and the attitude goal is missed. With the check held back while 3 sigma of its kick exceeds
+// half the rate bound (gnc.yaml: 5e-5 rad/s), both goals are met as without a survey.
+TEST(ClosedLoop, NoSurveyCheckKicksTheRateAgainstAModelRestartedByAFault) {
+  config::RunSetup s = load(1);
+  EXPECT_GT(s.flight.fdi.survey_max_kick_rad_s, 0.0) << "gnc.yaml flies it";
+  plant::ThrusterFault f;
+  f.thruster = 4;
+  f.kind = plant::FaultKind::kStuckOff;
+  f.onset_s = 10000.0;
+  s.truth.faults.push_back(f);
+  s.flight.fdi.survey_interval_s = 20000.0;
+  const RunResult gated = run(s, "ntcl+dpd_ref:id:fdi");
+  s.flight.fdi.survey_max_kick_rad_s = 0.0;
+  const RunResult open = run(s, "ntcl+dpd_ref:id:fdi");
+  for (const RunResult* r : {&gated, &open}) {
+    ASSERT_EQ(r->status, RunStatus::kOk) << r->note;
+    EXPECT_EQ(r->fdi.thruster, 4);
+    EXPECT_EQ(r->fdi.kind, "stuck-off");
+    EXPECT_EQ(r->fdi.confirmations, 1);
+    ASSERT_TRUE(r->fdi.first_confirmation_s.has_value());
+    EXPECT_LT(*r->fdi.first_confirmation_s, 20000.0) << "confirmed in the despin";
+    ASSERT_TRUE(r->t_omega_conv_s.has_value());
+  }
+  EXPECT_TRUE(gated.t_q_conv_s.has_value());
+  EXPECT_LT(*gated.t_omega_conv_s, 30000.0);
+  EXPECT_GT(*open.t_omega_conv_s, 90000.0) << "the trap: a late check kicks the rate out";
+  EXPECT_FALSE(open.t_q_conv_s.has_value()) << "the trap: the attitude goal missed";
 }
 
 // The campaign's measure of how much a stuck-off jet was asked to fire after onset (the issue's

@@ -323,6 +323,14 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOffInGncYaml) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_interval_s,
                                       0.0);
                           });
+  // (F44) The survey's kick bound: 5e-5 rad/s in gnc.yaml, off (0) when absent, a negative one named.
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.survey_max_kick_rad_s, 5.0e-5);
+  expect_optional_fdi_key("  survey_max_kick_rad_s: 5.0e-5", "survey_max_kick_rad_s",
+                          "  survey_max_kick_rad_s: -1e-5", "", [](const std::string& gnc) {
+                            EXPECT_EQ(
+                                load_run(kMission, gnc, case_file(1)).flight.fdi.survey_max_kick_rad_s,
+                                0.0);
+                          });
   TempFile on("gnc.yaml", replaced(read(kGnc), "  survey_interval_s: 0.0", "  survey_interval_s: 20000"));
   EXPECT_EQ(load_run(kMission, on.path(), case_file(1)).flight.fdi.survey_interval_s, 20000.0);
   expect_optional_fdi_key("  survey_energy: 10.0", "survey_energy", "  survey_energy: 0", "",

@@ -1829,6 +1829,38 @@ TEST(FaultDetector, NoSurveyCheckStartsWhileTheFlightDisallowsIt) {
   EXPECT_EQ(d.status().surveys, static_cast<std::uint32_t>(surveys));
 }
 
+// (F44) A survey check whose firing, against the model's error, may put more than
+// survey_max_kick_rad_s (3 sigma) of rate on the body is not flown. At a bound of 2e-6 rad/s: with
+// the centre of mass known to 1 mm the jets the firing commands are surveyed as without the gate;
+// known to 5 cm (the check's net force of about 100 N then leaves 5 N m unknown) none is, each
+// refusal counted. Without the bound both are surveyed; nothing is confirmed in any run.
+TEST(FaultDetector, ASurveyCheckThatMayKickTheRateBeyondItsBoundIsNotFlown) {
+  for (const double r_sigma : {1e-3, 0.05}) {
+    for (const double bound : {0.0, 2e-6}) {
+      Truth t;
+      FaultDetectorParams p = survey_params(t, 300.0);
+      p.survey_max_kick_rad_s = bound;
+      FaultDetector d;
+      d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+      FaultModel m = identified_model(t);
+      m.r_cov = Mat3::Identity() * r_sigma * r_sigma;
+      d.set_model(m);
+      const SurveyRun run = fly_hold(t, d, 12000, -1, -1, 21);
+      const std::string what =
+          "r 1 sigma " + std::to_string(r_sigma) + " m, bound " + std::to_string(bound);
+      EXPECT_LT(run.r.confirmed_at, 0) << what;
+      const bool gated = bound > 0.0 && r_sigma > 0.01;
+      if (gated) {
+        EXPECT_EQ(d.status().surveys, 0u) << what;
+        EXPECT_GT(d.status().survey_kick_refusals, 0u) << what;
+      } else {
+        EXPECT_GE(d.status().surveys, 10u) << what;
+        EXPECT_EQ(d.status().survey_kick_refusals, 0u) << what;
+      }
+    }
+  }
+}
+
 TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNothingWhenHealthy) {
   for (std::uint64_t seed : {21u, 22u}) {
     Truth t;
@@ -2064,6 +2096,9 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
   p = FaultDetectorParams{};
   p.survey_interval_s = -1.0;  // (F36)
   EXPECT_STREQ(validate(p).field, "fdi.survey_interval_s");
+  p = FaultDetectorParams{};
+  p.survey_max_kick_rad_s = -1e-5;  // (F44)
+  EXPECT_STREQ(validate(p).field, "fdi.survey_max_kick_rad_s");
   p = FaultDetectorParams{};
   p.survey_energy = 0.0;
   EXPECT_STREQ(validate(p).field, "fdi.survey_energy");
