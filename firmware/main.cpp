@@ -227,6 +227,7 @@ int firmware_main() {
     g_params.fdi.probe_read_elsewhere = true;  // (F40) ... which may name another pod's jet
     g_params.fdi.check_model_null_space = true;  // (F42) checks in the identified model's null space
     g_params.fdi.survey_hold_only = true;  // (F43) the survey in HOLD only
+    g_params.fdi.survey_max_kick_rad_s = 5.0e-5;  // (F44) ... and no survey check that may kick the rate
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown
