@@ -22,8 +22,8 @@
 //                 confirmation (gnc/fdi/README.md F18) runs on the counted ticks; success then also
 //                 needs that thruster, and only it, confirmed degraded
 //   survey=S      with modules=all: the jet survey (gnc/fdi/README.md F36; an option, off in
-//                 gnc.yaml) every S s, so that its checks run on the counted ticks (inside the
-//                 budget in HOLD, over it on a few ticks of a despin: DEVELOPERS.md)
+//                 gnc.yaml) every S s, so that its checks run on the counted ticks (in HOLD
+//                 only, F43; inside the budget: DEVELOPERS.md)
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
