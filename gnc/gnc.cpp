@@ -717,7 +717,8 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     }
   }
   // 5c. Jet check (gnc/fdi/README.md F19): the detector asks for a jet its evidence suspects of
-  // producing less than commanded to be fired firmly, in the null space of B_hat.
+  // producing less than commanded to be fired firmly, in the null space of the detector's model
+  // (F42) or of B_hat.
   check_jet_ = -1;
   if (fdi_.check_jet() < 0) check_move_jet_ = -1;  // the next check latches its own move
   if (enabled && params_.fdi.enabled && fdi_.check_jet() >= 0) apply_jet_check(limits, u);

@@ -1556,8 +1556,9 @@ void FaultDetector::update_check() {
   // (F19) Jet check. A stuck-off or partly failed jet shows only through what it is commanded,
   // and the despin asks most jets for a few newtons (F11): their evidence grows over hundreds of
   // seconds. Once a jet's stuck-off score or partial-loss CUSUM (F18) reaches check_llr, the
-  // flight fires it at check_force_n for check_windows windows in the null space of B_hat (the
-  // Gnc, no torque on the model). Its stuck-off signature then has the energy of a firm firing:
+  // flight fires it at check_force_n for check_windows windows in the null space of the channels'
+  // torques (the Gnc; the detector's model with F42, check_move): no torque on the model. Its
+  // stuck-off signature then has the energy of a firm firing:
   // a healthy jet loses about half of it from each hypothesis (exonerated within a window), a
   // failed one gains it (confirmed by F6 / F13 / F18 as before). Nothing here decides anything.
   const bool suspicious = st_.chi2 > p_.suspect_chi2;  // the window just evaluated

@@ -110,7 +110,8 @@ struct FaultDetectorParams {
   double degraded_min_loss{0.0};
   // (F19) Jet check: when a jet's stuck-off score or partial-loss CUSUM (F18) reaches check_llr
   // (the evidence of a jet the despin asks for only a few newtons), the flight fires that jet at
-  // check_force_n for check_windows windows in the null space of B_hat (no torque on the model),
+  // check_force_n for check_windows windows in the null space of the channels' torques (no torque
+  // on the model: the detector's own with F42, check_move; the table's B_hat without),
   // so its own hypotheses are confirmed or exonerated within seconds. A jet is checked at most
   // once per check_interval_s, doubled after each check of it that confirmed nothing (up to four
   // times the interval). 0: off.
