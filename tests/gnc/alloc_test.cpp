@@ -470,6 +470,7 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
   p.fdi.check_llr = 1e-3;
   p.fdi.check_interval_s = 10.0;
   p.fdi.skip_onset_window = true;  // (F21)
+  p.fdi.check_model_null_space = true;  // (F42) the move latched from the detector's model
   auto* loop = new test::SmallLoop(p);
   ASSERT_TRUE(loop->gnc.init(p).ok);
   std::mt19937_64 rng(5);
@@ -502,14 +503,15 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
   delete loop;
 }
 
-// gnc/fdi/README.md (F36)-(F38): the jet survey's bookkeeping and its checks, with the stale
-// episode's restart and the blocker's check on; no evidence check (check_llr out of reach), a
+// gnc/fdi/README.md (F36)-(F38), (F44): the jet survey's bookkeeping, its kick rating and its
+// checks, with the stale episode's restart and the blocker's check on; no evidence check (check_llr out of reach), a
 // survey every 20 s and a verification level no firing reaches: no heap.
 TEST(ZeroAllocation, NoHeapInAJetSurvey) {
   GncParams p = small_vehicle_checking();
   p.fdi.check_llr = 1e6;
   p.fdi.survey_interval_s = 20.0;
   p.fdi.survey_energy = 1e12;
+  p.fdi.survey_max_kick_rad_s = 1.0;  // (F44) the kick rated on every survey, never refusing
   p.fdi.check_blocker = true;
   p.fdi.episode_restart_stale = true;
   auto* loop = new test::SmallLoop(p);
