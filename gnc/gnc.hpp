@@ -101,10 +101,10 @@ class Gnc {
   bool isolation_inhibited_{false};
   int probe_pod_{-1};  // pod closed for the detector's isolation test this tick, -1 none
   int check_jet_{-1};    // (F19) thruster fired for a jet check this tick, -1 none
-  int check_move_jet_{-1};  // (F42) the check whose move check_move_ holds, -1 none
-  bool check_move_ok_{false};
-  Vec8 check_move_{Vec8::Zero()};  // ... unscaled, latched when the check starts
   int check_event_{-1};  // ... the one last reported by an event
+  int check_move_jet_{-1};  // (F42) the check whose move check_move_ holds, -1 none
+  bool check_move_ok_{false};      // ... whether that check has a move
+  Vec8 check_move_{Vec8::Zero()};  // ... the move, unscaled, latched when the check starts
   bool reduced_reported_{false};
   ModeManager modes_{};
   References refs_{};
