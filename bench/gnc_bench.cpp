@@ -196,6 +196,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.suspect_chi2 = 30.66;                 // ... and the suspicion at 1 - 1e-6, as flown
   p.fdi.detect_early_ticks = fdi ? 3 : 0;     // (F33) early detection, as flown
   p.fdi.skip_onset_window = true;             // (F21) the onset window not scored: 5-tick windows
+  p.fdi.onset_restart = fdi;                  // (F45) ... ended at its early suspicion, as flown
   p.fdi.episode_restart = true;               // (F25) the episode since the fault showed, as flown
   p.mode.auto_hold = false;
   Gnc gnc;

@@ -265,6 +265,7 @@ GncConfig load_gnc(const std::string& path) {
     }
     if (r.has("detect_early_chi2")) fd.detect_early_chi2 = r.positive("detect_early_chi2");
     if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)
+    if (r.has("onset_restart")) fd.onset_restart = r.boolean("onset_restart");  // (F45)
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
     if (r.has("identified_zero_chi2")) fd.identified_zero_chi2 = r.positive("identified_zero_chi2");

@@ -232,6 +232,7 @@ int firmware_main() {
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown
     g_params.fdi.skip_onset_window = true;     // (F21) the onset window not scored: 5-tick windows
+    g_params.fdi.onset_restart = true;         // (F45) ... ended at its early suspicion, as flown
     g_params.fdi.episode_restart = true;       // (F25) the episode since the fault showed, as flown
     // The identifier as flown (gnc.yaml) for this gyro's noise: the noisy sensors' 60 s window, the
     // second-order term (I20), the gate (I18), the noise correction (I25), the gyro bias (I17).

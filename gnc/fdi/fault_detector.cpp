@@ -461,6 +461,18 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
     ++st_.early_detections;
     pending_.suspected = true;
     pending_.early = true;
+    // (F45) The onset window (F21: the first suspicious window after a quiet one, no test or check
+    // under way) ends here and is dropped: the fault began within it, so the window starting on
+    // this sample is filled by it. The previous window's evaluation is past its first step (which
+    // reads last_suspicious_), since that step runs on the update after it closed.
+    if (p_.onset_restart && p_.skip_onset_window && !last_suspicious_ && probe_left_ == 0 &&
+        !verdict_pending_ && !sweeping() && acc.check_jet < 0 && st_.check_jet < 0) {
+      ++st_.onset_restarts;
+      last_suspicious_ = true;  // the dropped window was the onset: the next one is scored
+      check_prev_ = st_.check_jet;
+      start_window(in.omega);
+      return pending_;
+    }
   }
   // (F19) The thrust of this update was commanded while the check of the previous one ran.
   if (check_prev_ >= 0) acc.check_jet = check_prev_;

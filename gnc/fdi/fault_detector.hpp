@@ -52,6 +52,12 @@ struct FaultDetectorParams {
   // (F21) The window a fault starts in is not scored: the first window whose no-fault chi-square
   // exceeds suspect_chi2 after one that did not (outside isolation tests, sweeps and jet checks).
   bool skip_onset_window{false};
+  // (F45) With (F21) and (F33): the window whose early test first shows a fault ends there, its
+  // samples dropped (F21 would not score them), and the next window starts on that sample, so the
+  // first window scored is one the fault fills, a whole window sooner than the onset window's
+  // close. Not while a suspicion, a test or a check is under way. false: the onset window runs
+  // its course.
+  bool onset_restart{false};
   // (F8) The lead over each alternative must also exceed what an error of the model could have
   // produced: this many 1 sigma of the signature's model uncertainty.
   double model_sigmas{3.0};
@@ -288,6 +294,7 @@ struct FaultDetectorStatus {
   std::uint32_t survey_kick_refusals{0};  // (F44) due jets not surveyed: the check would kick the rate
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
+  std::uint32_t onset_restarts{0};  // (F45) onset windows ended at their early suspicion
   std::uint32_t elsewhere_verdicts{0};  // (F40) tests whose closed windows named another pod's jet
 };
 

@@ -421,8 +421,8 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
 // (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)
 // another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader,
-// (F21) the onset window not scored, (F42) checks in the identified model's null space and (F43)
-// the survey in HOLD only:
+// (F21) the onset window not scored, (F45) ended at its early suspicion, (F42) checks in the
+// identified model's null space and (F43) the survey in HOLD only:
 // gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is not a
 // boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
@@ -430,7 +430,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
                           "probe_read_closed", "check_quiet_start", "check_score_unfit",
                           "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
                           "episode_restart_leader", "skip_onset_window",
-                          "check_model_null_space", "survey_hold_only"}) {
+                          "check_model_null_space", "survey_hold_only", "onset_restart"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -446,6 +446,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "survey_hold_only" ? f.survey_hold_only
              : k == "episode_restart_leader" ? f.episode_restart_leader
              : k == "skip_onset_window"     ? f.skip_onset_window
+             : k == "onset_restart"         ? f.onset_restart
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;

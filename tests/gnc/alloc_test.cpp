@@ -539,6 +539,48 @@ TEST(ZeroAllocation, NoHeapInAJetSurvey) {
   delete loop;
 }
 
+// gnc/fdi/README.md (F45): a jet stuck on under the small vehicle's L1 flight, the early test
+// (F33) and the onset window unscored (F21): the onset window ends at its early suspicion, and
+// the windows started there are scored (the stuck jet leads the bank), under the counter.
+TEST(ZeroAllocation, NoHeapWhenAnOnsetWindowEndsAtItsEarlySuspicion) {
+  GncParams p = small_vehicle_checking();
+  p.fdi.skip_onset_window = true;
+  p.fdi.detect_early_ticks = 3;
+  p.fdi.detect_early_chi2 = 35.41;
+  p.fdi.onset_restart = true;
+  p.fdi.disturbance_sigma = 1e-4;  // the small vehicle's (the default is the asteroid's)
+  auto* loop = new test::SmallLoop(p);
+  ASSERT_TRUE(loop->gnc.init(p).ok);
+  constexpr int kChannel = 1;
+  constexpr int kOnset = 1203;  // in HOLD, three ticks into a window
+  const int pod = p.rcs.channel_pod[kChannel];
+  long counted = -1;
+  {
+    Armed armed;
+    GncCommands c;
+    c.has_mode_request = true;
+    c.mode_request = Mode::kDetumble;
+    for (int i = 0; i < 1600; ++i) {
+      loop->gnc.step(loop->sample(), i == 0 ? c : GncCommands{}, loop->out);
+      Vec8 f = loop->out.command.force;
+      if (i >= kOnset && loop->out.command.valve_open[static_cast<std::size_t>(pod)]) {
+        f(kChannel) = p.rcs.u_max + std::fmin(f(kChannel), 0.0);  // the "+" jet stuck on
+      }
+      loop->body.step(p.dt, loop->b_true * f);
+      loop->t += p.dt;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  const auto& st = loop->gnc.fault_detector().status();
+  EXPECT_EQ(st.onset_restarts, 1u) << "windows " << st.windows << " suspicions " << st.suspicions
+      << " early " << st.early_detections << " chi2 " << st.chi2 << " best " << st.best << " mode "
+      << to_string(loop->gnc.mode()) << " t " << loop->t;
+  // ... and the windows after it were scored: the stuck jet leads the bank.
+  EXPECT_EQ(st.best, 2 * kChannel) << "llr " << st.best_llr;
+  delete loop;
+}
+
 TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {
   GncParams truth = test::small_vehicle_params();
   auto* loop = new test::SmallLoop(truth);

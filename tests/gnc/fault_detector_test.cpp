@@ -383,6 +383,93 @@ TEST(FaultDetector, ANewLeaderWhoseFaultBeganAfterTheEpisodeStartedRestartsIt) {
   EXPECT_LT(latency_now, latency_before);
 }
 
+// (F45) The onset window ended at its early suspicion. The rig of (F41) as gnc.yaml flies it
+// (10-tick windows, F21, F33's early test from 3 samples, F41), every jet stuck on at every phase of
+// the window, with and without (F45). Without it, the first window scored is the one after the
+// onset window's close; with it, the window that starts on the early suspicion, which the fault
+// fills: every jet is still named right, none later, and on average sooner by what is left of the
+// onset window after its early suspicion.
+struct OnsetRestartRun {
+  RunResult r;
+  std::uint32_t onset_restarts{0};
+  std::uint32_t early{0};
+};
+
+OnsetRestartRun fly_onset_restart(int jet, int onset, bool onset_restart) {
+  Truth t;
+  t.gyro_sigma = 1e-7;
+  FaultDetectorParams p = bank_params(t.gyro_sigma);
+  p.episode_restart = true;
+  p.episode_restart_stale = true;
+  p.episode_restart_leader = true;
+  p.probe_windows = 1;
+  p.probe_aligned = true;
+  p.probe_read_closed = true;
+  p.probe_partial_rival = true;
+  p.probe_read_elsewhere = true;
+  p.centred_gyro_noise = true;
+  p.skip_onset_window = true;
+  p.detect_early_ticks = 3;
+  p.detect_early_chi2 = 35.41;
+  p.onset_restart = onset_restart;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  m.r_cov = Mat3::Identity() * (0.03 * 0.03);
+  m.k_sigma = 0.01;
+  d.set_model(m);
+  OnsetRestartRun out;
+  out.r = fly_weak(t, d, onset + 200, onset, -1, 31, jet);
+  if (out.r.confirmed_at >= 0) out.r.confirmed_at -= onset;
+  out.onset_restarts = d.status().onset_restarts;
+  out.early = d.status().early_detections;
+  return out;
+}
+
+TEST(FaultDetector, AnOnsetWindowEndedAtItsEarlySuspicionNamesEveryJetSooner) {
+  double latency_before = 0.0, latency_now = 0.0;
+  int sooner = 0, later = 0, worst_before = 0, worst_now = 0;
+  for (int jet = 0; jet < 16; ++jet) {
+    for (int onset = 500; onset < 510; ++onset) {  // every phase of the window
+      const OnsetRestartRun before = fly_onset_restart(jet, onset, false);
+      const OnsetRestartRun now = fly_onset_restart(jet, onset, true);
+      const std::string what = "jet " + std::to_string(jet) + " onset " + std::to_string(onset);
+      ASSERT_GE(before.r.confirmed_at, 0) << what;
+      ASSERT_GE(now.r.confirmed_at, 0) << what;
+      EXPECT_EQ(before.r.thruster, jet) << what;
+      EXPECT_EQ(now.r.thruster, jet) << what;
+      EXPECT_EQ(now.r.kind, FaultKind::kStuckOn) << what;
+      EXPECT_EQ(before.onset_restarts, 0u) << what;
+      // One early suspicion, and the onset window ended there: the healthy flight before it has
+      // none.
+      EXPECT_GE(now.early, 1u) << what;
+      // The onset window ends at its early suspicion once, whenever its early test can fire: the
+      // fault shows from the sample after onset, and the test needs 3 samples of the window.
+      EXPECT_LE(now.onset_restarts, 1u) << what;
+      if (onset <= 506) {
+        EXPECT_EQ(now.onset_restarts, 1u) << what;
+      }
+      // The windows move by less than one: a run can lose at most that (its first scored window
+      // decided with another firing, an isolation test the other did not need).
+      EXPECT_LE(now.r.confirmed_at, before.r.confirmed_at + 10) << what;
+      if (now.r.confirmed_at < before.r.confirmed_at) ++sooner;
+      if (now.r.confirmed_at > before.r.confirmed_at) ++later;
+      latency_before += before.r.confirmed_at;
+      latency_now += now.r.confirmed_at;
+      worst_before = std::max(worst_before, before.r.confirmed_at);
+      worst_now = std::max(worst_now, now.r.confirmed_at);
+    }
+  }
+  std::printf("onset window ended at its early suspicion: latency mean %.1f -> %.1f ticks, worst "
+              "%d -> %d, %d of 160 sooner, %d later\n",
+              latency_before / 160.0, latency_now / 160.0, worst_before, worst_now, sooner, later);
+  EXPECT_LT(worst_now, worst_before);
+  EXPECT_GT(sooner, 8 * later);
+  // Sooner on average by at least a third of a window: the onset window's rest after its early
+  // suspicion, 3 samples in or 1-2 after the onset, whichever is later (none at the last phases).
+  EXPECT_LE(latency_now, latency_before - 3.0 * 160.0);
+}
+
 // (F33) Early detection. Every jet stuck on at every phase of a 10-tick window, under HOLD's
 // few-newton firing (WeakFiring) with case 5's gyro: the first suspicion after onset with the window so far tested each
 // update, against the same flight with the window's own test only. Scores and decisions are the
