@@ -266,6 +266,12 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("detect_early_chi2")) fd.detect_early_chi2 = r.positive("detect_early_chi2");
     if (r.has("skip_onset_window")) fd.skip_onset_window = r.boolean("skip_onset_window");  // (F21)
     if (r.has("onset_restart")) fd.onset_restart = r.boolean("onset_restart");  // (F45)
+    if (r.has("probe_window_ticks")) {  // (F46)
+      fd.probe_window_ticks = r.integer("probe_window_ticks");
+      if (fd.probe_window_ticks != 0 && (fd.probe_window_ticks < 4 || fd.probe_window_ticks > 1000)) {
+        r.fail("probe_window_ticks", "must be 0 or in [4, 1000]");
+      }
+    }
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
     if (r.has("identified_zero_chi2")) fd.identified_zero_chi2 = r.positive("identified_zero_chi2");
@@ -472,6 +478,16 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
                                                     g.fdi_window_snr, g.params.fdi.window_ticks,
                                                     g.fdi_window_noisy_ticks)
                              : g.fdi_window_noisy_ticks;
+    // (F46) The isolation test's window likewise: the shortest from gnc.yaml's in which the
+    // weakest jet stands window_snr sigma above the gyro's noise, at most the bank's window (0,
+    // the bank's window, without window_snr).
+    if (p.fdi.probe_window_ticks > 0) {
+      p.fdi.probe_window_ticks =
+          g.fdi_window_snr > 0.0
+              ? fdi_window_for_noise(p, std::sqrt(c.gyro_psd / m.sensor_period_s), g.fdi_window_snr,
+                                     g.params.fdi.probe_window_ticks, p.fdi.window_ticks)
+              : 0;
+    }
   }
   const gnc::ParamCheck check = gnc::validate(p);
   if (!check.ok) {

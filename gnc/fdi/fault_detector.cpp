@@ -51,6 +51,9 @@ Check validate(const FaultDetectorParams& p) {
   if (p.probe_windows < 0 || p.probe_windows > 1000) {
     return bad("fdi.probe_windows", "must be in [0, 1000]");
   }
+  if (p.probe_window_ticks != 0 && (p.probe_window_ticks < 4 || p.probe_window_ticks > 1000)) {
+    return bad("fdi.probe_window_ticks", "must be 0 or in [4, 1000]");
+  }
   if (!finite_positive(p.identified_zero_chi2)) {
     return bad("fdi.identified_zero_chi2", "must be positive");
   }
@@ -401,9 +404,11 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   }
   if (!have_start_ || restart_window_) {
     // (F27) At a pod's closure the window restarts on this sample: every interval of the new
-    // window is flown with the valve as the test set it.
+    // window is flown with the valve as the test set it. (F46) That window is the test's length.
+    const bool test_start = restart_window_ && probe_left_ > 0 && !sweeping();
     restart_window_ = false;
     start_window(in.omega);
+    if (test_start && p_.probe_window_ticks > 0) window_len_ = p_.probe_window_ticks;
     return pending_;
   }
   // (F2): the interval ending now, with the thrust commanded over it and the mid-interval rate.
@@ -454,7 +459,7 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   }
   // (F33) The window so far, from detect_early_ticks samples until its last (which the closed
   // window's evaluation reads), once per window.
-  if (p_.detect_early_ticks > 0 && n_ >= p_.detect_early_ticks && n_ < p_.window_ticks &&
+  if (p_.detect_early_ticks > 0 && n_ >= p_.detect_early_ticks && n_ < window_len_ &&
       !acc.early_suspected && early_chi2(acc, static_cast<double>(n_)) > p_.detect_early_chi2) {
     acc.early_suspected = true;
     ++st_.suspicions;
@@ -478,7 +483,7 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   if (check_prev_ >= 0) acc.check_jet = check_prev_;
   check_prev_ = st_.check_jet;
   omega_prev_ = in.omega;
-  if (n_ >= p_.window_ticks) {
+  if (n_ >= window_len_) {
     close_window();
     start_window(in.omega);  // the window's last sample starts the next one
   }
@@ -572,6 +577,7 @@ void FaultDetector::accumulate(WindowSums& w, const FaultDetectorInput& in, cons
 void FaultDetector::start_window(const Vec3& omega) {
   have_start_ = true;
   n_ = 0;
+  window_len_ = p_.window_ticks;
   omega_start_ = omega;
   omega_prev_ = omega;
   predicted_.setZero();

@@ -70,6 +70,12 @@ struct FaultDetectorParams {
   // this many windows, its pod's valve is closed for probe_windows windows (0: never).
   int probe_after_windows{1};
   int probe_windows{3};
+  // (F46) With (F27): the window that an aligned isolation test starts is this many samples long
+  // (0: window_ticks; otherwise in [4, 1000]). With probe_windows 1 that window is the test. The
+  // pod's closure removes a stuck-on jet's whole torque, so the test needs as many samples as
+  // the weakest jet's torque needs to stand out of the gyro's noise, fewer than the bank's
+  // windows, which must also tell the jets apart by their signatures.
+  int probe_window_ticks{0};
   // (F27) The pod's closure (a test of F9, or a sweep's of F17) starts a new window, so the test's
   // first window is flown closed throughout (the decision comes kEvaluationSteps updates into the
   // window that follows the one it read: without this, that window is flown partly open and a
@@ -574,6 +580,7 @@ class FaultDetector {
   int probe_tested_pod_{-1};
   int probe_closed_{0};
   bool verdict_pending_{false};
+  int window_len_{5};  // (F46) the samples of the window under way (window_ticks or a test's)
   bool restart_window_{false};  // (F27) the next sample starts a new window
   double eval_open_fraction_{1.0};           // the evaluated window's open time of the tested pod
   std::array<double, kHypotheses> window_llr_{};  // the evaluated window's LLR per hypothesis

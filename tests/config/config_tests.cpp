@@ -366,47 +366,43 @@ TEST(ConfigShipped, EarlyDetectionIsReadAndOptional) {
 
 // (F30) The window sized by the case's gyro noise, against a brute-force count: for each case, the
 // weakest jet's acceleration from the table's model, column by column, and the slope statistic's
-// sum of squared sample times written out; the window is the first n from window_ticks whose
-// stuck-on ramp stands window_snr sigma above the gyro. gnc.yaml's value, and the former switch
-// when the key is absent.
+// sum of squared sample times written out; the window is the first n from `from` (below `to`)
+// whose stuck-on ramp stands snr sigma above the gyro, `to` when none does, `from` with a
+// noise-free gyro.
+int brute_force_window(const gnc::GncParams& p, const CaseConfig& cs, double snr, int from, int to) {
+  const double sigma = std::sqrt(cs.gyro_psd / 0.1);
+  if (!(sigma > 0.0)) return from;
+  const gnc::Mat3 j = gnc::total_inertia(p.mass_hat);
+  double a_min = 1e300;
+  for (int ch = 0; ch < gnc::kChannels; ++ch) {
+    const auto k = static_cast<std::size_t>(ch);
+    const gnc::Vec3 arm = p.mass_hat.r_so_bcm +
+                          p.rcs.pod_position[static_cast<std::size_t>(p.rcs.channel_pod[k])];
+    const gnc::Vec3 b = arm.cross(p.rcs.channel_direction[k]);
+    a_min = std::fmin(a_min, j.ldlt().solve(b).norm() * p.rcs.u_max);
+  }
+  for (int n = from; n < to; ++n) {
+    double mean = 0.0;
+    for (int t = 1; t <= n; ++t) mean += t;
+    mean /= n;
+    double stt = 0.0;
+    for (int t = 1; t <= n; ++t) stt += (t - mean) * (t - mean);
+    if (a_min * 0.1 * std::sqrt(stt) / sigma >= snr) return n;
+  }
+  return to;
+}
+
+// gnc.yaml's value, and the former switch when the key is absent.
 TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
   const std::string line = "  window_snr: 5.0";
   ASSERT_NE(read(kGnc).find(line), std::string::npos);
-  const double snr = 5.0;
   for (int c = 1; c <= 7; ++c) {
     const auto run = load_run(kMission, kGnc, case_file(c));
     const CaseConfig cs = load_case(case_file(c));
-    const gnc::GncParams& p = run.flight;
-    const double sigma = std::sqrt(cs.gyro_psd / 0.1);
-    int expect = 10;  // gnc.yaml's window_ticks (quiet sensors)
-    if (cs.gyro_psd > 0.0 || cs.star_psd > 0.0) {
-      const gnc::Mat3 j = gnc::total_inertia(p.mass_hat);
-      double a_min = 1e300;
-      for (int ch = 0; ch < gnc::kChannels; ++ch) {
-        const auto k = static_cast<std::size_t>(ch);
-        const gnc::Vec3 arm = p.mass_hat.r_so_bcm +
-                              p.rcs.pod_position[static_cast<std::size_t>(p.rcs.channel_pod[k])];
-        const gnc::Vec3 b = arm.cross(p.rcs.channel_direction[k]);
-        a_min = std::fmin(a_min, j.ldlt().solve(b).norm() * p.rcs.u_max);
-      }
-      expect = 25;  // window_noisy_ticks
-      for (int n = 10; n < 25; ++n) {
-        double mean = 0.0;
-        for (int t = 1; t <= n; ++t) mean += t;
-        mean /= n;
-        double stt = 0.0;
-        for (int t = 1; t <= n; ++t) stt += (t - mean) * (t - mean);
-        if (sigma > 0.0 && a_min * 0.1 * std::sqrt(stt) / sigma >= snr) {
-          expect = n;
-          break;
-        }
-        if (!(sigma > 0.0)) {
-          expect = 10;
-          break;
-        }
-      }
-    }
-    EXPECT_EQ(p.fdi.window_ticks, expect) << "case " << c;
+    const bool noisy = cs.gyro_psd > 0.0 || cs.star_psd > 0.0;
+    // gnc.yaml: window_ticks 10 (quiet sensors), window_noisy_ticks 25.
+    const int expect = noisy ? brute_force_window(run.flight, cs, 5.0, 10, 25) : 10;
+    EXPECT_EQ(run.flight.fdi.window_ticks, expect) << "case " << c;
   }
   // The study's noisy cases: case 5's gyro (3.2e-6 rad/s a sample) flies the quiet window, cases
   // 6-7 (3.2e-5) a long one.
@@ -415,6 +411,33 @@ TEST(ConfigShipped, TheNoisyWindowIsSizedByTheGyroNoise) {
   expect_optional_fdi_key(line, "window_snr", "  window_snr: -1", "", [](const std::string& gnc) {
     EXPECT_EQ(load_run(kMission, gnc, case_file(5)).flight.fdi.window_ticks, 25);
   });
+}
+
+// (F46) The isolation test's window: gnc.yaml's 5 samples with quiet sensors; with noisy ones the
+// same brute-force count from 5 up to the bank's window. Absent, 0 (the test flies a whole
+// window); a value below the evaluation's 4 steps names the file and key.
+TEST(ConfigShipped, TheIsolationTestsWindowIsSizedByTheGyroNoise) {
+  const std::string line = "  probe_window_ticks: 5";
+  ASSERT_NE(read(kGnc).find(line), std::string::npos);
+  for (int c = 1; c <= 7; ++c) {
+    const auto run = load_run(kMission, kGnc, case_file(c));
+    const CaseConfig cs = load_case(case_file(c));
+    const bool noisy = cs.gyro_psd > 0.0 || cs.star_psd > 0.0;
+    const int expect =
+        noisy ? brute_force_window(run.flight, cs, 5.0, 5, run.flight.fdi.window_ticks) : 5;
+    EXPECT_EQ(run.flight.fdi.probe_window_ticks, expect) << "case " << c;
+    EXPECT_LE(run.flight.fdi.probe_window_ticks, run.flight.fdi.window_ticks) << "case " << c;
+    std::printf("case %d: bank window %d, isolation test %d samples\n", c,
+                run.flight.fdi.window_ticks, run.flight.fdi.probe_window_ticks);
+  }
+  // Case 5 tests on a shorter window than its bank's 10 samples; cases 6-7 on about their bank's.
+  EXPECT_LT(load_run(kMission, kGnc, case_file(5)).flight.fdi.probe_window_ticks, 10);
+  EXPECT_GE(load_run(kMission, kGnc, case_file(7)).flight.fdi.probe_window_ticks, 20);
+  expect_optional_fdi_key(line, "probe_window_ticks", "  probe_window_ticks: 3",
+                          "must be 0 or in [4, 1000]", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.probe_window_ticks, 0);
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(6)).flight.fdi.probe_window_ticks, 0);
+                          });
 }
 
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
