@@ -314,30 +314,48 @@ struct OnsetLeaderRun {
   std::uint32_t probes{0};
 };
 
-OnsetLeaderRun fly_onset_leader(int jet, bool restart_leader, int onset = 509) {
-  Truth t;
-  t.gyro_sigma = 1e-7;
-  FaultDetectorParams p = bank_params(t.gyro_sigma);
+// The rig's detector: gnc.yaml's one-window aligned tests, read on their closed window, against
+// every jet's partial loss and naming another pod's jet; the episode restarts of (F25), (F38)
+// and (F41); the centred gyro noise.
+FaultDetectorParams onset_rig_params(double gyro_sigma) {
+  FaultDetectorParams p = bank_params(gyro_sigma);
   p.episode_restart = true;
   p.episode_restart_stale = true;
-  p.episode_restart_leader = restart_leader;
+  p.episode_restart_leader = true;
   p.probe_windows = 1;
   p.probe_aligned = true;
   p.probe_read_closed = true;
   p.probe_partial_rival = true;
   p.probe_read_elsewhere = true;
   p.centred_gyro_noise = true;
+  return p;
+}
+
+// `jet` stuck on at update `onset`, flown 200 updates on; the latency counts from onset.
+RunResult fly_onset_rig(const FaultDetectorParams& p, int jet, int onset,
+                        FaultDetectorStatus* status) {
+  Truth t;
+  t.gyro_sigma = p.gyro_sigma;
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
   FaultModel m = identified_model(t);
   m.r_cov = Mat3::Identity() * (0.03 * 0.03);
   m.k_sigma = 0.01;
   d.set_model(m);
+  RunResult r = fly_weak(t, d, onset + 200, onset, -1, 31, jet);
+  if (r.confirmed_at >= 0) r.confirmed_at -= onset;
+  *status = d.status();
+  return r;
+}
+
+OnsetLeaderRun fly_onset_leader(int jet, bool restart_leader, int onset = 509) {
+  FaultDetectorParams p = onset_rig_params(1e-7);
+  p.episode_restart_leader = restart_leader;
+  FaultDetectorStatus st;
   OnsetLeaderRun out;
-  out.r = fly_weak(t, d, onset + 200, onset, -1, 31, jet);
-  if (out.r.confirmed_at >= 0) out.r.confirmed_at -= onset;
-  out.restarts = d.status().episode_restarts;
-  out.probes = d.status().probes;
+  out.r = fly_onset_rig(p, jet, onset, &st);
+  out.restarts = st.episode_restarts;
+  out.probes = st.probes;
   return out;
 }
 
@@ -398,35 +416,18 @@ struct OnsetRestartRun {
 
 OnsetRestartRun fly_onset_restart(int jet, int onset, bool onset_restart,
                                   int probe_window_ticks = 0) {
-  Truth t;
-  t.gyro_sigma = 1e-7;
-  FaultDetectorParams p = bank_params(t.gyro_sigma);
-  p.episode_restart = true;
-  p.episode_restart_stale = true;
-  p.episode_restart_leader = true;
-  p.probe_windows = 1;
-  p.probe_aligned = true;
-  p.probe_read_closed = true;
-  p.probe_partial_rival = true;
-  p.probe_read_elsewhere = true;
-  p.centred_gyro_noise = true;
+  FaultDetectorParams p = onset_rig_params(1e-7);
   p.skip_onset_window = true;
   p.detect_early_ticks = 3;
   p.detect_early_chi2 = 35.41;
   p.onset_restart = onset_restart;
   p.probe_window_ticks = probe_window_ticks;
-  FaultDetector d;
-  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-  FaultModel m = identified_model(t);
-  m.r_cov = Mat3::Identity() * (0.03 * 0.03);
-  m.k_sigma = 0.01;
-  d.set_model(m);
+  FaultDetectorStatus st;
   OnsetRestartRun out;
-  out.r = fly_weak(t, d, onset + 200, onset, -1, 31, jet);
-  if (out.r.confirmed_at >= 0) out.r.confirmed_at -= onset;
-  out.onset_restarts = d.status().onset_restarts;
-  out.early = d.status().early_detections;
-  out.probes = d.status().probes;
+  out.r = fly_onset_rig(p, jet, onset, &st);
+  out.onset_restarts = st.onset_restarts;
+  out.early = st.early_detections;
+  out.probes = st.probes;
   return out;
 }
 
