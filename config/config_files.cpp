@@ -272,6 +272,9 @@ GncConfig load_gnc(const std::string& path) {
         r.fail("probe_window_ticks", "must be 0 or in [4, 1000]");
       }
     }
+    if (r.has("probe_short_min_llr")) {  // (F47)
+      fd.probe_short_min_llr = r.non_negative("probe_short_min_llr");
+    }
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
     if (r.has("identified_zero_chi2")) fd.identified_zero_chi2 = r.positive("identified_zero_chi2");

@@ -54,6 +54,9 @@ Check validate(const FaultDetectorParams& p) {
   if (p.probe_window_ticks != 0 && (p.probe_window_ticks < 4 || p.probe_window_ticks > 1000)) {
     return bad("fdi.probe_window_ticks", "must be 0 or in [4, 1000]");
   }
+  if (!(p.probe_short_min_llr >= 0.0) || !std::isfinite(p.probe_short_min_llr)) {
+    return bad("fdi.probe_short_min_llr", "must be finite and >= 0");
+  }
   if (!finite_positive(p.identified_zero_chi2)) {
     return bad("fdi.identified_zero_chi2", "must be positive");
   }
@@ -408,7 +411,9 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
     const bool test_start = restart_window_ && probe_left_ > 0 && !sweeping();
     restart_window_ = false;
     start_window(in.omega);
-    if (test_start && p_.probe_window_ticks > 0) window_len_ = p_.probe_window_ticks;
+    if (test_start && p_.probe_window_ticks > 0 && probe_short_) {
+      window_len_ = p_.probe_window_ticks;
+    }
     return pending_;
   }
   // (F2): the interval ending now, with the thrust commanded over it and the mid-interval rate.
@@ -1039,6 +1044,14 @@ void FaultDetector::decide() {
     end_probe_verdict();
     probe_tested_pod_ = pod;
     trigger_llr_ = window_llr_;  // (F32)
+    if (p_.probe_window_ticks > 0) {  // (F47)
+      const double ratio =
+          static_cast<double>(p_.probe_window_ticks) / static_cast<double>(p_.window_ticks);
+      probe_short_ = p_.probe_short_min_llr <= 0.0 ||
+                     window_llr_[static_cast<std::size_t>(best)] * ratio * ratio * ratio >=
+                         p_.probe_short_min_llr;
+      if (!probe_short_ && p_.probe_window_ticks != p_.window_ticks) ++st_.probe_whole_windows;
+    }
     trigger_energy_ = window_energy_;
     closed_llr_.fill(0.0);
     closed_energy_.fill(0.0);

@@ -76,6 +76,12 @@ struct FaultDetectorParams {
   // the weakest jet's torque needs to stand out of the gyro's noise, fewer than the bank's
   // windows, which must also tell the jets apart by their signatures.
   int probe_window_ticks{0};
+  // (F47) With (F46): a test flies the short window only when the window that started it
+  // showed its leader with at least this LLR, scaled to the short window by the cube of the
+  // lengths' ratio (a ramp's evidence, the weakest jet's, grows with the cube of its samples); a
+  // test started on weaker evidence (a model still far from the truth) flies a whole window.
+  // 0: every test short.
+  double probe_short_min_llr{0.0};
   // (F27) The pod's closure (a test of F9, or a sweep's of F17) starts a new window, so the test's
   // first window is flown closed throughout (the decision comes kEvaluationSteps updates into the
   // window that follows the one it read: without this, that window is flown partly open and a
@@ -301,6 +307,7 @@ struct FaultDetectorStatus {
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
   std::uint32_t onset_restarts{0};  // (F45) onset windows ended at their early suspicion
+  std::uint32_t probe_whole_windows{0};  // (F47) tests flown on a whole window, weak evidence
   std::uint32_t elsewhere_verdicts{0};  // (F40) tests whose closed windows named another pod's jet
 };
 
@@ -581,6 +588,7 @@ class FaultDetector {
   int probe_closed_{0};
   bool verdict_pending_{false};
   int window_len_{5};  // (F46) the samples of the window under way (window_ticks or a test's)
+  bool probe_short_{true};  // (F47) the test under way flies the short window (F46)
   bool restart_window_{false};  // (F27) the next sample starts a new window
   double eval_open_fraction_{1.0};           // the evaluated window's open time of the tested pod
   std::array<double, kHypotheses> window_llr_{};  // the evaluated window's LLR per hypothesis

@@ -440,6 +440,21 @@ TEST(ConfigShipped, TheIsolationTestsWindowIsSizedByTheGyroNoise) {
                           });
 }
 
+// (F47) The short test's evidence gate: gnc.yaml's 25 in every case, 0 (every test short) when the
+// key is absent, a negative one named by file and key.
+TEST(ConfigShipped, TheShortIsolationTestsEvidenceGateIsReadAndOptional) {
+  for (int c = 1; c <= 7; ++c) {
+    EXPECT_EQ(load_run(kMission, kGnc, case_file(c)).flight.fdi.probe_short_min_llr, 25.0)
+        << "case " << c;
+  }
+  expect_optional_fdi_key("  probe_short_min_llr: 25.0", "probe_short_min_llr",
+                          "  probe_short_min_llr: -1", "must not be negative",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.probe_short_min_llr,
+                                      0.0);
+                          });
+}
+
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
 // (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)

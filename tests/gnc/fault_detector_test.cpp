@@ -333,13 +333,15 @@ FaultDetectorParams onset_rig_params(double gyro_sigma) {
 
 // `jet` stuck on at update `onset`, flown 200 updates on; the latency counts from onset.
 RunResult fly_onset_rig(const FaultDetectorParams& p, int jet, int onset,
-                        FaultDetectorStatus* status) {
+                        FaultDetectorStatus* status, double r_sigma = 0.03,
+                        const Vec3& r_error = Vec3::Zero()) {
   Truth t;
   t.gyro_sigma = p.gyro_sigma;
   FaultDetector d;
   d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
   FaultModel m = identified_model(t);
-  m.r_cov = Mat3::Identity() * (0.03 * 0.03);
+  m.r_cov = Mat3::Identity() * (r_sigma * r_sigma);
+  m.r += r_error;
   m.k_sigma = 0.01;
   d.set_model(m);
   RunResult r = fly_weak(t, d, onset + 200, onset, -1, 31, jet);
@@ -412,22 +414,26 @@ struct OnsetRestartRun {
   std::uint32_t onset_restarts{0};
   std::uint32_t early{0};
   std::uint32_t probes{0};
+  std::uint32_t probe_whole{0};  // (F47) tests flown on a whole window
 };
 
 OnsetRestartRun fly_onset_restart(int jet, int onset, bool onset_restart,
-                                  int probe_window_ticks = 0) {
+                                  int probe_window_ticks = 0, double probe_short_min_llr = 0.0,
+                                  double r_sigma = 0.03, const Vec3& r_error = Vec3::Zero()) {
   FaultDetectorParams p = onset_rig_params(1e-7);
   p.skip_onset_window = true;
   p.detect_early_ticks = 3;
   p.detect_early_chi2 = 35.41;
   p.onset_restart = onset_restart;
   p.probe_window_ticks = probe_window_ticks;
+  p.probe_short_min_llr = probe_short_min_llr;
   FaultDetectorStatus st;
   OnsetRestartRun out;
-  out.r = fly_onset_rig(p, jet, onset, &st);
+  out.r = fly_onset_rig(p, jet, onset, &st, r_sigma, r_error);
   out.onset_restarts = st.onset_restarts;
   out.early = st.early_detections;
   out.probes = st.probes;
+  out.probe_whole = st.probe_whole_windows;
   return out;
 }
 
@@ -515,6 +521,82 @@ TEST(FaultDetector, AnIsolationTestOnAShortWindowNamesTheSameJet) {
   EXPECT_GT(tested, 40);  // the twin jets of other pods (F9): about half of the runs
   EXPECT_GT(sooner, later);
   EXPECT_LE(latency_short, latency_whole);
+}
+
+// (F47) The short test (F46) gated by the evidence of the window that started it, in the same rig:
+// a test whose leader showed less than the gate, scaled to 5 samples by the cube of the lengths'
+// ratio, flies the whole window. A run whose every test was short flies as with every test short,
+// a run whose every test was whole as with the whole window, tick for tick; a gate no evidence
+// reaches gives the whole window's flight in every run. A higher gate sends every run a lower one
+// sent to the whole window there too (one evidence per test, compared with the gate). The weaker
+// the model (the centre of mass 10 cm off, its 1 sigma 10 cm, as before identification), the
+// weaker the evidence that starts a test, and the more tests fly a whole window at gnc.yaml's 25.
+struct GateCount {
+  int tested{0}, gated{0}, sooner{0}, later{0};
+};
+
+GateCount fly_gated(double gate, double r_sigma, std::vector<bool>* gated_runs) {
+  GateCount c;
+  const Vec3 r_error = Vec3(0.6, -0.6, 0.4) * r_sigma;
+  for (int jet = 0; jet < 16; ++jet) {
+    for (int onset = 500; onset < 510; ++onset) {
+      const OnsetRestartRun whole = fly_onset_restart(jet, onset, true, 0, 0.0, r_sigma, r_error);
+      const OnsetRestartRun shortened = fly_onset_restart(jet, onset, true, 5, 0.0, r_sigma, r_error);
+      const OnsetRestartRun gated = fly_onset_restart(jet, onset, true, 5, gate, r_sigma, r_error);
+      const std::string what = "gate " + std::to_string(gate) + " jet " + std::to_string(jet) +
+                               " onset " + std::to_string(onset);
+      EXPECT_EQ(shortened.probe_whole, 0u) << what;  // no gate: every test short
+      EXPECT_LE(gated.probe_whole, gated.probes) << what;
+      if (gated.r.confirmed_at >= 0) {
+        EXPECT_EQ(gated.r.thruster, jet) << what;
+        EXPECT_EQ(gated.r.kind, FaultKind::kStuckOn) << what;
+      }
+      if (gated.probe_whole == 0) {
+        EXPECT_EQ(gated.r.confirmed_at, shortened.r.confirmed_at) << what;
+        EXPECT_EQ(gated.r.thruster, shortened.r.thruster) << what;
+      } else if (gated.probe_whole == gated.probes) {
+        EXPECT_EQ(gated.r.confirmed_at, whole.r.confirmed_at) << what;
+        EXPECT_EQ(gated.r.thruster, whole.r.thruster) << what;
+      }
+      if (gated_runs != nullptr) gated_runs->push_back(gated.probes > 0 && gated.probe_whole > 0);
+      if (gated.probes == 0) continue;
+      ++c.tested;
+      c.gated += gated.probe_whole == gated.probes ? 1 : 0;
+      c.sooner += gated.r.confirmed_at < whole.r.confirmed_at ? 1 : 0;
+      c.later += gated.r.confirmed_at > whole.r.confirmed_at ? 1 : 0;
+    }
+  }
+  std::printf("short tests gated at %g (model 1 sigma %.2f m): %d runs tested, %d on whole "
+              "windows, against the whole window %d sooner, %d later\n",
+              gate, r_sigma, c.tested, c.gated, c.sooner, c.later);
+  return c;
+}
+
+TEST(FaultDetector, AShortIsolationTestIsFlownOnlyOnStrongEvidence) {
+  std::vector<bool> at35, at50;
+  const GateCount none = fly_gated(0.0, 0.03, nullptr);
+  const GateCount low = fly_gated(35.0, 0.03, &at35);
+  const GateCount high = fly_gated(50.0, 0.03, &at50);
+  const GateCount never = fly_gated(1e12, 0.03, nullptr);
+  EXPECT_EQ(none.gated, 0);
+  EXPECT_EQ(never.gated, never.tested);  // every test whole: the whole window's flight
+  EXPECT_EQ(never.sooner + never.later, 0);
+  ASSERT_EQ(at35.size(), at50.size());
+  for (std::size_t i = 0; i < at35.size(); ++i) {
+    if (at35[i]) {
+      EXPECT_TRUE(at50[i]) << "run " << i;
+    }
+  }
+  EXPECT_GT(low.gated, 0);
+  EXPECT_GT(high.gated, low.gated);
+  EXPECT_LT(high.gated, high.tested);
+  // A gated test flies as without F46: fewer runs later than the whole window than with every
+  // test short.
+  EXPECT_LT(high.later, none.later);
+  // The weaker model: at gnc.yaml's gate some tests fly whole windows, none in the rig's model.
+  const GateCount coarse = fly_gated(25.0, 0.1, nullptr);
+  EXPECT_EQ(fly_gated(25.0, 0.03, nullptr).gated, 0);
+  EXPECT_GT(coarse.gated, 0);
 }
 
 // (F33) Early detection. Every jet stuck on at every phase of a 10-tick window, under HOLD's
