@@ -308,6 +308,7 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("check_model_null_space")) fd.check_model_null_space = r.boolean("check_model_null_space");  // (F42)
     if (r.has("survey_hold_only")) fd.survey_hold_only = r.boolean("survey_hold_only");  // (F43)
     if (r.has("survey_max_kick_rad_s")) fd.survey_max_kick_rad_s = r.non_negative("survey_max_kick_rad_s");  // (F44)
+    if (r.has("survey_noise_kick")) fd.survey_noise_kick = r.boolean("survey_noise_kick");  // (F48)
     if (r.has("episode_restart_leader")) fd.episode_restart_leader = r.boolean("episode_restart_leader");  // (F41)
     if (r.has("episode_restart_stale")) {  // (F38)
       fd.episode_restart_stale = r.boolean("episode_restart_stale");

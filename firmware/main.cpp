@@ -21,8 +21,8 @@
 //   degraded=N    thruster N delivers half of what is commanded from onset=T s: the partial-loss
 //                 confirmation (gnc/fdi/README.md F18) runs on the counted ticks; success then also
 //                 needs that thruster, and only it, confirmed degraded
-//   survey=S      with modules=all: the jet survey (gnc/fdi/README.md F36; an option, off in
-//                 gnc.yaml) every S s, so that its checks run on the counted ticks (in HOLD
+//   survey=S      with modules=all: the jet survey (gnc/fdi/README.md F36) every S s (default
+//                 20000, gnc.yaml's; 0 off), so that its checks run on the counted ticks (in HOLD
 //                 only, F43; inside the budget: DEVELOPERS.md)
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
@@ -65,7 +65,7 @@ struct Options {
   int degraded{-1};             // thruster at half strength (-1: none)
   bool pinv{false};             // modules=all with the pseudoinverse allocator
   std::uint32_t onset_s{1000};  // ... from this simulated time
-  std::uint32_t survey_s{0};    // (F36) jet survey interval, 0 off
+  std::uint32_t survey_s{20000};  // (F36) jet survey interval, 0 off (gnc.yaml's 20 000 s)
 };
 
 // Parses "key=value" tokens of the semihosting command line (unknown tokens are ignored).
@@ -217,7 +217,7 @@ int firmware_main() {
     g_params.fdi.check_blocker = true;           // (F37) the jet blocking a stuck-off leader checked
     g_params.fdi.episode_restart_stale = true;   // (F38) a stale episode restarted
     g_params.fdi.episode_restart_leader = true;  // (F41) ... and one a new leader's fault postdates
-    g_params.fdi.survey_interval_s = static_cast<double>(opt.survey_s);  // (F36) 0: off, as flown
+    g_params.fdi.survey_interval_s = static_cast<double>(opt.survey_s);  // (F36) as flown: 20 000 s
     g_params.fdi.model_rel_floor = 0.005;      // the model's relative error floor, as flown
     g_params.fdi.model_floor_gyroscopic = true;   // (F22) ... on both terms, as flown
     g_params.fdi.probe_windows = 1;            // isolation tests of one window ...
@@ -228,6 +228,7 @@ int firmware_main() {
     g_params.fdi.check_model_null_space = true;  // (F42) checks in the identified model's null space
     g_params.fdi.survey_hold_only = true;  // (F43) the survey in HOLD only
     g_params.fdi.survey_max_kick_rad_s = 5.0e-5;  // (F44) ... and no survey check that may kick the rate
+    g_params.fdi.survey_noise_kick = true;  // (F48) ... nor where the gyro is too noisy for one
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown

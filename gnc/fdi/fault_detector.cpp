@@ -122,6 +122,12 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
   }
   st_ = FaultDetectorStatus{};
   factor_.fill(1.0);
+  // (F48) The least kick by which one window shows a total loss at survey_energy (F6's ramp
+  // energy over n samples, the gyro's noise sigma_g).
+  const double nw = static_cast<double>(p_.window_ticks);
+  survey_noisy_ = p_.survey_noise_kick && p_.survey_max_kick_rad_s > 0.0 &&
+                  nw * p_.gyro_sigma * std::sqrt(12.0 * p_.survey_energy / (nw * (nw * nw - 1.0))) >
+                      p_.survey_max_kick_rad_s;
   reset_scores();
   // Before set_model: nothing suspected, the model is taken (F7).
   suspecting_ = false;
@@ -1730,6 +1736,8 @@ int FaultDetector::survey_candidate(int& windows) {
   }
   if (jet < 0) return -1;
   ++st_.survey_ratings;
+  const bool noisy = survey_noisy_;  // (F48)
+  if (noisy) ++st_.survey_noise_refusals;
   double kick_rate = 0.0;
   const double e = signature_rel_error(jet) > p_.check_max_model_error
                        ? 0.0
@@ -1742,7 +1750,7 @@ int FaultDetector::survey_candidate(int& windows) {
   const bool kicks = p_.survey_max_kick_rad_s > 0.0 &&
                      3.0 * kick_rate * static_cast<double>(n) * window_s > p_.survey_max_kick_rad_s;
   if (kicks) ++st_.survey_kick_refusals;
-  if (!(e > 0.0) || kicks ||
+  if (!(e > 0.0) || kicks || noisy ||
       (p_.check_min_llr > 0.0 && 0.5 * e * static_cast<double>(n) < p_.check_min_llr)) {
     // Not checkable now: due again one check interval from now.
     const auto retry = std::min(

@@ -218,6 +218,14 @@ struct FaultDetectorParams {
   // the check's length. After a confirmed fault the identifier restarts from its prior (I27 off)
   // and a survey check against that model kicks the rate out of the SPEC §7 bound in HOLD.
   double survey_max_kick_rad_s{0.0};
+  // (F48) With (F44): no survey check where the gyro is too noisy for any check to show a jet's
+  // loss within that bound. A check verifies a jet when a total loss would have given it
+  // survey_energy (F36); over one window of n samples (the most a window can hold) the least
+  // kick that does so is K = n sigma_g sqrt(12 E / (n (n^2 - 1))) (F6's ramp energy, sigma_g the
+  // gyro's noise). Above survey_max_kick_rad_s a check of a failed jet kicks the rate past the
+  // bound before it is confirmed, and a half-strength jet, not confirmed by one check, at every
+  // survey interval. false: the survey checks whatever the gyro's noise.
+  bool survey_noise_kick{false};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -304,6 +312,7 @@ struct FaultDetectorStatus {
   std::uint32_t surveys{0};                   // (F36) of the checks, those started by the survey
   std::uint32_t survey_ratings{0};  // (F36) due jets rated against the check gates (<= 1 a decision)
   std::uint32_t survey_kick_refusals{0};  // (F44) due jets not surveyed: the check would kick the rate
+  std::uint32_t survey_noise_refusals{0};  // (F48) due jets not surveyed: the gyro too noisy
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
   std::uint32_t onset_restarts{0};  // (F45) onset windows ended at their early suspicion
@@ -455,6 +464,7 @@ class FaultDetector {
   std::array<std::uint8_t, kThrusters> check_backoff_{};  // doublings of each jet's interval (0..2)
   std::array<double, kThrusters> survey_e_{};  // (F36) stuck-off energy since last verified
   bool survey_allowed_{true};  // (F43) this update's FaultDetectorInput::survey_allowed
+  bool survey_noisy_{false};  // (F48) the gyro too noisy for a survey check within its kick bound
   std::array<std::uint32_t, kThrusters> survey_from_{};  // (F36) window count when last verified
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window

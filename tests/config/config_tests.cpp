@@ -312,13 +312,15 @@ TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
                           });
 }
 
-// (F36) The jet survey: off (0) in gnc.yaml and when the key is absent; its energy and its
-// longest check read (the struct's values when absent); bad values named by file and key.
-TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOffInGncYaml) {
-  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.survey_interval_s, 0.0);
+// (F36) The jet survey: every 20 000 s in gnc.yaml (F48), off (0) when the key is absent; its
+// energy and its longest check read (the struct's values when absent); bad values named by file
+// and key.
+TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOnInGncYaml) {
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.survey_interval_s, 20000.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(7)).flight.fdi.survey_interval_s, 20000.0);
   EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.survey_energy, 10.0);
   EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.survey_max_windows, 8);
-  expect_optional_fdi_key("  survey_interval_s: 0.0", "survey_interval_s",
+  expect_optional_fdi_key("  survey_interval_s: 20000.0", "survey_interval_s",
                           "  survey_interval_s: -5", "", [](const std::string& gnc) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_interval_s,
                                       0.0);
@@ -331,8 +333,8 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOffInGncYaml) {
                                 load_run(kMission, gnc, case_file(1)).flight.fdi.survey_max_kick_rad_s,
                                 0.0);
                           });
-  TempFile on("gnc.yaml", replaced(read(kGnc), "  survey_interval_s: 0.0", "  survey_interval_s: 20000"));
-  EXPECT_EQ(load_run(kMission, on.path(), case_file(1)).flight.fdi.survey_interval_s, 20000.0);
+  TempFile other("gnc.yaml", replaced(read(kGnc), "  survey_interval_s: 20000.0", "  survey_interval_s: 300"));
+  EXPECT_EQ(load_run(kMission, other.path(), case_file(1)).flight.fdi.survey_interval_s, 300.0);
   expect_optional_fdi_key("  survey_energy: 10.0", "survey_energy", "  survey_energy: 0", "",
                           [](const std::string& gnc) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_energy,
@@ -460,7 +462,8 @@ TEST(ConfigShipped, TheShortIsolationTestsEvidenceGateIsReadAndOptional) {
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)
 // another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader,
 // (F21) the onset window not scored, (F45) ended at its early suspicion, (F42) checks in the
-// identified model's null space and (F43) the survey in HOLD only:
+// identified model's null space, (F43) the survey in HOLD only and (F48) not where the gyro is
+// too noisy:
 // gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is not a
 // boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
@@ -468,7 +471,8 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
                           "probe_read_closed", "check_quiet_start", "check_score_unfit",
                           "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
                           "episode_restart_leader", "skip_onset_window",
-                          "check_model_null_space", "survey_hold_only", "onset_restart"}) {
+                          "check_model_null_space", "survey_hold_only", "onset_restart",
+                          "survey_noise_kick"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -485,6 +489,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "episode_restart_leader" ? f.episode_restart_leader
              : k == "skip_onset_window"     ? f.skip_onset_window
              : k == "onset_restart"         ? f.onset_restart
+             : k == "survey_noise_kick"     ? f.survey_noise_kick
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;

@@ -2077,6 +2077,49 @@ TEST(FaultDetector, ASurveyCheckThatMayKickTheRateBeyondItsBoundIsNotFlown) {
   }
 }
 
+// (F48) No survey check where the gyro is too noisy for one window to show a dead jet within the
+// kick bound. The least kick K that gives a total loss survey_energy over one window is found here
+// by summing the mean-centred ramp sample by sample (the rate K j / n at sample j), and the
+// gyro's noise sigma* at which K reaches the bound: just below it the due jets are surveyed as
+// without the gate, just above it none is and each refusal is counted; with the gate off the
+// noisier rig surveys them too. Nothing is confirmed in any run.
+TEST(FaultDetector, NoSurveyCheckWhereTheGyroIsTooNoisyToSeeALossWithinTheKickBound) {
+  constexpr double kBound = 1e-5;
+  constexpr double kEnergy = 10.0;
+  const int n = bank_params(1e-6).window_ticks;
+  double centred = 0.0;  // sum over the window of (j / n - mean)^2
+  for (int j = 0; j < n; ++j) {
+    const double mean = 0.5 * (n - 1) / n;
+    centred += (static_cast<double>(j) / n - mean) * (static_cast<double>(j) / n - mean);
+  }
+  // E = K^2 centred / sigma^2 = kEnergy at K = kBound:
+  const double sigma_star = kBound * std::sqrt(centred / kEnergy);
+  for (const double scale : {0.9, 1.1}) {
+    for (const bool gate : {true, false}) {
+      Truth t;
+      t.gyro_sigma = scale * sigma_star;
+      FaultDetectorParams p = survey_params(t, 300.0);
+      p.survey_max_kick_rad_s = kBound;
+      p.survey_energy = kEnergy;
+      p.survey_noise_kick = gate;
+      FaultDetector d = make_detector(t, p);
+      const SurveyRun run = fly_hold(t, d, 12000, -1, -1, 21);
+      const std::string what = "gyro " + std::to_string(scale) + " sigma*, gate " +
+                               std::to_string(gate) + ", surveys " +
+                               std::to_string(d.status().surveys) + ", F44 refusals " +
+                               std::to_string(d.status().survey_kick_refusals);
+      EXPECT_LT(run.r.confirmed_at, 0) << what;
+      if (gate && scale > 1.0) {
+        EXPECT_EQ(d.status().surveys, 0u) << what;
+        EXPECT_GT(d.status().survey_noise_refusals, 0u) << what;
+      } else {
+        EXPECT_GE(d.status().surveys, 5u) << what;
+        EXPECT_EQ(d.status().survey_noise_refusals, 0u) << what;
+      }
+    }
+  }
+}
+
 TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNothingWhenHealthy) {
   for (std::uint64_t seed : {21u, 22u}) {
     Truth t;
