@@ -190,6 +190,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.probe_read_closed = true;             // (F32) ... and first on the closed window
   p.fdi.probe_read_elsewhere = true;          // (F40) ... which may name another pod's jet
   p.fdi.check_model_null_space = true;        // (F42) checks in the identified model's null space
+  p.fdi.survey_interval_s = fdi ? 20000.0 : 0.0;  // (F36) the survey as flown: its bookkeeping
   p.fdi.survey_hold_only = true;              // (F43) the survey in HOLD only
   p.fdi.survey_max_kick_rad_s = 5.0e-5;       // (F44) ... and no survey check that may kick the rate
   p.fdi.survey_noise_kick = true;             // (F48) ... nor where the gyro is too noisy for one
