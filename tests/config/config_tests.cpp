@@ -442,14 +442,14 @@ TEST(ConfigShipped, TheIsolationTestsWindowIsSizedByTheGyroNoise) {
                           });
 }
 
-// (F47) The short test's evidence gate: gnc.yaml's 25 in every case, 0 (every test short) when the
+// (F47) The short test's evidence gate: gnc.yaml's 10 in every case, 0 (every test short) when the
 // key is absent, a negative one named by file and key.
 TEST(ConfigShipped, TheShortIsolationTestsEvidenceGateIsReadAndOptional) {
   for (int c = 1; c <= 7; ++c) {
-    EXPECT_EQ(load_run(kMission, kGnc, case_file(c)).flight.fdi.probe_short_min_llr, 25.0)
+    EXPECT_EQ(load_run(kMission, kGnc, case_file(c)).flight.fdi.probe_short_min_llr, 10.0)
         << "case " << c;
   }
-  expect_optional_fdi_key("  probe_short_min_llr: 25.0", "probe_short_min_llr",
+  expect_optional_fdi_key("  probe_short_min_llr: 10.0", "probe_short_min_llr",
                           "  probe_short_min_llr: -1", "must not be negative",
                           [](const std::string& gnc) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.probe_short_min_llr,

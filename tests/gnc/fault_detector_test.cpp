@@ -529,8 +529,8 @@ TEST(FaultDetector, AnIsolationTestOnAShortWindowNamesTheSameJet) {
 // a run whose every test was whole as with the whole window, tick for tick; a gate no evidence
 // reaches gives the whole window's flight in every run. A higher gate sends every run a lower one
 // sent to the whole window there too (one evidence per test, compared with the gate). The weaker
-// the model (the centre of mass 10 cm off, its 1 sigma 10 cm, as before identification), the
-// weaker the evidence that starts a test, and the more tests fly a whole window at gnc.yaml's 25.
+// the model (the centre of mass 30 cm off, its 1 sigma 30 cm, as before identification), the
+// weaker the evidence that starts a test, and the more tests fly a whole window at gnc.yaml's 10.
 struct GateCount {
   int tested{0}, gated{0}, sooner{0}, later{0};
 };
@@ -594,8 +594,8 @@ TEST(FaultDetector, AShortIsolationTestIsFlownOnlyOnStrongEvidence) {
   // test short.
   EXPECT_LT(high.later, none.later);
   // The weaker model: at gnc.yaml's gate some tests fly whole windows, none in the rig's model.
-  const GateCount coarse = fly_gated(25.0, 0.1, nullptr);
-  EXPECT_EQ(fly_gated(25.0, 0.03, nullptr).gated, 0);
+  const GateCount coarse = fly_gated(10.0, 0.3, nullptr);
+  EXPECT_EQ(fly_gated(10.0, 0.03, nullptr).gated, 0);
   EXPECT_GT(coarse.gated, 0);
 }
 
