@@ -227,6 +227,12 @@ GncConfig load_gnc(const std::string& path) {
       xc.r_sigma_stop_m = x.positive("r_sigma_stop_m");
       if (x.has("start_after_s")) xc.start_after_s = x.non_negative("start_after_s");
       if (x.has("r_sigma_target_m")) xc.r_sigma_target_m = x.non_negative("r_sigma_target_m");
+      if (x.has("inertia_torque_nm")) {  // (X8), optional: no inertia phase when absent
+        xc.inertia_torque_nm = x.vec3("inertia_torque_nm");
+        if (!(xc.inertia_torque_nm.minCoeff() >= 0.0)) {
+          x.fail("inertia_torque_nm", "every amplitude must be >= 0");
+        }
+      }
       x.finish();
     }
     r.finish();

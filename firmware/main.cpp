@@ -245,6 +245,7 @@ int firmware_main() {
       g_params.identification.excitation.r_sigma_stop_m = 0.005;
       g_params.identification.excitation.start_after_s = 60.0;
       g_params.identification.excitation.r_sigma_target_m = 0.01;  // (X7)
+      g_params.identification.excitation.inertia_torque_nm = gnc::Vec3(100.0, 100.0, 100.0);  // (X8)
     }
   }
   const gnc::ParamCheck check = g_gnc.init(g_params);

@@ -692,8 +692,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
   }
-  // 5b. Identification excitation (gnc/estimation/README.md §I.6, X1-X6): a net force in the
-  // null space of B_hat, added within the channels' box, while r is not yet known. Healthy RCS
+  // 5b. Identification excitation (gnc/estimation/README.md §I.6, X1-X8): first the inertia
+  // phase (X8: the net force nulled, a couple added), then a net force in the null space of
+  // B_hat, added within the channels' box, while r is not yet known. Healthy RCS
   // only (no latched fault, no closed valve, no suspicion); the torque on the model is unchanged.
   excite_status_ = ExcitationStatus{};
   if (excitation_on()) {
@@ -705,7 +706,12 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       const IdentifierEstimate& e = ident_.estimate();
       const double identified_s =
           static_cast<double>(ident_.counters().windows) * params_.identification.config.window_s;
-      if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable,
+      if (healthy && excite_.inertia_wanted(identified_s)) {
+        // (X8) Before start_after_s: the allocation made force-free (r_hat still unknown) and a
+        // couple added, one axis per window.
+        excite_status_ = excite_.apply_inertia(excite_.inertia_torque(ident_.counters().windows),
+                                               lim.lo, lim.hi, params_.dt, u);
+      } else if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable,
                                     identified_s)) {
         // (X7) The amplitude for this window's noise (fixed within a window: the noise is the
         // last closed window's).
@@ -842,6 +848,8 @@ void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
   e.excitation_active = excite_status_.active;
   e.excitation_force = excite_status_.force;
   e.excitation_gamma = excite_status_.gamma;
+  e.excitation_inertia = excite_status_.inertia;
+  e.excitation_torque = excite_status_.torque;
   e.candidate = candidate_status_;
 }
 

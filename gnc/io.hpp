@@ -178,6 +178,8 @@ struct EstimationTelemetry {
   bool excitation_active{false};        // (X1-X6) the identification excitation flew this tick
   Vec3 excitation_force{Vec3::Zero()};  // N, the net force it asked for (F_B), before gamma
   double excitation_gamma{0.0};         // the fraction of it that fitted the channels' box (X5)
+  bool excitation_inertia{false};       // (X8) the inertia phase: the net force nulled, a couple added
+  Vec3 excitation_torque{Vec3::Zero()}; // N m, (X8) the couple it asked for (F_B), before gamma
   ModelCandidate candidate{ModelCandidate::kDisabled};
   std::uint32_t adoptions{0};           // identified models adopted into the active table
 };

@@ -132,6 +132,8 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   m.id_excitation_active = e.excitation_active ? 1 : 0;
   put(e.excitation_force, m.id_excitation_force);
   m.id_excitation_gamma = e.excitation_gamma;
+  m.id_excitation_inertia = e.excitation_inertia ? 1 : 0;
+  put(e.excitation_torque, m.id_excitation_torque);
   m.id_candidate = static_cast<std::int8_t>(e.candidate);
   m.model_adoptions = e.adoptions;
   const gnc::FdiTelemetry& f = g.fdi;

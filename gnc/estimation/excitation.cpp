@@ -29,6 +29,9 @@ ExcitationConfigCheck validate(const ExcitationConfig& c) {
   if (!(std::isfinite(c.r_sigma_target_m) && c.r_sigma_target_m >= 0.0)) {
     return {false, "identification.excitation.r_sigma_target_m", "must be >= 0 and finite"};
   }
+  if (!(c.inertia_torque_nm.allFinite() && c.inertia_torque_nm.minCoeff() >= 0.0)) {
+    return {false, "identification.excitation.inertia_torque_nm", "must be finite and >= 0"};
+  }
   return {};
 }
 
@@ -41,6 +44,15 @@ void IdentificationExcitation::configure(const ExcitationConfig& c) {
       directions_[n_directions_] = Vec3::Zero();
       directions_[n_directions_](axis) = sign * c.force_n(axis);
       ++n_directions_;
+    }
+  }
+  n_couples_ = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(c.inertia_torque_nm(axis) > 0.0)) continue;
+    for (const double sign : {1.0, -1.0}) {
+      couples_[n_couples_] = Vec3::Zero();
+      couples_[n_couples_](axis) = sign * c.inertia_torque_nm(axis);
+      ++n_couples_;
     }
   }
   // (X7) Every component of r is seen from the forces normal to it: r_a from the other axes'.
@@ -90,8 +102,9 @@ void IdentificationExcitation::step_model() {
       g_inv_ = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
       break;
     }
-    case 2:  // N = M' G^-1 [0; I3]   (X2), and H = G^-1 M for the projector
+    case 2:  // N = M' G^-1 [0; I3]   (X2), C = M' G^-1 [I3; 0] (X8), and H = G^-1 M for the projector
       n_ = m_.transpose() * g_inv_.rightCols<3>();
+      c_ = m_.transpose() * g_inv_.leftCols<3>();
       h_ = g_inv_ * m_;
       break;
     case 3:  // the projector on the kernel of M: P = I - M' G^-1 M
@@ -121,12 +134,15 @@ void IdentificationExcitation::step_model() {
       }
       break;
     }
-    case 5:  // checks: B_hat N = 0, E N = I, M Z = 0 (to rounding)
+    case 5:  // checks: B_hat N = 0, E N = I, B_hat C = I, E C = 0, M Z = 0 (to rounding)
       if (valid_) {
         const double scale = std::max(1.0, m_.cwiseAbs().maxCoeff());
         Eigen::Matrix<double, 6, 3> target = Eigen::Matrix<double, 6, 3>::Zero();
         target.bottomRows<3>().setIdentity();
+        Eigen::Matrix<double, 6, 3> target_c = Eigen::Matrix<double, 6, 3>::Zero();
+        target_c.topRows<3>().setIdentity();
         valid_ = (m_ * n_ - target).cwiseAbs().maxCoeff() < 1e-9 * scale * (1.0 + n_.cwiseAbs().maxCoeff()) &&
+                 (m_ * c_ - target_c).cwiseAbs().maxCoeff() < 1e-9 * scale * (1.0 + c_.cwiseAbs().maxCoeff()) &&
                  (m_ * z_).cwiseAbs().maxCoeff() < 1e-9 * scale;
       }
       break;
@@ -148,6 +164,15 @@ Vec3 IdentificationExcitation::force(std::uint32_t window_index) const {
   return scale_ * directions_[window_index % static_cast<std::uint32_t>(n_directions_)];
 }
 
+bool IdentificationExcitation::inertia_wanted(double identified_s) const {
+  return config_.enabled && ready() && n_couples_ > 0 && identified_s < config_.start_after_s;
+}
+
+Vec3 IdentificationExcitation::inertia_torque(std::uint32_t window_index) const {
+  if (n_couples_ == 0) return Vec3::Zero();
+  return couples_[window_index % static_cast<std::uint32_t>(n_couples_)];  // (X8)
+}
+
 ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, const Vec8& hi,
                                                  double dt, Vec8& u) {
   ExcitationStatus s;
@@ -155,9 +180,28 @@ ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, 
   if (!ready()) return s;
   s.active = true;
   elapsed_ += dt;
-  Vec8 du = n_ * f;  // (X2), z = 0
+  fit(n_ * f, lo, hi, u, s);  // (X2), z = 0
+  return s;
+}
+
+ExcitationStatus IdentificationExcitation::apply_inertia(const Vec3& tau, const Vec8& lo,
+                                                         const Vec8& hi, double dt, Vec8& u) {
+  ExcitationStatus s;
+  s.inertia = true;
+  s.torque = tau;
+  if (!ready()) return s;
+  s.active = true;
+  inertia_elapsed_ += dt;
+  s.force = m_.bottomRows<3>() * u;  // E u, the allocation's net force
+  fit(c_ * tau - n_ * s.force, lo, hi, u, s);  // (X8)
+  return s;
+}
+
+void IdentificationExcitation::fit(Vec8 du, const Vec8& lo, const Vec8& hi, Vec8& u,
+                                   ExcitationStatus& s) const {
   // (X4) A channel already at its bound that du would push further leaves the excitation: the
   // kernel Z moves the null-space force off it (up to two such channels; more leave it to gamma).
+  // Z is in the kernel of [B_hat; E], so neither the torque nor the force of du changes.
   int blocked[2] = {-1, -1};
   int nb = 0;
   for (int i = 0; i < kChannels && nb < 2; ++i) {
@@ -198,7 +242,6 @@ ExcitationStatus IdentificationExcitation::apply(const Vec3& f, const Vec8& lo, 
   gamma = std::max(0.0, gamma);
   for (int i = 0; i < kChannels; ++i) u(i) = std::min(hi(i), std::max(lo(i), u(i) + gamma * du(i)));
   s.gamma = gamma;
-  return s;
 }
 
 }  // namespace rocksteady::gnc

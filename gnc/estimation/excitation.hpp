@@ -17,7 +17,17 @@
 // (X7) With r_sigma_target_m > 0 the amplitudes are scaled per window to what (X6) needs for that
 // 1 sigma of r given the identifier's window noise: quiet gyros fly a tenth of noisy ones' force.
 //
-// N and Z depend only on B_hat and E: they are computed once per model change, spread over
+// (X8) The inertia phase, before start_after_s of identification: r_hat is still up to 1 m off, so
+// any net force turns into a torque (r - r_hat) x F that the first windows would fit into J. The
+// allocated forces are made force-free instead, and a pure couple is added:
+//   Delta u = C tau - N (E u),   [B_hat; E] C = [I3; 0]                       (X8)
+// so E (u + Delta u) = 0 and B_hat (u + Delta u) = B_hat u + tau on the model. With the
+// pseudoinverse's u (in the row space of B_hat) u + Delta u is the minimum-norm force-free
+// allocation of the law's torque plus tau. tau cycles +x, -x, +y, -y, +z, -z (F_B), one per window,
+// at inertia_torque_nm per axis: the law's own torque lies along -omega, and a torque along other
+// axes is what shows J's columns in two windows instead of six.
+//
+// N, C and Z depend only on B_hat and E: they are computed once per model change, spread over
 // kModelStages ticks (set_model, then step_model once a tick); the excitation stays off until
 // they are ready. Per tick: 24 multiply-adds for N F, a scan of the eight channels and eight
 // divisions for gamma (a 2x2 solve more when the allocation saturates).
@@ -48,6 +58,10 @@ struct ExcitationConfig {
   // given the identifier's window noise (at most 1): quiet sensors need a fraction of the force
   // that noisy ones do (README §I.6).
   double r_sigma_target_m{0.0};
+  // (X8) The inertia phase before start_after_s: the allocation made force-free, plus a couple of
+  // this amplitude per body axis (N m), cycled +x, -x, +y, -y, +z, -z one per window (an axis at
+  // 0 is left out of the cycle). 0 on every axis: no inertia phase.
+  Vec3 inertia_torque_nm{Vec3::Zero()};
 };
 
 struct ExcitationConfigCheck {
@@ -60,7 +74,9 @@ ExcitationConfigCheck validate(const ExcitationConfig& c);
 // What one tick's excitation did.
 struct ExcitationStatus {
   bool active{false};          // the excitation was asked for this tick
-  Vec3 force{Vec3::Zero()};    // net force asked, N (F_B)
+  bool inertia{false};         // (X8) the inertia phase: force nulled, a couple added
+  Vec3 force{Vec3::Zero()};    // net force asked, N (F_B); in the inertia phase the one nulled
+  Vec3 torque{Vec3::Zero()};   // (X8) couple asked, N m (F_B), before gamma
   double gamma{0.0};           // the fraction that fitted the channels' box (X5)
   std::uint8_t blocked{0};     // channels removed from the excitation at their bound (X4)
 };
@@ -98,6 +114,16 @@ class IdentificationExcitation {
   // B_hat multiplies) within lo <= u <= hi (X4, X5), and counts dt of excitation time. Returns
   // what was done; u is unchanged when !ready().
   ExcitationStatus apply(const Vec3& f, const Vec8& lo, const Vec8& hi, double dt, Vec8& u);
+  // (X8) Whether the inertia phase should run: enabled, model ready, a couple configured, and
+  // less than start_after_s of identification done (identified_s).
+  bool inertia_wanted(double identified_s) const;
+  // The couple of window `window_index` (X8): +x, -x, +y, -y, +z, -z at inertia_torque_nm.
+  Vec3 inertia_torque(std::uint32_t window_index) const;
+  // (X8) Nulls the net force of the allocated channel forces u and adds the couple tau, within
+  // lo <= u <= hi (X4, X5 as for apply), and counts dt of inertia-phase time. u is unchanged when
+  // !ready().
+  ExcitationStatus apply_inertia(const Vec3& tau, const Vec8& lo, const Vec8& hi, double dt, Vec8& u);
+  double inertia_elapsed() const { return inertia_elapsed_; }
   // Seconds of excitation spent so far.
   double elapsed() const { return elapsed_; }
   // Back to no excitation spent (a declared change: r must be learned again).
@@ -105,6 +131,7 @@ class IdentificationExcitation {
 
   const Mat83& force_map() const { return n_; }  // N of (X2)
   const Mat82& kernel() const { return z_; }     // Z of (X2)
+  const Mat83& couple_map() const { return c_; } // C of (X8)
 
  private:
   ExcitationConfig config_{};
@@ -115,9 +142,15 @@ class IdentificationExcitation {
   Eigen::Matrix<double, kChannels, kChannels> p_{
       Eigen::Matrix<double, kChannels, kChannels>::Zero()};  // I - M'(MM')^-1 M
   Mat83 n_{Mat83::Zero()};
+  Mat83 c_{Mat83::Zero()};
   Mat82 z_{Mat82::Zero()};
   Vec3 directions_[kDirections]{};
   int n_directions_{0};
+  Vec3 couples_[kDirections]{};  // (X8)
+  int n_couples_{0};
+  double inertia_elapsed_{0.0};
+  // (X4, X5) fits du into the channels' box and adds it to u; fills blocked and gamma.
+  void fit(Vec8 du, const Vec8& lo, const Vec8& hi, Vec8& u, ExcitationStatus& s) const;
   double min_pair_{0.0};  // min over the cycle's axes a of sum_{b != a} f_b^2 (X7), N^2
   double scale_{1.0};     // (X7)
   int stage_{kModelStages};

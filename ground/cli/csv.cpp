@@ -91,7 +91,7 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_I(id_excited_thrusters); RS_I(id_offset_unobservable); RS_A(id_residual_torque);
   RS_D(id_residual_chi2); RS_I(id_windows); RS_A(id_rate_bias_sigma); RS_I(id_windows_gated);
   RS_I(id_gate_reinflations); RS_I(id_guard_refusals);
-  RS_I(id_excitation_active); RS_A(id_excitation_force); RS_D(id_excitation_gamma); RS_I(id_candidate); RS_I(model_adoptions);
+  RS_I(id_excitation_active); RS_A(id_excitation_force); RS_D(id_excitation_gamma); RS_I(id_excitation_inertia); RS_A(id_excitation_torque); RS_I(id_candidate); RS_I(model_adoptions);
   RS_I(fdi_enabled); RS_A(fdi_residual); RS_D(fdi_chi2); RS_D(fdi_noise_sigma); RS_I(fdi_best);
   RS_D(fdi_best_llr); RS_D(fdi_runner_up_llr); RS_I(fdi_suspected_on); RS_I(fdi_suspected_off);
   RS_I(fdi_confirmed_on); RS_I(fdi_confirmed_off);

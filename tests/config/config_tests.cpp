@@ -302,6 +302,27 @@ void expect_optional_fdi_key(const std::string& line, const std::string& key,
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "fdi." + key, reason);
 }
 
+// (X8) The excitation's inertia phase: gnc.yaml's 100 N m per axis, no inertia phase when the key
+// is absent, and a negative amplitude names the file and key.
+TEST(ConfigShipped, TheExcitationsInertiaPhaseIsReadAndOptional) {
+  const std::string line = "    inertia_torque_nm: [100.0, 100.0, 100.0]";
+  const std::string text = read(kGnc);
+  ASSERT_NE(text.find(line), std::string::npos);
+  for (int c : {1, 4, 7}) {
+    EXPECT_EQ(load_run(kMission, kGnc, case_file(c)).flight.identification.excitation.inertia_torque_nm,
+              gnc::Vec3(100.0, 100.0, 100.0))
+        << "case " << c;
+  }
+  const std::size_t eol = text.find('\n', text.find(line));
+  const std::string whole = text.substr(text.find(line), eol - text.find(line));
+  TempFile without("gnc.yaml", replaced(text, whole, "    #"));
+  EXPECT_EQ(load_run(kMission, without.path(), case_file(4)).flight.identification.excitation.inertia_torque_nm,
+            gnc::Vec3::Zero());
+  TempFile bad("gnc.yaml", replaced(text, whole, "    inertia_torque_nm: [100.0, -1.0, 100.0]"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "identification.excitation.inertia_torque_nm",
+               "must be >= 0");
+}
+
 TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
   EXPECT_EQ(load_run(kMission, kGnc, case_file(1)).flight.fdi.check_min_llr, 5.0);
   EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.check_min_llr, 5.0);

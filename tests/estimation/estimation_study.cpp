@@ -4,7 +4,8 @@
 // Farrenkopf steady state. Ground tool: prints a table, asserts nothing.
 //
 //   estimation_study CONFIG_DIR
-//   estimation_study CONFIG_DIR excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M [R_SIGMA_TARGET_M]]]]
+//   estimation_study CONFIG_DIR excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M [R_SIGMA_TARGET_M
+//                    [INERTIA_TORQUE_NM]]]]]
 //     the seven cases with the flight's identifier settings, without and with the identification
 //     excitation (README §I.6), and the fuel each run spent
 #include <cmath>
@@ -141,8 +142,14 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
       ++m;
     }
     Vec8 u = allocate(b_hat, dpd(s.gyro.rate, s.star.quat, pd), run.flight.rcs.u_max);
-    if (ex.wanted(id.estimate().r_sigma.maxCoeff(), id.observability().offset_unobservable,
-                  static_cast<double>(id.counters().windows) * c.window_s)) {
+    const double identified_s = static_cast<double>(id.counters().windows) * c.window_s;
+    if (ex.inertia_wanted(identified_s)) {  // (X8) the inertia phase first
+      const gnc::ExcitationStatus xs =
+          ex.apply_inertia(ex.inertia_torque(id.counters().windows), lo, hi, c.dt, u);
+      gamma_sum += xs.gamma;
+      ++excited_ticks;
+    } else if (ex.wanted(id.estimate().r_sigma.maxCoeff(), id.observability().offset_unobservable,
+                  identified_s)) {
       ex.size_to_window_noise(id.latched_window_noise(), c.window_s);  // (X7)
       const gnc::ExcitationStatus xs = ex.apply(ex.force(id.counters().windows), lo, hi, c.dt, u);
       scale_sum += ex.amplitude_scale();
@@ -172,9 +179,9 @@ Outcome identification(const std::string& dir, int case_number, gnc::IdentifierM
 // The seven cases without and with the excitation: markdown rows for the design note.
 void excitation_table(const std::string& dir, const gnc::ExcitationConfig& x) {
   std::printf("excitation F (%.0f, %.0f, %.0f) N, after %.0f s, at most %.0f s, stop at r 1s %.3f m, "
-              "sized for r 1s %.3f m (0: not sized)%s\n",
+              "sized for r 1s %.3f m (0: not sized); before it the inertia phase (X8) at (%.0f, %.0f, %.0f) N m%s\n",
               x.force_n(0), x.force_n(1), x.force_n(2), x.start_after_s, x.duration_s, x.r_sigma_stop_m,
-              x.r_sigma_target_m,
+              x.r_sigma_target_m, x.inertia_torque_nm(0), x.inertia_torque_nm(1), x.inertia_torque_nm(2),
               g_estimate_bias ? ", gyro bias estimated" : "");
   std::printf("| case | excitation | 60 s | 300 s | 600 s | 1000 s | 3000 s | fuel 3000 s (kg) | excited (s) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
@@ -277,8 +284,10 @@ int run(int argc, char** argv) {
     g_estimate_bias = true;
     --argc;
   }
-  if (argc < 2 || (argc > 2 && std::string(argv[2]) != "excitation") || argc > 7) {
-    std::fprintf(stderr, "usage: %s CONFIG_DIR [excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M [R_SIGMA_TARGET_M]]]]]\n",
+  if (argc < 2 || (argc > 2 && std::string(argv[2]) != "excitation") || argc > 8) {
+    std::fprintf(stderr,
+                 "usage: %s CONFIG_DIR [excitation [FORCE_N [DURATION_S [R_SIGMA_STOP_M [R_SIGMA_TARGET_M "
+                 "[INERTIA_TORQUE_NM]]]]]]\n",
                  argv[0]);
     return 2;
   }
@@ -303,6 +312,7 @@ int run(int argc, char** argv) {
     if (argc > 4) x.duration_s = std::stod(argv[4]);
     if (argc > 5) x.r_sigma_stop_m = std::stod(argv[5]);
     if (argc > 6) x.r_sigma_target_m = std::stod(argv[6]);
+    if (argc > 7) x.inertia_torque_nm = Vec3::Constant(std::stod(argv[7]));  // (X8)
     const gnc::ExcitationConfigCheck xc = gnc::validate(x);
     if (!xc.ok) {
       std::fprintf(stderr, "bad excitation: %s: %s\n", xc.field, xc.reason);

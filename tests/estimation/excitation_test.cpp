@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/QR>
+
 #include "gnc/estimation/excitation.hpp"
 #include "gnc/model/mass_properties.hpp"
 #include "gnc/model/rcs.hpp"
@@ -196,6 +198,129 @@ TEST(IdentificationExcitation, KeepsTheChannelBoundsWhenTheAllocationSaturates) 
   EXPECT_LT(rederived_zero, naive_zero / 4);    // the re-derived term mostly can
 }
 
+// (X8) The inertia phase. Independent truth: the minimum-norm channel forces that make the law's
+// torque plus the couple with no net force, from a complete orthogonal decomposition of the 6x8
+// system [B; E] u = [tau; 0] written from the layout here (torque_of, force_of), not from N or C.
+TEST(IdentificationExcitation, InertiaPhaseNullsTheNetForceAndAddsTheCoupleOnTheModel) {
+  Rig rig;
+  ExcitationConfig c = rig.ex.config();
+  c.inertia_torque_nm = Vec3(100.0, 100.0, 100.0);
+  rig.ex.configure(c);
+  rig.ready();
+  Eigen::Matrix<double, 6, kChannels> m;
+  for (int ch = 0; ch < kChannels; ++ch) {
+    Vec8 e = Vec8::Zero();
+    e(ch) = 1.0;
+    m.block<3, 1>(0, ch) = torque_of(rig.rcs, rig.r_hat, e);
+    m.block<3, 1>(3, ch) = force_of(rig.rcs, e);
+  }
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 6, kChannels>> cod(m);
+  const Mat38 b = torque_matrix(rig.rcs, rig.r_hat);
+  const Mat83 pinv = b.transpose() * (b * b.transpose()).inverse();  // Eq. (53)
+  const Vec8 lo = Vec8::Constant(-1000.0), hi = Vec8::Constant(1000.0);
+  std::mt19937 gen(8);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int d = 0; d < 200; ++d) {
+    const Vec3 law(300.0 * n(gen), 300.0 * n(gen), 300.0 * n(gen));
+    const Vec3 tau = rig.ex.inertia_torque(static_cast<std::uint32_t>(d));
+    // The pseudoinverse's allocation: the result is the minimum-norm force-free one.
+    const Vec8 u0 = pinv * law;
+    Vec8 u = u0;
+    const ExcitationStatus s = rig.ex.apply_inertia(tau, lo, hi, 0.1, u);
+    ASSERT_TRUE(s.active && s.inertia);
+    ASSERT_EQ(s.gamma, 1.0);
+    EXPECT_LT((s.force - force_of(rig.rcs, u0)).norm(), 1e-9);  // the force it nulled
+    Eigen::Matrix<double, 6, 1> y;
+    y << law + tau, Vec3::Zero();
+    const Vec8 expected = cod.solve(y);
+    EXPECT_LT((u - expected).cwiseAbs().maxCoeff(), 1e-9 * (1.0 + expected.cwiseAbs().maxCoeff())) << "draw " << d;
+    EXPECT_LT(force_of(rig.rcs, u).norm(), 1e-9) << "draw " << d;
+    EXPECT_LT((torque_of(rig.rcs, rig.r_hat, u) - law - tau).norm(), 1e-8) << "draw " << d;
+    // Any allocation (here one with a null-space component, as L1's are): the force nulled and
+    // the torque plus tau all the same.
+    Vec8 v0 = u0 + 40.0 * rig.ex.kernel().col(d % 2) + rig.ex.force_map() * Vec3(n(gen), n(gen), n(gen)) * 50.0;
+    Vec8 v = v0;
+    rig.ex.apply_inertia(tau, lo, hi, 0.1, v);
+    EXPECT_LT(force_of(rig.rcs, v).norm(), 1e-9) << "draw " << d;
+    EXPECT_LT((torque_of(rig.rcs, rig.r_hat, v - v0) - tau).norm(), 1e-8) << "draw " << d;
+  }
+  EXPECT_NEAR(rig.ex.inertia_elapsed(), 40.0, 1e-9);
+  EXPECT_EQ(rig.ex.elapsed(), 0.0);  // the force phase's budget is its own
+  // The cycle: +x, -x, +y, -y, +z, -z at the configured amplitude, no net momentum per cycle.
+  const Vec3 expected[6] = {Vec3(100, 0, 0), Vec3(-100, 0, 0), Vec3(0, 100, 0),
+                            Vec3(0, -100, 0), Vec3(0, 0, 100), Vec3(0, 0, -100)};
+  for (std::uint32_t w = 0; w < 12; ++w) EXPECT_EQ(rig.ex.inertia_torque(w), expected[w % 6]);
+}
+
+// (X8) In the box: a saturated allocation keeps every channel within its bounds, and what is added
+// is a fraction gamma of the whole move (the couple and the nulling together), torque and force.
+TEST(IdentificationExcitation, InertiaPhaseKeepsTheChannelBounds) {
+  Rig rig;
+  ExcitationConfig c = rig.ex.config();
+  c.inertia_torque_nm = Vec3(300.0, 300.0, 300.0);
+  rig.ex.configure(c);
+  rig.ready();
+  const Mat38 b = torque_matrix(rig.rcs, rig.r_hat);
+  const Mat83 pinv = b.transpose() * (b * b.transpose()).inverse();
+  std::mt19937 gen(81);
+  std::normal_distribution<double> n(0.0, 1.0);
+  int partial = 0;
+  for (int d = 0; d < 2000; ++d) {
+    Vec8 lo = Vec8::Constant(-200.0), hi = Vec8::Constant(200.0);
+    if (d % 2 == 1) lo(d % 8) = -100.0;
+    Vec8 u0 = pinv * Vec3(n(gen), n(gen), n(gen)) * 2000.0;
+    double scale = 1.0;
+    for (int i = 0; i < kChannels; ++i) {
+      if (u0(i) > hi(i)) scale = std::min(scale, hi(i) / u0(i));
+      if (u0(i) < lo(i)) scale = std::min(scale, lo(i) / u0(i));
+    }
+    u0 *= scale;
+    const Vec3 tau = rig.ex.inertia_torque(static_cast<std::uint32_t>(d));
+    Vec8 u = u0;
+    const ExcitationStatus s = rig.ex.apply_inertia(tau, lo, hi, 0.1, u);
+    for (int i = 0; i < kChannels; ++i) {
+      ASSERT_LE(u(i), hi(i)) << "draw " << d;
+      ASSERT_GE(u(i), lo(i)) << "draw " << d;
+    }
+    EXPECT_LT((torque_of(rig.rcs, rig.r_hat, u - u0) - s.gamma * tau).norm(), 1e-7) << "draw " << d;
+    EXPECT_LT((force_of(rig.rcs, u) - (1.0 - s.gamma) * force_of(rig.rcs, u0)).norm(), 1e-7) << "draw " << d;
+    partial += s.gamma < 1.0 ? 1 : 0;
+  }
+  EXPECT_GT(partial, 100);  // the draws do reach the bounds
+}
+
+TEST(IdentificationExcitation, InertiaPhaseOnlyBeforeTheForcePhaseAndOnlyWhenConfigured) {
+  Rig rig;
+  ExcitationConfig c = rig.ex.config();
+  c.start_after_s = 60.0;
+  rig.ex.configure(c);
+  EXPECT_FALSE(rig.ex.inertia_wanted(0.0));  // basis not ready
+  rig.ready();
+  EXPECT_FALSE(rig.ex.inertia_wanted(0.0));  // no couple configured: no inertia phase
+  EXPECT_EQ(rig.ex.inertia_torque(0), Vec3::Zero());
+  c.inertia_torque_nm = Vec3(0.0, 50.0, 0.0);
+  rig.ex.configure(c);
+  EXPECT_TRUE(rig.ex.inertia_wanted(0.0));
+  EXPECT_TRUE(rig.ex.inertia_wanted(40.0));
+  EXPECT_FALSE(rig.ex.inertia_wanted(60.0));  // the force phase's turn
+  EXPECT_TRUE(rig.ex.wanted(1.0, 3, 60.0));
+  EXPECT_FALSE(rig.ex.wanted(1.0, 3, 40.0));
+  EXPECT_EQ(rig.ex.inertia_torque(0), Vec3(0, 50, 0));  // an axis at 0 leaves the cycle
+  EXPECT_EQ(rig.ex.inertia_torque(1), Vec3(0, -50, 0));
+  EXPECT_EQ(rig.ex.inertia_torque(2), Vec3(0, 50, 0));
+  c.enabled = false;
+  rig.ex.configure(c);
+  EXPECT_FALSE(rig.ex.inertia_wanted(0.0));
+  // A new model: off until its basis is ready.
+  c.enabled = true;
+  rig.ex.configure(c);
+  rig.ex.set_model(torque_matrix(rig.rcs, rig.r_hat + Vec3(0.1, 0, 0)), rig.rcs);
+  EXPECT_FALSE(rig.ex.inertia_wanted(0.0));
+  Vec8 u = Vec8::Constant(5.0);
+  EXPECT_FALSE(rig.ex.apply_inertia(Vec3(0, 50, 0), Vec8::Constant(-200), Vec8::Constant(200), 0.1, u).active);
+  EXPECT_EQ(u, Vec8::Constant(5.0));
+}
+
 TEST(IdentificationExcitation, ConfigValidationNamesTheField) {
   ExcitationConfig c;
   EXPECT_TRUE(validate(c).ok);
@@ -213,6 +338,11 @@ TEST(IdentificationExcitation, ConfigValidationNamesTheField) {
   c = ExcitationConfig{};
   c.r_sigma_target_m = -0.01;
   EXPECT_STREQ(validate(c).field, "identification.excitation.r_sigma_target_m");
+  c = ExcitationConfig{};
+  c.inertia_torque_nm = Vec3(10.0, -1.0, 0.0);
+  EXPECT_STREQ(validate(c).field, "identification.excitation.inertia_torque_nm");
+  c.inertia_torque_nm = Vec3(10.0, std::nan(""), 0.0);
+  EXPECT_STREQ(validate(c).field, "identification.excitation.inertia_torque_nm");
 }
 
 // (X7) Sized to the window noise. Independent truth: the information on r summed window by window

@@ -184,12 +184,15 @@ TEST(ZeroAllocation, NoHeapWithTheIdentificationExcitation) {
     id.excitation.force_n = Vec3(3.0, 3.0, 6.0);
     id.excitation.duration_s = 40.0;
     id.excitation.r_sigma_stop_m = 1e-3;
+    id.excitation.start_after_s = 6.0;                    // (X8) the inertia phase first
+    id.excitation.inertia_torque_nm = Vec3(0.5, 0.5, 0.5);
     loop->body.omega *= 4.0;  // a long saturated despin
     ASSERT_TRUE(loop->gnc.init(p).ok);
     long counted = -1;
     double gamma_min = 1.0;
     int blocked = 0;
     int excited = 0;
+    int inertia = 0;
     {
       Armed armed;
       GncCommands c;
@@ -201,6 +204,7 @@ TEST(ZeroAllocation, NoHeapWithTheIdentificationExcitation) {
         const ExcitationStatus& s = loop->gnc.excitation_status();
         if (s.active) {
           ++excited;
+          inertia += s.inertia ? 1 : 0;
           gamma_min = std::fmin(gamma_min, s.gamma);
           blocked += s.blocked > 0 ? 1 : 0;
         }
@@ -210,6 +214,8 @@ TEST(ZeroAllocation, NoHeapWithTheIdentificationExcitation) {
     EXPECT_EQ(counted, 0) << to_string(kind);
     EXPECT_GE(loop->gnc.model_adoptions(), 1u) << to_string(kind);
     EXPECT_GT(excited, 100) << to_string(kind);
+    EXPECT_GT(inertia, 100) << to_string(kind) << ": the inertia phase (X8) ran";
+    EXPECT_GT(excited - inertia, 100) << to_string(kind) << ": ... and the force phase after it";
     EXPECT_GT(blocked, 0) << to_string(kind) << ": the saturated path ran";
     EXPECT_LT(gamma_min, 1.0) << to_string(kind);
     delete loop;
