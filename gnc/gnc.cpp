@@ -706,9 +706,10 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       const IdentifierEstimate& e = ident_.estimate();
       const double identified_s =
           static_cast<double>(ident_.counters().windows) * params_.identification.config.window_s;
-      if (healthy && excite_.inertia_wanted(identified_s)) {
+      if (healthy && modes_.mode() == Mode::kDetumble && excite_.inertia_wanted(identified_s)) {
         // (X8) Before start_after_s: the allocation made force-free (r_hat still unknown) and a
-        // couple added, one axis per window.
+        // couple added, one axis per window. In DETUMBLE only: there the despin's own torque
+        // dwarfs the couple; in HOLD or TRACK it would be a pointing disturbance.
         excite_status_ = excite_.apply_inertia(excite_.inertia_torque(ident_.counters().windows),
                                                lim.lo, lim.hi, params_.dt, u);
       } else if (healthy && excite_.wanted(e.r_sigma.maxCoeff(), ident_.observability().offset_unobservable,

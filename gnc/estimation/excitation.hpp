@@ -115,7 +115,7 @@ class IdentificationExcitation {
   // what was done; u is unchanged when !ready().
   ExcitationStatus apply(const Vec3& f, const Vec8& lo, const Vec8& hi, double dt, Vec8& u);
   // (X8) Whether the inertia phase should run: enabled, model ready, a couple configured, and
-  // less than start_after_s of identification done (identified_s).
+  // less than start_after_s of identification done (identified_s). Gnc flies it in DETUMBLE only.
   bool inertia_wanted(double identified_s) const;
   // The couple of window `window_index` (X8): +x, -x, +y, -y, +z, -z at inertia_torque_nm.
   Vec3 inertia_torque(std::uint32_t window_index) const;

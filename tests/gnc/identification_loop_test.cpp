@@ -441,10 +441,11 @@ struct InertiaPhaseRun {
   double max_couple_gap{0.0};// largest |B_hat F - torque_achieved - gamma tau| there, N m
   double fuel_kg{0.0};
 };
-InertiaPhaseRun inertia_phase_run(double couple_nm, AllocatorKind allocator) {
+// hold: at rest in HOLD instead (the phase is flown in DETUMBLE only).
+InertiaPhaseRun inertia_phase_run(double couple_nm, AllocatorKind allocator, bool hold = false) {
   const GncParams truth = study_gnc_params(1000.0);
   test::SmallLoop loop(truth);
-  loop.body.omega = Vec3(0.01, 0.02, 0.03);
+  loop.body.omega = hold ? Vec3::Zero() : Vec3(0.01, 0.02, 0.03);
   GncParams p = truth;
   p.law = LawId::kDpd;
   p.allocator = allocator;
@@ -468,8 +469,9 @@ InertiaPhaseRun inertia_phase_run(double couple_nm, AllocatorKind allocator) {
   EXPECT_TRUE(loop.gnc.init(p).ok);
   GncCommands c;
   c.has_mode_request = true;
-  c.mode_request = Mode::kDetumble;
+  c.mode_request = hold ? Mode::kHold : Mode::kDetumble;
   loop.tick(c);
+  EXPECT_EQ(loop.gnc.mode(), c.mode_request);
   InertiaPhaseRun run;
   const Mat38 b_hat = torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
   std::mt19937 gen(4);
@@ -520,6 +522,8 @@ TEST(GncIdentification, TheInertiaPhaseIdentifiesCaseFoursInertiaWithin60s) {
     EXPECT_LT(on.max_net_force, 1e-6) << to_string(a);
     EXPECT_LT(on.max_couple_gap, 1e-6) << to_string(a);
   }
+  // In HOLD no couple is flown: it would be a pointing disturbance there.
+  EXPECT_EQ(inertia_phase_run(100.0, AllocatorKind::kPseudoInverse, true).inertia_ticks, 0);
 }
 
 TEST(GncIdentification, OffByDefaultAndTelemetryZero) {
