@@ -210,6 +210,10 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("min_offset_information")) {
       ic.min_offset_information = r.non_negative("min_offset_information");
     }
+    if (r.has("guard_halvings")) {  // (I28), optional: refused as before when absent
+      ic.guard_halvings = r.integer("guard_halvings");
+      if (ic.guard_halvings < 0 || ic.guard_halvings > 10) r.fail("guard_halvings", "must be in [0, 10]");
+    }
     ic.j_forget_s = r.non_negative("inertia_forget_s");
     ic.r_forget_s = r.non_negative("offset_forget_s");
     ic.j_confident_rel = r.positive("inertia_confident_rel");

@@ -45,6 +45,7 @@ void apply_flight_identification_settings(GncParams& p, double gyro_sigma) {
   c.gate_reinflate_after = 3;
   c.min_inertia_information = 1.0;
   c.min_offset_information = 1.0;
+  c.guard_halvings = 3;
   c.j_forget_s = 0.0;
   c.r_forget_s = 0.0;
   c.j_confident_rel = 0.01;

@@ -207,6 +207,7 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   if (!finite_non_negative(c.min_offset_information)) {
     return bad("min_offset_information", "must be >= 0 (0: off)");
   }
+  if (c.guard_halvings < 0 || c.guard_halvings > 10) return bad("guard_halvings", "must be in [0, 10]");
   if (!finite_non_negative(c.min_thruster_impulse)) {
     return bad("min_thruster_impulse", "must be >= 0");
   }
@@ -625,6 +626,7 @@ void Identifier::joint_gain() {
   exc_.offset_informative = true;
   joint_.inertia_held = false;
   joint_.offset_held = false;
+  joint_.damped = false;
   joint_.gated = false;
 
   // Forgetting per group (I8): P_f = D P D, D = diag(lambda_g^-1/2) on the excited groups.
@@ -766,25 +768,53 @@ bool Identifier::gate_reinflate() {
 void Identifier::joint_apply() {
   if (!joint_.pending) return;
   joint_.pending = false;
-  VecId x;
-  x << a_, r_, k_, b_, d_;
-  x -= joint_.k * joint_.e0;
+  VecId x0;
+  x0 << a_, r_, k_, b_, d_;
+  const VecId step = joint_.k * joint_.e0;
   // Guards (I14): J positive definite and physical, r within bounds; else the update is refused
-  // and the covariance left as it was.
-  const Mat3 j = inertia_matrix(x.head<6>());
-  bool physical = j.allFinite() && Eigen::LLT<Mat3>(j).info() == Eigen::Success;
-  if (physical) {
+  // and the covariance left as it was. (I28) Before refusing, the gain is halved up to
+  // guard_halvings times; the first fraction the guards accept is applied.
+  // (I28) The triangle inequality m0 + m1 >= m2 of the principal moments is asked of the step
+  // only as far as the estimate meets it: a prior outside it (a table that is only positive
+  // definite) may move back towards it, never further out.
+  const auto triangle_margin = [](const Mat3& j) {
     Eigen::SelfAdjointEigenSolver<Mat3> es;
     es.computeDirect(j, Eigen::EigenvaluesOnly);
     const Vec3 m = es.eigenvalues();
-    physical = m(0) > 0.0 && m(0) + m(1) >= m(2);
+    return m(0) > 0.0 ? m(0) + m(1) - m(2) : -1e300;
+  };
+  double floor_margin = 0.0;
+  bool floor_known = c_.guard_halvings == 0;  // without I28 the inequality itself is the guard
+  VecId x = x0 - step;
+  bool physical = false;
+  bool r_ok = false;
+  double alpha = 1.0;
+  for (int halving = 0;; ++halving) {
+    const Mat3 j = inertia_matrix(x.head<6>());
+    physical = j.allFinite() && Eigen::LLT<Mat3>(j).info() == Eigen::Success;
+    if (physical) {
+      const double margin = triangle_margin(j);
+      if (margin < 0.0 && !floor_known) {
+        floor_margin = std::fmin(0.0, triangle_margin(inertia_matrix(x0.head<6>())));
+        floor_known = true;
+      }
+      physical = margin >= floor_margin;
+    }
+    r_ok = x.segment<3>(kIdR).allFinite() && (x.segment<3>(kIdR) - c_.r0).norm() <= c_.r_max_offset;
+    if ((physical && r_ok) || halving >= c_.guard_halvings) break;
+    alpha *= 0.5;
+    x = x0 - alpha * step;
   }
-  const bool r_ok =
-      x.segment<3>(kIdR).allFinite() && (x.segment<3>(kIdR) - c_.r0).norm() <= c_.r_max_offset;
   if (!physical || !r_ok) {
     if (!physical) ++counters_.inertia_refused;
     if (!r_ok) ++counters_.offset_refused;
     return;
+  }
+  if (alpha < 1.0) {
+    // (I28) The gain actually applied; the covariance rows then take the full form for it.
+    joint_.k *= alpha;
+    joint_.damped = true;
+    ++counters_.damped_steps;
   }
   // The covariance is updated a block of rows per tick from the next tick on (each row needs
   // only its own old row, p_ht, K and S).
@@ -816,8 +846,9 @@ void Identifier::joint_covariance_rows(int first, int n) {
   for (int i = first; i < first + n; ++i) {
     Eigen::Matrix<double, 1, kIdParams> row = d(i) * p_all_.row(i).cwiseProduct(d.transpose());
     row.noalias() -= joint_.k.row(i) * joint_.p_ht.transpose();
-    if (!exc_.offset || !c_.gyro_bias_estimated || joint_.inertia_held || joint_.offset_held) {
-      // a gain with zeroed rows: the full form
+    if (!exc_.offset || !c_.gyro_bias_estimated || joint_.inertia_held || joint_.offset_held ||
+        joint_.damped) {
+      // a gain with zeroed rows, or halved (I28): the full form
       row.noalias() -= joint_.p_ht.row(i) * joint_.k.transpose();
       row.noalias() += (joint_.k.row(i) * joint_.s) * joint_.k.transpose();
     }

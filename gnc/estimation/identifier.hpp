@@ -144,6 +144,12 @@ struct IdentifierConfig {
   double r_max_offset{5.0};
   double k_min{0.0};
   double k_max{1.5};
+  // (I28) A step the guards refuse is first halved up to this many times: the largest fraction
+  // 2^-n of the gain that the guards accept is applied, with the covariance of that gain (the
+  // full form, valid for any gain), so a first window from a far prior is not lost. With it on
+  // (> 0), the triangle inequality is asked only as far as the estimate already meets it: a prior
+  // outside it may move back, never further out. 0: refused, the inequality strict.
+  int guard_halvings{0};
   // Observability: a direction whose 1 sigma is still above unobservable_ratio times its prior
   // is reported unobservable (not estimated).
   double unobservable_ratio{0.5};
@@ -207,6 +213,7 @@ struct IdentifierCounters {
   std::uint32_t inertia_refused{0};  // guard refusals
   std::uint32_t offset_refused{0};
   std::uint32_t strength_clamped{0};
+  std::uint32_t damped_steps{0};     // (I28) steps applied at a halved gain
   std::uint32_t reinflations{0};
   std::uint32_t windows_gated{0};      // refused by the innovation gate (I18)
   std::uint32_t gate_reinflations{0};  // ... re-inflations after too many in a row
@@ -454,6 +461,7 @@ class Identifier {
     bool any_thruster{false};
     bool inertia_held{false};  // (I26) J's gain is zero in this window: the full covariance form
     bool offset_held{false};   // (I26) ... r's
+    bool damped{false};        // (I28) the gain was halved for the guards: the full form
     bool gated{false};         // (I26) the information gate has been decided for this step
     VecId d{VecId::Ones()};
     Vec3 e0{Vec3::Zero()};

@@ -232,7 +232,7 @@ void write_timeseries_csv(const std::string& path, const RunResult& r) {
          "u0,u1,u2,u3,u4,u5,u6,u7,fuel_kg,fuel_hat_kg,mode";
   if (id) {
     out << ",id_j_rel,id_r_err_m,id_k_max_err,id_j_nees,id_r_nees,id_r_sigma_max_m,"
-           "id_windows_gated,id_gate_reinflations";
+           "id_windows_gated,id_gate_reinflations,id_windows,id_guard_refusals,id_excited_inertia";
   }
   if (fdi) out << ",fdi_chi2,fdi_best,fdi_best_llr,fdi_confirmed,fdi_check_jet";
   out << "\n";
@@ -258,7 +258,8 @@ void write_timeseries_csv(const std::string& path, const RunResult& r) {
         std::snprintf(buf, sizeof buf, ",%.9g", v);
         out << buf;
       }
-      out << "," << row.windows_gated << "," << row.gate_reinflations;
+      out << "," << row.windows_gated << "," << row.gate_reinflations << "," << row.windows << ","
+          << row.guard_refusals << "," << (row.excited_inertia ? 1 : 0);
     }
     if (fdi) {
       std::snprintf(buf, sizeof buf, ",%.9g,%d,%.9g,%u,%d", row.fdi_chi2, row.fdi_best,

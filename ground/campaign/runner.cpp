@@ -164,6 +164,9 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       row.r_sigma_max_m = e.r_sigma.maxCoeff();
       row.windows_gated = e.windows_gated;
       row.gate_reinflations = e.gate_reinflations;
+      row.windows = e.windows;
+      row.guard_refusals = e.guard_refusals;
+      row.excited_inertia = e.excited_inertia;
     }
     if (o.telemetry.fdi.enabled) {
       const gnc::FdiTelemetry& f = o.telemetry.fdi;

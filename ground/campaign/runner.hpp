@@ -34,7 +34,8 @@ struct TimeRow {
   double fuel_hat_kg{0.0};                              // flight software's estimate
   gnc::Mode mode{gnc::Mode::kIdle};
   // Identification against the truth (written when the identifier runs): as IdentificationMark,
-  // and the innovation gate's counters (estimation README I18).
+  // the innovation gate's counters (estimation README I18), the windows closed, the guards'
+  // refusals (I14) and the last window's inertia excitation (I16).
   double j_rel{0.0};
   double r_err_m{0.0};
   double k_max_err{0.0};
@@ -43,6 +44,9 @@ struct TimeRow {
   double r_sigma_max_m{0.0};  // largest reported 1 sigma of r
   std::uint32_t windows_gated{0};
   std::uint32_t gate_reinflations{0};
+  std::uint32_t windows{0};         // identification windows closed
+  std::uint32_t guard_refusals{0};  // updates refused by the guards (I14)
+  bool excited_inertia{false};      // the last window excited the inertia scale (I16)
   // Fault detection (written when the detector runs): the last window's no-fault chi-square, the
   // leading hypothesis (0..15 stuck on, 16..31 stuck off, -1 none) and its LLR, the confirmed
   // jets (on | off | degraded) and the jet under a check (-1 none).

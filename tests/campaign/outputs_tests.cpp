@@ -137,7 +137,8 @@ TEST(CampaignOutputs, TimeSeriesCarriesIdentificationAndFaultDetectionWhenFlown)
   ASSERT_GE(ts.size(), 2u);
   const std::string tail =
       ",mode,id_j_rel,id_r_err_m,id_k_max_err,id_j_nees,id_r_nees,id_r_sigma_max_m,"
-      "id_windows_gated,id_gate_reinflations,fdi_chi2,fdi_best,fdi_best_llr,fdi_confirmed,"
+      "id_windows_gated,id_gate_reinflations,id_windows,id_guard_refusals,id_excited_inertia,"
+      "fdi_chi2,fdi_best,fdi_best_llr,fdi_confirmed,"
       "fdi_check_jet";
   ASSERT_GE(ts[0].size(), tail.size());
   EXPECT_EQ(ts[0].substr(ts[0].size() - tail.size()), tail);
@@ -154,10 +155,17 @@ TEST(CampaignOutputs, TimeSeriesCarriesIdentificationAndFaultDetectionWhenFlown)
     return static_cast<std::size_t>(it - head.begin());
   };
   int at_marks = 0;
+  long windows = 0, refusals = 0;
   for (std::size_t i = 1; i < ts.size(); ++i) {
     const std::vector<std::string> f = fields(ts[i]);
     ASSERT_EQ(f.size(), head.size()) << "row " << i;
     const double t = std::stod(f[0]);
+    // The identifier's counters only grow; the excitation flag is a boolean.
+    EXPECT_GE(std::stol(f[col("id_windows")]), windows) << t;
+    EXPECT_GE(std::stol(f[col("id_guard_refusals")]), refusals) << t;
+    windows = std::stol(f[col("id_windows")]);
+    refusals = std::stol(f[col("id_guard_refusals")]);
+    EXPECT_TRUE(f[col("id_excited_inertia")] == "0" || f[col("id_excited_inertia")] == "1") << t;
     for (const IdentificationMark& m : id.estimation.marks) {
       if (!m.reached || std::fabs(t - m.t_s) > 1e-6) continue;
       ++at_marks;
@@ -170,6 +178,7 @@ TEST(CampaignOutputs, TimeSeriesCarriesIdentificationAndFaultDetectionWhenFlown)
     EXPECT_EQ(f[col("fdi_check_jet")], "-1") << t;
   }
   EXPECT_EQ(at_marks, 2) << "the 60 s and 300 s marks fall on logged rows";
+  EXPECT_GT(windows, 0) << "windows closed over the run";
   // Without the modules: the series ends with the mode.
   const auto plain = lines(slurp(rep.results[1].timeseries_path));
   ASSERT_GE(plain.size(), 1u);

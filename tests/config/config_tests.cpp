@@ -229,6 +229,7 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
     EXPECT_EQ(f.config.gate_reinflate_after, y.config.gate_reinflate_after);
     EXPECT_EQ(f.config.min_inertia_information, y.config.min_inertia_information);
     EXPECT_EQ(f.config.min_offset_information, y.config.min_offset_information);
+    EXPECT_EQ(f.config.guard_halvings, y.config.guard_halvings);
     EXPECT_EQ(f.config.j_forget_s, y.config.j_forget_s);
     EXPECT_EQ(f.config.r_forget_s, y.config.r_forget_s);
     EXPECT_EQ(f.config.j_confident_rel, y.config.j_confident_rel);
@@ -321,6 +322,20 @@ TEST(ConfigShipped, TheExcitationsInertiaPhaseIsReadAndOptional) {
   TempFile bad("gnc.yaml", replaced(text, whole, "    inertia_torque_nm: [100.0, -1.0, 100.0]"));
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "identification.excitation.inertia_torque_nm",
                "must be >= 0");
+}
+
+// (I28) The guards' halvings: gnc.yaml's 3, refused as before (0) when the key is absent, and a
+// value outside [0, 10] names the file and key.
+TEST(ConfigShipped, TheGuardHalvingsAreReadAndOptional) {
+  const std::string text = read(kGnc);
+  const std::size_t at = text.find("  guard_halvings: 3 ");
+  ASSERT_NE(at, std::string::npos);
+  const std::string whole = text.substr(at, text.find('\n', at) - at);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(4)).flight.identification.config.guard_halvings, 3);
+  TempFile without("gnc.yaml", replaced(text, whole, "  #"));
+  EXPECT_EQ(load_run(kMission, without.path(), case_file(4)).flight.identification.config.guard_halvings, 0);
+  TempFile bad("gnc.yaml", replaced(text, whole, "  guard_halvings: 11"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "identification.guard_halvings", "must be in [0, 10]");
 }
 
 TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {
