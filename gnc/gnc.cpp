@@ -692,10 +692,11 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
     status.torque_requested.setZero();
     status.torque_achieved.setZero();
   }
-  // 5b. Identification excitation (gnc/estimation/README.md §I.6, X1-X8): first the inertia
-  // phase (X8: the net force nulled, a couple added), then a net force in the null space of
-  // B_hat, added within the channels' box, while r is not yet known. Healthy RCS
-  // only (no latched fault, no closed valve, no suspicion); the torque on the model is unchanged.
+  // 5b. Identification excitation (gnc/estimation/README.md §I.6, X1-X8): first, in DETUMBLE, the
+  // inertia phase (X8: the net force nulled, a couple added to the law's torque), then a net
+  // force in the null space of B_hat (the torque on the model unchanged) while r is not yet
+  // known; within the channels' box. Healthy RCS only (no latched fault, no closed valve, no
+  // suspicion).
   excite_status_ = ExcitationStatus{};
   if (excitation_on()) {
     if (excite_quiet_) excite_.step_model();

@@ -9,6 +9,20 @@ namespace rocksteady::gnc {
 
 namespace {
 bool finite_positive(double x) { return std::isfinite(x) && x > 0.0; }
+// The cycle +a, -a per body axis with a positive amplitude, in axis order (X3, X8): the number of
+// entries written to out.
+int axis_cycle(const Vec3& amplitude, Vec3 (&out)[IdentificationExcitation::kDirections]) {
+  int n = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(amplitude(axis) > 0.0)) continue;
+    for (const double sign : {1.0, -1.0}) {
+      out[n] = Vec3::Zero();
+      out[n](axis) = sign * amplitude(axis);
+      ++n;
+    }
+  }
+  return n;
+}
 constexpr double kRankTol = 1e-10;   // pivot of M M' (relative to the largest) counted as zero
 constexpr double kBoundTol = 1e-9;   // a channel within this fraction of its bound is at the bound
 }  // namespace
@@ -37,24 +51,8 @@ ExcitationConfigCheck validate(const ExcitationConfig& c) {
 
 void IdentificationExcitation::configure(const ExcitationConfig& c) {
   config_ = c;
-  n_directions_ = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (!(c.force_n(axis) > 0.0)) continue;
-    for (const double sign : {1.0, -1.0}) {
-      directions_[n_directions_] = Vec3::Zero();
-      directions_[n_directions_](axis) = sign * c.force_n(axis);
-      ++n_directions_;
-    }
-  }
-  n_couples_ = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (!(c.inertia_torque_nm(axis) > 0.0)) continue;
-    for (const double sign : {1.0, -1.0}) {
-      couples_[n_couples_] = Vec3::Zero();
-      couples_[n_couples_](axis) = sign * c.inertia_torque_nm(axis);
-      ++n_couples_;
-    }
-  }
+  n_directions_ = axis_cycle(c.force_n, directions_);      // (X3)
+  n_couples_ = axis_cycle(c.inertia_torque_nm, couples_);  // (X8)
   // (X7) Every component of r is seen from the forces normal to it: r_a from the other axes'.
   min_pair_ = 0.0;
   for (int a = 0; a < 3; ++a) {

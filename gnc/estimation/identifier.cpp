@@ -773,10 +773,9 @@ void Identifier::joint_apply() {
   const VecId step = joint_.k * joint_.e0;
   // Guards (I14): J positive definite and physical, r within bounds; else the update is refused
   // and the covariance left as it was. (I28) Before refusing, the gain is halved up to
-  // guard_halvings times; the first fraction the guards accept is applied.
-  // (I28) The triangle inequality m0 + m1 >= m2 of the principal moments is asked of the step
-  // only as far as the estimate meets it: a prior outside it (a table that is only positive
-  // definite) may move back towards it, never further out.
+  // guard_halvings times and the first fraction the guards accept is applied; and the triangle
+  // inequality m0 + m1 >= m2 of the principal moments is asked of the step only as far as the
+  // estimate meets it (a prior that is only positive definite may move back, never further out).
   const auto triangle_margin = [](const Mat3& j) {
     Eigen::SelfAdjointEigenSolver<Mat3> es;
     es.computeDirect(j, Eigen::EigenvaluesOnly);

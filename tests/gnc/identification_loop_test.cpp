@@ -286,6 +286,23 @@ TEST(GncIdentification, AModelThatFailsValidationIsRefusedWithAnEvent) {
   EXPECT_EQ(loop.gnc.model_candidate(candidate), ModelCandidate::kInvalid);
 }
 
+// The flight's identification at the study's scale (gnc.yaml): joint step, the priors of the
+// cases (10^7 kg m^2, 1 m, a 1 % strength), the second-order term, the innovation gate, and the
+// excitation's amplitudes and start (off until a test enables it).
+IdentificationParams& study_scale_identification(GncParams& p, double window_s) {
+  IdentificationParams& id = p.identification;
+  id.enabled = true;
+  id.config.window_s = window_s;
+  id.config.j_prior_sigma = 1e7;
+  id.config.r_prior_sigma = 1.0;
+  id.config.k_prior_sigma = 0.01;
+  id.config.second_order_noise = true;
+  id.config.gate_chi2 = 16.27;
+  id.excitation.force_n = Vec3(100.0, 100.0, 400.0);
+  id.excitation.start_after_s = 60.0;
+  return id;
+}
+
 // gnc/estimation/README.md §I.6: at the study's scale, a D+PD despin from the SPEC §5 initial rate
 // with r_hat 1 m off (the case-4 direction) and J_hat 1e7 kg m^2 off, case 7's sensors and
 // disturbance (gyro PSD 1e-10 rad^2/s, the 1 N m disturbance held 10 s; seeded) and the flight's
@@ -318,20 +335,11 @@ DespinRun despin_identification(bool excite, AllocatorKind allocator, bool quiet
   p.mass_hat.j_ast(0, 0) += 6.0e6;  // the case-4 direction (-1, 1, 0.5), scaled down
   p.mass_hat.j_ast(1, 1) -= 6.0e6;
   p.mass_hat.j_ast(2, 2) -= 3.0e6;
-  IdentificationParams& id = p.identification;
-  id.enabled = true;
-  id.config.window_s = quiet ? 20.0 : 60.0;
+  IdentificationParams& id = study_scale_identification(p, quiet ? 20.0 : 60.0);
   const double gyro_sigma = quiet ? 0.0 : std::sqrt(1e-10 / p.dt);
   id.config.gyro_sigma = gyro_sigma;
   id.config.gyro_bias_sigma = quiet ? 0.0 : 3e-5;
-  id.config.j_prior_sigma = 1e7;
-  id.config.r_prior_sigma = 1.0;
-  id.config.k_prior_sigma = 0.01;
-  id.config.second_order_noise = true;
-  id.config.gate_chi2 = 16.27;
   id.excitation.enabled = excite;
-  id.excitation.force_n = Vec3(100.0, 100.0, 400.0);
-  id.excitation.start_after_s = 60.0;  // the flight setting (gnc.yaml)
   id.excitation.r_sigma_target_m = r_sigma_target_m;
   EXPECT_TRUE(loop.gnc.init(p).ok);
   GncCommands c;
@@ -453,17 +461,8 @@ InertiaPhaseRun inertia_phase_run(double couple_nm, AllocatorKind allocator, boo
   p.mass_hat.j_ast(0, 0) += 1.0e7;
   p.mass_hat.j_ast(1, 1) -= 1.0e7;
   p.mass_hat.j_ast(2, 2) -= 5.0e6;
-  IdentificationParams& id = p.identification;
-  id.enabled = true;
-  id.config.window_s = 20.0;
-  id.config.j_prior_sigma = 1e7;
-  id.config.r_prior_sigma = 1.0;
-  id.config.k_prior_sigma = 0.01;
-  id.config.second_order_noise = true;
-  id.config.gate_chi2 = 16.27;
+  IdentificationParams& id = study_scale_identification(p, 20.0);
   id.excitation.enabled = true;
-  id.excitation.force_n = Vec3(100.0, 100.0, 400.0);
-  id.excitation.start_after_s = 60.0;
   id.excitation.r_sigma_target_m = 0.01;
   id.excitation.inertia_torque_nm = Vec3::Constant(couple_nm);
   EXPECT_TRUE(loop.gnc.init(p).ok);
