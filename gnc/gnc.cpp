@@ -825,6 +825,9 @@ void Gnc::fill_estimation_telemetry(GncTelemetry& tl) const {
   e.r_sigma = est.r_sigma;
   e.k = est.k;
   e.k_sigma = est.k_sigma;
+  e.j_cov = est.j_cov;
+  e.r_cov = est.r_cov;
+  e.thrust_scale_sigma = est.thrust_scale_sigma;
   e.inertia_confident = est.inertia_confident;
   e.offset_confident = est.offset_confident;
   std::uint16_t confident = 0;

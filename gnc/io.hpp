@@ -161,6 +161,9 @@ struct EstimationTelemetry {
   Vec3 r_sigma{Vec3::Zero()};
   Vec16 k{Vec16::Zero()};            // identified thruster strengths
   Vec16 k_sigma{Vec16::Zero()};
+  Vec21 j_cov{Vec21::Zero()};        // covariance of j, packed (pack_upper), kg^2 m^4
+  Vec6 r_cov{Vec6::Zero()};          // covariance of r, packed, m^2
+  double thrust_scale_sigma{0.0};    // (I29) relative 1 sigma of the thrust scale the identifier anchors
   bool inertia_confident{false};
   bool offset_confident{false};
   std::uint16_t thruster_confident{0};  // bit i: thruster i within its confidence bound

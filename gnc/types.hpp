@@ -22,5 +22,30 @@ inline constexpr int kPods = 4;      // SPEC §4: four RCS pods
 inline constexpr int kThrusters = 2 * kChannels;
 
 using Vec16 = Eigen::Matrix<double, kThrusters, 1>;
+using Vec21 = Eigen::Matrix<double, 21, 1>;  // a packed symmetric 6 x 6 (pack_upper)
+
+// The upper triangle of a symmetric N x N matrix row by row ((0,0) (0,1) ... (0,N-1) (1,1) ...),
+// and back: telemetry carries a covariance in N (N + 1) / 2 numbers.
+template <int N>
+Eigen::Matrix<double, N*(N + 1) / 2, 1> pack_upper(const Eigen::Matrix<double, N, N>& m) {
+  Eigen::Matrix<double, N*(N + 1) / 2, 1> v;
+  int k = 0;
+  for (int i = 0; i < N; ++i) {
+    for (int j = i; j < N; ++j) v(k++) = m(i, j);
+  }
+  return v;
+}
+template <int N>
+Eigen::Matrix<double, N, N> unpack_upper(const Eigen::Matrix<double, N*(N + 1) / 2, 1>& v) {
+  Eigen::Matrix<double, N, N> m;
+  int k = 0;
+  for (int i = 0; i < N; ++i) {
+    for (int j = i; j < N; ++j) {
+      m(i, j) = v(k);
+      m(j, i) = v(k++);
+    }
+  }
+  return m;
+}
 
 }  // namespace rocksteady::gnc

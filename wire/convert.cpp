@@ -115,6 +115,9 @@ void fill_gnc(const gnc::GncOutput& out, rocksteady::gnc_telemetry_t& m) {
   put(e.r_sigma, m.id_r_sigma);
   put(e.k, m.id_k);
   put(e.k_sigma, m.id_k_sigma);
+  put(e.j_cov, m.id_j_cov);
+  put(e.r_cov, m.id_r_cov);
+  m.id_thrust_scale_sigma = e.thrust_scale_sigma;
   m.id_inertia_confident = e.inertia_confident ? 1 : 0;
   m.id_offset_confident = e.offset_confident ? 1 : 0;
   m.id_thruster_confident = e.thruster_confident;

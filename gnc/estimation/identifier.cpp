@@ -949,6 +949,22 @@ void Identifier::anchor_scale() {
   }
 }
 
+double Identifier::thrust_scale_sigma() const {
+  // (I29) sigma of eps, the relative error of the anchored scale: the calibration's mean error of
+  // the n reference thrusters (independent, sigma_k each) over their mean prior strength b.
+  if (!c_.anchor_thrust_scale) return 0.0;  // the k prior holds the scale in P itself
+  int n = 0;
+  double b = 0.0;
+  for (int i = 0; i < kThrusters; ++i) {
+    if (!reference_[i]) continue;
+    b += c_.k0(i);
+    ++n;
+  }
+  if (n == 0 || !(b > 0.0)) return 0.0;
+  b /= n;
+  return c_.k_prior_sigma / (std::sqrt(static_cast<double>(n)) * b);
+}
+
 void Identifier::anchor_scale_finish() {
   if (!anchor_.pc_pending) return;
   anchor_.pc_pending = false;
@@ -1411,12 +1427,27 @@ void Identifier::update_strengths() {
 
 void Identifier::report() {
   // Estimates and 1 sigma.
+  // (I29) The covariance is conditional on the thrust scale the anchor (I15) holds; the true mean
+  // strength of the reference thrusters is the calibration's, b (1 + eps) with
+  // eps ~ N(0, sigma_k^2 / (n b^2)), and the data cannot tell eps (every datum is invariant under
+  // (J, k) -> ((1 + eps) J, (1 + eps) k)). The reported 1 sigma of J and k are the marginal ones:
+  // var(a_i) + var(eps) a_i^2, var(k_i) + var(eps) k_i^2.
+  est_.thrust_scale_sigma = thrust_scale_sigma();
+  const double ve = est_.thrust_scale_sigma * est_.thrust_scale_sigma;
   est_.j = inertia_matrix(a_);
-  est_.j_sigma = p_j_.diagonal().cwiseMax(0.0).cwiseSqrt();
+  est_.j_sigma = (p_j_.diagonal() + ve * a_.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
   est_.r = r_;
   est_.r_sigma = p_r_.diagonal().cwiseMax(0.0).cwiseSqrt();
   est_.k = k_;
-  est_.k_sigma = p_k_.diagonal().cwiseMax(0.0).cwiseSqrt();
+  est_.k_sigma = (p_k_.diagonal() + ve * k_.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+  est_.j_cov = pack_upper<6>(p_j_);
+  {
+    int n = 0;
+    for (int i = 0; i < 6; ++i) {
+      for (int j = i; j < 6; ++j) est_.j_cov(n++) += ve * a_(i) * a_(j);
+    }
+  }
+  est_.r_cov = pack_upper<3>(p_r_);
   est_.gyro_bias = b_;
   est_.gyro_bias_sigma = p_b_.diagonal().cwiseMax(0.0).cwiseSqrt();
 

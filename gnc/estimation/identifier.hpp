@@ -227,6 +227,15 @@ struct IdentifierEstimate {
   Vec3 r_sigma{Vec3::Zero()};
   Vec16 k{Vec16::Ones()};
   Vec16 k_sigma{Vec16::Zero()};
+  // (I29) Relative 1 sigma of the thrust scale the anchor (I15) holds: the thrusters' mean
+  // calibration error. j_sigma and k_sigma include it (their marginal 1 sigma); the covariances
+  // (inertia_covariance() ...) are conditional on the scale, which no prediction of the motion
+  // depends on (J^-1 (tau(k) - omega x J omega) is invariant under (J, k) -> (sJ, sk)).
+  double thrust_scale_sigma{0.0};
+  // The marginal covariances of J's parameters (with the scale, I29) and of r, packed (pack_upper):
+  // the normalised error of J is da' C^-1 da with the correlations, not the sum over 1 sigma.
+  Vec21 j_cov{Vec21::Zero()};
+  Vec6 r_cov{Vec6::Zero()};
   Vec3 gyro_bias{Vec3::Zero()};  // bias of the given rate (I17), rad/s
   Vec3 gyro_bias_sigma{Vec3::Zero()};
   bool inertia_confident{false};
@@ -398,6 +407,7 @@ class Identifier {
   // only.
   void finish_kept_rows(const std::array<bool, kIdParams>& kept);
   void anchor_scale_finish();
+  double thrust_scale_sigma() const;  // (I29)
   // reinflate_all's rewrite of p_all_, deferred to the identifier's next block (or to whatever
   // reads p_all_ first).
   void complete_reinflation();

@@ -7,6 +7,8 @@
 #include <exception>
 #include <memory>
 
+#include <Eigen/Cholesky>
+
 #include "gnc/estimation/identifier.hpp"
 #include "gnc/math/rotation.hpp"
 #include "ground/campaign/plant_binding.hpp"
@@ -25,6 +27,26 @@ const char* to_string(RunStatus s) {
   }
   return "?";
 }
+
+template <int N>
+double normalised_error(const Eigen::Matrix<double, N, 1>& err,
+                        const Eigen::Matrix<double, N*(N + 1) / 2, 1>& cov_packed,
+                        const Eigen::Matrix<double, N, 1>& sigma) {
+  const Eigen::Matrix<double, N, N> c = gnc::unpack_upper<N>(cov_packed);
+  const Eigen::LLT<Eigen::Matrix<double, N, N>> llt(c);
+  if (llt.info() == Eigen::Success && c.diagonal().minCoeff() > 0.0) {
+    const double e = err.dot(llt.solve(err));
+    if (std::isfinite(e)) return e;
+  }
+  // Not positive definite (not yet reported, or a direction known exactly): the 1 sigma alone.
+  return err.cwiseQuotient(sigma.cwiseMax(1e-300)).squaredNorm();
+}
+template double normalised_error<3>(const Eigen::Matrix<double, 3, 1>&,
+                                    const Eigen::Matrix<double, 6, 1>&,
+                                    const Eigen::Matrix<double, 3, 1>&);
+template double normalised_error<6>(const Eigen::Matrix<double, 6, 1>&,
+                                    const Eigen::Matrix<double, 21, 1>&,
+                                    const Eigen::Matrix<double, 6, 1>&);
 
 gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& strategy) {
   gnc::GncParams p = setup.flight;
@@ -119,8 +141,9 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     r.series.reserve(static_cast<std::size_t>(n_ticks / log_every + 2));
   }
 
-  // The identifier's errors against the truth, with its reported 1 sigma (diagonal NEES, 6 and
-  // 3 dof): the marks and the time series.
+  // The identifier's errors against the truth, with its reported covariances (NEES e' C^-1 e, 6
+  // and 3 dof; the correlations count: J's errors along the thrust scale (I29) are one number in
+  // six parameters): the marks and the time series.
   const Eigen::Matrix3d j_true = plant.inertia();
   const Eigen::Vector3d r_true = setup.truth.mass.r_so_bcm;
   const gnc::Vec16 k_true = setup.truth.thruster_strength;
@@ -133,8 +156,8 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
     return IdentificationErrors{
         (j_hat - j_true).norm() / j_true.norm(), (e.r - r_true).norm(),
         (e.k - k_true).cwiseAbs().maxCoeff(),
-        da.cwiseQuotient(e.j_sigma.cwiseMax(1e-300)).squaredNorm(),
-        (e.r - r_true).cwiseQuotient(e.r_sigma.cwiseMax(1e-300)).squaredNorm()};
+        normalised_error<6>(da, e.j_cov, e.j_sigma),
+        normalised_error<3>(e.r - r_true, e.r_cov, e.r_sigma)};
   };
 
   ConvergenceTracker omega_conv(setup.omega_tol_rad_s);

@@ -258,5 +258,12 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
 // The flight parameters of a strategy: the case's GncParams with the strategy's law.
 gnc::GncParams flight_params(const config::RunSetup& setup, const Strategy& strategy);
 
+// The normalised estimation error err' C^-1 err with C the packed covariance (gnc::pack_upper);
+// when C is not positive definite, the sum of (err_i / sigma_i)^2. Instantiated for N = 3, 6.
+template <int N>
+double normalised_error(const Eigen::Matrix<double, N, 1>& err,
+                        const Eigen::Matrix<double, N*(N + 1) / 2, 1>& cov_packed,
+                        const Eigen::Matrix<double, N, 1>& sigma);
+
 
 }  // namespace rocksteady::campaign

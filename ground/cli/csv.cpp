@@ -86,7 +86,7 @@ void visit(const rocksteady::gnc_telemetry_t& m, Sink& s) {
   RS_I(thrusters_enabled); RS_A(channel_force); RS_D(fuel_kg);
   RS_I(mekf_active); RS_A(gyro_bias); RS_A(attitude_sigma); RS_A(gyro_bias_sigma);
   RS_I(star_gated); RS_I(identifying); RS_A(id_j); RS_A(id_j_sigma); RS_A(id_r); RS_A(id_r_sigma);
-  RS_A(id_k); RS_A(id_k_sigma); RS_I(id_inertia_confident); RS_I(id_offset_confident);
+  RS_A(id_k); RS_A(id_k_sigma); RS_A(id_j_cov); RS_A(id_r_cov); RS_D(id_thrust_scale_sigma); RS_I(id_inertia_confident); RS_I(id_offset_confident);
   RS_I(id_thruster_confident); RS_I(id_excited_inertia); RS_I(id_excited_offset);
   RS_I(id_excited_thrusters); RS_I(id_offset_unobservable); RS_A(id_residual_torque);
   RS_D(id_residual_chi2); RS_I(id_windows); RS_A(id_rate_bias_sigma); RS_I(id_windows_gated);

@@ -1,6 +1,7 @@
 // Campaign outputs: results.csv header and NC fields, the Markdown table layout, time series, plots.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "ground/campaign/campaign.hpp"
+#include "ground/campaign/runner.hpp"
 
 namespace rocksteady::campaign {
 namespace {
@@ -30,6 +32,39 @@ std::vector<std::string> lines(const std::string& text) {
   std::string l;
   while (std::getline(ss, l)) out.push_back(l);
   return out;
+}
+
+// The identification marks' NEES (gnc/estimation README §I.11): e' C^-1 e with the reported
+// covariance, packed row by row, against an explicit inverse; J's errors along one direction (the
+// thrust scale) are one number, so the per-parameter sum over-counts them six times. A covariance
+// that is not positive definite falls back to the 1 sigma form.
+TEST(CampaignOutputs, TheNormalisedErrorUsesTheCorrelations) {
+  Eigen::Matrix<double, 6, 6> c = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> v, sigma;
+  v << 2.0e7, 1.8e7, 3.1e7, -0.4e7, 0.2e7, 0.9e6;  // a J's parameters
+  for (int i = 0; i < 6; ++i) c(i, i) = std::pow(1e-3 * (1.0 + 0.3 * i) * 2e7, 2.0);
+  for (int i = 0; i < 5; ++i) c(i, i + 1) = c(i + 1, i) = 0.2 * std::sqrt(c(i, i) * c(i + 1, i + 1));
+  const double s_eps = 2.5e-3;
+  c += s_eps * s_eps * v * v.transpose();
+  const Eigen::Matrix<double, 21, 1> packed = gnc::pack_upper<6>(c);
+  int k = 0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = i; j < 6; ++j) ASSERT_EQ(packed(k++), c(i, j)) << i << " " << j;
+  }
+  EXPECT_TRUE(gnc::unpack_upper<6>(packed) == c);
+  for (int i = 0; i < 6; ++i) sigma(i) = std::sqrt(c(i, i));
+  Eigen::Matrix<double, 6, 1> err = 2.0 * s_eps * v;  // a 2 sigma thrust-scale error
+  err(1) += 0.5 * std::sqrt(c(1, 1));
+  const double expected = err.dot(c.inverse() * err);
+  const double got = normalised_error<6>(err, packed, sigma);
+  EXPECT_NEAR(got, expected, 1e-9 * expected);
+  const double diagonal = err.cwiseQuotient(sigma).squaredNorm();
+  std::printf("NEES %.2f with the correlations, %.2f from the 1 sigma alone\n", got, diagonal);
+  EXPECT_GT(diagonal, 2.0 * got);
+  // Not positive definite (nothing reported yet): the 1 sigma form.
+  const Eigen::Matrix<double, 6, 1> zero_cov = Eigen::Matrix<double, 6, 1>::Zero();
+  const Eigen::Vector3d e3(0.01, -0.02, 0.03), s3(0.01, 0.01, 0.02);
+  EXPECT_DOUBLE_EQ(normalised_error<3>(e3, zero_cov, s3), 1.0 + 4.0 + 2.25);
 }
 
 TEST(CampaignOutputs, ResultsCsvHasTheExactHeaderAndEmptyFieldsForNc) {
