@@ -187,6 +187,11 @@ GncConfig load_gnc(const std::string& path) {
     }
     ic.window_s = r.positive("window_s");
     g.id_window_noisy_s = r.positive("window_noisy_s");
+    if (r.has("window_early_s") || r.has("window_early_span_s")) {  // (I30), optional: off when absent
+      ic.early_window_s = r.non_negative("window_early_s");
+      ic.early_span_s = r.non_negative("window_early_span_s");
+      if (ic.early_window_s > ic.window_s) r.fail("window_early_s", "must not exceed window_s");
+    }
     ic.j_prior_sigma = r.positive("inertia_prior_sigma_kg_m2");
     ic.r_prior_sigma = r.positive("offset_prior_sigma_m");
     ic.k_prior_sigma = r.positive("strength_prior_sigma");
@@ -479,7 +484,12 @@ gnc::GncParams flight_params(const MissionConfig& m, const GncConfig& g, const C
   // passes a perfect gyro through, the MEKF's rate is then the gyro less the bias, without the
   // model's lag (which with the case-4 model error costs the fuel-optimal trackers 50 %).
   if (c.gyro_psd <= 0.0) p.mekf.rate_cutoff = 0.0;
-  if (noisy) p.identification.config.window_s = g.id_window_noisy_s;
+  if (noisy) {
+    p.identification.config.window_s = g.id_window_noisy_s;
+    // (I30) Early windows with quiet sensors only: a noisy gyro needs the long window from the first.
+    p.identification.config.early_window_s = 0.0;
+    p.identification.config.early_span_s = 0.0;
+  }
   // A gyro is never noise-free: the detector assumes at least 1e-7 rad/s per sample (a
   // navigation-grade gyro's resolution), so the noise-free cases do not trust rates to the bit.
   // That floor was measured with the start sample's noise counted in every sample (2 sigma^2,

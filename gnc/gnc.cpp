@@ -705,8 +705,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
       const bool healthy = (lim.lo.array() < 0.0).all() && (lim.hi.array() > 0.0).all() &&
                            (lim.bias.array() == 0.0).all();
       const IdentifierEstimate& e = ident_.estimate();
-      const double identified_s =
-          static_cast<double>(ident_.counters().windows) * params_.identification.config.window_s;
+      const double identified_s = ident_.identified_s();
       if (healthy && modes_.mode() == Mode::kDetumble && excite_.inertia_wanted(identified_s)) {
         // (X8) Before start_after_s: the allocation made force-free (r_hat still unknown) and a
         // couple added, one axis per window. In DETUMBLE only: there the despin's own torque
@@ -717,8 +716,7 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
                                     identified_s)) {
         // (X7) The amplitude for this window's noise (fixed within a window: the noise is the
         // last closed window's).
-        excite_.size_to_window_noise(ident_.latched_window_noise(),
-                                     params_.identification.config.window_s);
+        excite_.size_to_window_noise(ident_.latched_window_noise(), ident_.latched_window_s());
         excite_status_ = excite_.apply(excite_.force(ident_.counters().windows), lim.lo, lim.hi,
                                        params_.dt, u);
       }

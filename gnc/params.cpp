@@ -33,6 +33,8 @@ void apply_flight_identification_settings(GncParams& p, double gyro_sigma) {
   const bool noisy = gyro_sigma > 0.0;
   c.mode = IdentifierMode::kJoint;
   c.window_s = noisy ? 60.0 : 20.0;
+  c.early_window_s = noisy ? 0.0 : 12.0;  // (I30)
+  c.early_span_s = noisy ? 0.0 : 60.0;
   c.j_prior_sigma = 1e7;
   c.r_prior_sigma = 1.0;
   c.k_prior_sigma = 0.01;
@@ -63,6 +65,13 @@ IdentifierConfig build_identifier_config(const GncParams& p) {
   c.j0 = total_inertia(p.mass_hat);
   c.r0 = p.mass_hat.r_so_bcm;
   c.k0 = p.rcs.strength;
+  // (I30) Early windows only while the excitation's inertia phase (X8) can fly its couples:
+  // without them, short windows from a far prior measured worse at 60 s (estimation README I.12).
+  const ExcitationConfig& x = p.identification.excitation;
+  if (!(x.enabled && (x.inertia_torque_nm.array() > 0.0).any())) {
+    c.early_window_s = 0.0;
+    c.early_span_s = 0.0;
+  }
   // (I22) With the detector's stuck-on isolation inside identification (F14), the identifier
   // carries a constant fault torque whose prior 1 sigma is the largest single-jet torque.
   c.fault_torque_sigma = 0.0;

@@ -147,6 +147,19 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
   if (std::fabs(ticks - static_cast<double>(n)) > 1e-6 || n < 8 || n % 2 != 0 || n > 1000000) {
     return bad("window_s", "must be an even number of ticks, at least 8");
   }
+  if (!(std::isfinite(c.early_window_s) && c.early_window_s >= 0.0)) {
+    return bad("early_window_s", "must be >= 0 and finite");
+  }
+  if (!(std::isfinite(c.early_span_s) && c.early_span_s >= 0.0)) {
+    return bad("early_span_s", "must be >= 0 and finite");
+  }
+  if (c.early_window_s > 0.0) {
+    const double et = c.early_window_s / c.dt;
+    if (std::fabs(et - std::round(et)) > 1e-6 || std::lround(et) % 2 != 0 || std::lround(et) < 8) {
+      return bad("early_window_s", "must be an even number of ticks, at least 8");
+    }
+    if (c.early_window_s > c.window_s) return bad("early_window_s", "must not exceed window_s");
+  }
   for (int ch = 0; ch < kChannels; ++ch) {
     if (!c.rcs.channel_direction[ch].allFinite() ||
         std::fabs(c.rcs.channel_direction[ch].norm() - 1.0) > 1e-6) {
@@ -226,8 +239,15 @@ IdentifierConfigCheck validate(const IdentifierConfig& c) {
 
 void Identifier::configure(const IdentifierConfig& c) {
   c_ = c;
-  n_ = static_cast<int>(std::lround(c.window_s / c.dt));
+  n_full_ = static_cast<int>(std::lround(c.window_s / c.dt));
+  n_early_ = c.early_window_s > 0.0 && c.early_span_s > 0.0
+                 ? static_cast<int>(std::lround(c.early_window_s / c.dt))
+                 : 0;
+  n_ = n_full_;
   dist_factor_ = held_disturbance_factor(c.window_s, c.disturbance_corr_s);
+  dist_factor_early_ =
+      n_early_ > 0 ? held_disturbance_factor(c.early_window_s, c.disturbance_corr_s) : 0.0;
+  const int n_min = n_early_ > 0 ? std::min(n_early_, n_full_) : n_full_;
   // Ticks of one joint step: linearisation, the second-order term (3), the information gate
   // (I26), gain rows, gain, a gate re-inflation (4), apply, covariance rows, finish, strengths
   // and report. Smallest blocks that let the step end well before the next window closes.
@@ -241,7 +261,7 @@ void Identifier::configure(const IdentifierConfig& c) {
   gain_rows_per_tick_ = 4;
   cov_rows_per_tick_ = 1;
   // (4/5 of the window: ticks withheld for other periodic work must not make the step overrun.)
-  while (ticks_for(gain_rows_per_tick_, cov_rows_per_tick_) > (n_ - 1) * 4 / 5 &&
+  while (ticks_for(gain_rows_per_tick_, cov_rows_per_tick_) > (n_min - 1) * 4 / 5 &&
          cov_rows_per_tick_ < kIdParams) {
     cov_rows_per_tick_ = std::min(kIdParams, 2 * cov_rows_per_tick_);
     gain_rows_per_tick_ = std::min(kIdParams, 2 * gain_rows_per_tick_);
@@ -289,6 +309,8 @@ void Identifier::reset() {
   acc_ = Window{};
   latched_ = Window{};
   sample_ = -1;
+  identified_s_ = 0.0;
+  n_ = window_ticks_next();
   phase_ = Phase::kIdle;
   latched_noise_ = 1.0;
   latched_r_ = Mat3::Identity();
@@ -633,13 +655,13 @@ void Identifier::joint_gain() {
   VecId& d = joint_.d;
   d.setOnes();
   if (exc_.inertia_scale && c_.j_forget_s > 0.0) {
-    d.head<6>().setConstant(std::exp(0.5 * c_.window_s / c_.j_forget_s));
+    d.head<6>().setConstant(std::exp(0.5 * latched_.length_s / c_.j_forget_s));
   }
   if (exc_.offset && c_.r_forget_s > 0.0) {
-    d.segment<3>(6).setConstant(std::exp(0.5 * c_.window_s / c_.r_forget_s));
+    d.segment<3>(6).setConstant(std::exp(0.5 * latched_.length_s / c_.r_forget_s));
   }
   if (joint_.any_thruster && c_.k_forget_s > 0.0) {
-    d.segment<kThrusters>(kIdK).setConstant(std::exp(0.5 * c_.window_s / c_.k_forget_s));
+    d.segment<kThrusters>(kIdK).setConstant(std::exp(0.5 * latched_.length_s / c_.k_forget_s));
   }
   // (I20) on the next ticks (second_order_step), one part per tick.
   joint_.second_order.setZero();
@@ -1064,6 +1086,12 @@ void Identifier::accumulate(const IdentifierInput& in) {
   acc_.n += (alpha * wdt) * in.omega;
 }
 
+int Identifier::window_ticks_next() const {
+  // (I30) Early windows while one more still closes within early_span_s of identification.
+  if (n_early_ > 0 && identified_s_ + n_early_ * c_.dt <= c_.early_span_s + 1e-9) return n_early_;
+  return n_full_;
+}
+
 void Identifier::finish_step() {
   complete_reinflation();
   for (int guard = 0; phase_ != Phase::kIdle && guard < 4 * kIdParams; ++guard) step_phase();
@@ -1092,6 +1120,10 @@ void Identifier::update(const IdentifierInput& in, bool background) {
   if (sample_ == n_) {
     finish_step();  // only when ticks were withheld from a window too short for the blocks
     latched_ = acc_;
+    latched_.length_s = n_ * c_.dt;
+    latched_.dist_factor = n_ == n_full_ ? dist_factor_ : dist_factor_early_;
+    identified_s_ += latched_.length_s;
+    n_ = window_ticks_next();
     latched_noise_ = window_noise();
     latched_r_ = window_noise_matrix();
     ++counters_.windows;
@@ -1217,7 +1249,7 @@ double Identifier::window_noise() const {
   const double jn = inertia_matrix(a_).norm();
   const double g2 = c_.gyro_sigma * c_.gyro_sigma;
   const double gyro = g2 * jn * jn * (latched_.sum_alpha2 + 4.0 * latched_.sum_gyro2);
-  const double t = c_.window_s;
+  const double t = latched_.length_s;
   const double dist = c_.disturbance_sigma * c_.disturbance_sigma * c_.disturbance_corr_s * t / 3.0;
   const double floor = c_.torque_floor * latched_.weight;
   return gyro + dist + floor * floor;
@@ -1290,7 +1322,7 @@ Mat3 Identifier::window_noise_matrix() const {
     }
   }
   const double g2 = c_.gyro_sigma * c_.gyro_sigma;
-  const double dist = c_.disturbance_sigma * c_.disturbance_sigma * dist_factor_;
+  const double dist = c_.disturbance_sigma * c_.disturbance_sigma * latched_.dist_factor;
   const double floor = c_.torque_floor * latched_.weight;
   Mat3 r = g2 * c;
   r = 0.5 * (r + r.transpose()).eval();
@@ -1351,7 +1383,7 @@ void Identifier::update_inertia() {
   const Vec6 a_keep = a_;
   const Mat6 p_keep = p_j_;
   const double prior_var = c_.j_prior_sigma * c_.j_prior_sigma;
-  if (exc_.inertia_scale) forget<6>(p_j_, c_.window_s, c_.j_forget_s, prior_var);
+  if (exc_.inertia_scale) forget<6>(p_j_, latched_.length_s, c_.j_forget_s, prior_var);
   // The other groups' uncertainty enters as measurement noise (I7).
   const Mat3 r_noise = latched_r_ + consider_offset() + consider_strengths();
   residual_cov_ = r_noise + consider_inertia();
@@ -1390,7 +1422,7 @@ void Identifier::update_offset() {
   const Vec3 r_keep = r_;
   const Mat3 p_keep = p_r_;
   const Mat3 r_noise = latched_r_ + consider_inertia() + consider_strengths();
-  forget<3>(p_r_, c_.window_s, c_.r_forget_s, c_.r_prior_sigma * c_.r_prior_sigma);
+  forget<3>(p_r_, latched_.length_s, c_.r_forget_s, c_.r_prior_sigma * c_.r_prior_sigma);
   rls_update<3>(r_, p_r_, phi, y, r_noise);
   if (!r_.allFinite() || (r_ - c_.r0).norm() > c_.r_max_offset) {
     r_ = r_keep;
@@ -1412,7 +1444,7 @@ void Identifier::update_strengths() {
   const Mat316 phi = strength_regressor();
   const Vec3 y = latched_.a_j * a_;
   const Mat3 r_noise = latched_r_ + consider_inertia() + consider_offset();
-  forget<kThrusters>(p_k_, c_.window_s, c_.k_forget_s, c_.k_prior_sigma * c_.k_prior_sigma);
+  forget<kThrusters>(p_k_, latched_.length_s, c_.k_forget_s, c_.k_prior_sigma * c_.k_prior_sigma);
   rls_update<kThrusters>(k_, p_k_, phi, y, r_noise);
   for (int i = 0; i < kThrusters; ++i) {
     const double clamped = std::fmin(std::fmax(k_(i), c_.k_min), c_.k_max);

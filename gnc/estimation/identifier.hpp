@@ -71,6 +71,11 @@ struct IdentifierConfig {
   IdentifierMode mode{IdentifierMode::kJoint};
   double dt{0.1};         // s, tick period
   double window_s{20.0};  // s, modulating-window length T (an even number of ticks)
+  // (I30) The windows that close within the first early_span_s of identification are
+  // early_window_s long (an even number of ticks, at most window_s): more steps while the prior is
+  // far and the couples of the excitation's inertia phase (X8) cycle. 0: every window window_s.
+  double early_window_s{0.0};
+  double early_span_s{0.0};
   RcsLayout rcs{};        // thruster geometry (positions, directions); u_max unused
   // Priors (the table's values) and their 1 sigma.
   Mat3 j0{Mat3::Identity()};   // kg m^2
@@ -308,6 +313,10 @@ class Identifier {
   // (I5) The variance of one row of the last closed window's equation, (N m s)^2: the gyro's
   // noise through the window, the held disturbance, the floor (0 before the first window).
   double latched_window_noise() const { return counters_.windows > 0 ? latched_noise_ : 0.0; }
+  // The last closed window's length (s), and the length of all closed windows (I30: the early
+  // windows are shorter than window_s).
+  double latched_window_s() const { return latched_.length_s > 0.0 ? latched_.length_s : c_.window_s; }
+  double identified_s() const { return identified_s_; }
   const Mat6& inertia_covariance() const { return p_j_; }
   const Mat3& offset_covariance() const { return p_r_; }
   const Mat16& strength_covariance() const { return p_k_; }
@@ -340,6 +349,8 @@ class Identifier {
     Vec3 m{Vec3::Zero()};          // sum of w dt omega: G = S(m) J - S(J m) (I17)
     Mat3 w2{Mat3::Zero()};         // sum of (w dt)^2 omega omega' (I19)
     Vec3 n{Vec3::Zero()};          // sum of alpha w dt omega (I19)
+    double length_s{0.0};          // the window's length T (I30: early windows are shorter)
+    double dist_factor{0.0};       // (I21) for that length
   };
   enum class Phase : std::uint8_t {
     kIdle, kInertia, kSecondOrder, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
@@ -428,9 +439,14 @@ class Identifier {
   void report();
   void step_phase();   // one block of the latched window's step
   void finish_step();  // every remaining block at once
+  int window_ticks_next() const;  // (I30)
 
   IdentifierConfig c_{};
-  int n_{200};                                // ticks per window
+  int n_{200};                                // ticks of the window being accumulated
+  int n_full_{200};                           // ... window_s
+  int n_early_{0};                            // ... early_window_s (I30), 0: none
+  double dist_factor_early_{0.0};             // (I21) for early_window_s
+  double identified_s_{0.0};                  // total length of the windows closed so far
   std::array<Vec3, kThrusters> e_{};          // thruster directions
   std::array<Vec3, kThrusters> p_pos_{};      // thruster positions
   std::array<Vec3, kThrusters> p_cross_e_{};  // p_i x e_i

@@ -230,6 +230,8 @@ TEST(ConfigShipped, TheFirmwaresIdentifierSettingsAreGncYamls) {
     EXPECT_EQ(f.config.min_inertia_information, y.config.min_inertia_information);
     EXPECT_EQ(f.config.min_offset_information, y.config.min_offset_information);
     EXPECT_EQ(f.config.guard_halvings, y.config.guard_halvings);
+    EXPECT_EQ(f.config.early_window_s, y.config.early_window_s);
+    EXPECT_EQ(f.config.early_span_s, y.config.early_span_s);
     EXPECT_EQ(f.config.j_forget_s, y.config.j_forget_s);
     EXPECT_EQ(f.config.r_forget_s, y.config.r_forget_s);
     EXPECT_EQ(f.config.j_confident_rel, y.config.j_confident_rel);
@@ -336,6 +338,26 @@ TEST(ConfigShipped, TheGuardHalvingsAreReadAndOptional) {
   EXPECT_EQ(load_run(kMission, without.path(), case_file(4)).flight.identification.config.guard_halvings, 0);
   TempFile bad("gnc.yaml", replaced(text, whole, "  guard_halvings: 11"));
   expect_error([&] { load_gnc(bad.path()); }, bad.path(), "identification.guard_halvings", "must be in [0, 10]");
+}
+
+// (I30) The early windows: 12 s over the first 60 s with quiet sensors, none with a noisy gyro,
+// none when the keys are absent; one longer than window_s is named with its file and key.
+TEST(ConfigShipped, TheEarlyWindowsAreReadOptionalAndQuietSensorsOnly) {
+  const std::string text = read(kGnc);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(4)).flight.identification.config.early_window_s, 12.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(4)).flight.identification.config.early_span_s, 60.0);
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.identification.config.early_window_s, 0.0);
+  const std::size_t at = text.find("  window_early_s: 12.0 ");
+  ASSERT_NE(at, std::string::npos);
+  const std::string whole = text.substr(at, text.find('\n', at) - at);
+  const std::size_t at2 = text.find("  window_early_span_s: 60.0");
+  ASSERT_NE(at2, std::string::npos);
+  const std::string span = text.substr(at2, text.find('\n', at2) - at2);
+  TempFile without("gnc.yaml", replaced(replaced(text, whole, "  #"), span, "  #"));
+  EXPECT_EQ(load_run(kMission, without.path(), case_file(4)).flight.identification.config.early_window_s, 0.0);
+  TempFile bad("gnc.yaml", replaced(text, whole, "  window_early_s: 30.0"));
+  expect_error([&] { load_gnc(bad.path()); }, bad.path(), "identification.window_early_s",
+               "must not exceed window_s");
 }
 
 TEST(ConfigShipped, TheJetCheckInformationGateIsReadAndOptional) {

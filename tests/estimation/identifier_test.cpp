@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "estimation_truth.hpp"
 #include "gnc/estimation/identifier.hpp"
@@ -104,6 +105,9 @@ TEST(IdentifierConfig, DefaultsAreValidAndTheFirstBadFieldIsNamed) {
       {[](IdentifierConfig& c) { c.k_max = 0.0; }, "k_min"},
       {[](IdentifierConfig& c) { c.unobservable_ratio = 1.0; }, "unobservable_ratio"},
       {[](IdentifierConfig& c) { c.r_confident = 0.0; }, "r_confident"},
+      {[](IdentifierConfig& c) { c.early_window_s = 12.05; }, "early_window_s"},
+      {[](IdentifierConfig& c) { c.early_window_s = 30.0; }, "early_window_s"},
+      {[](IdentifierConfig& c) { c.early_span_s = -1.0; }, "early_span_s"},
   };
   for (const Case& cs : cases) {
     IdentifierConfig c = ok;
@@ -472,6 +476,62 @@ TEST(Identifier, TheThrustScalesSigmaFollowsTheReferenceSet) {
   EXPECT_EQ(unanchored.estimate().thrust_scale_sigma, 0.0);
   const Vec6 sd = unanchored.inertia_covariance().diagonal().cwiseSqrt();
   for (int i = 0; i < 6; ++i) EXPECT_DOUBLE_EQ(unanchored.estimate().j_sigma(i), sd(i));
+}
+
+// (I30) Early windows: the windows that close within early_span_s (60 s) are early_window_s (12 s)
+// long, the rest window_s; identified_s() is their sum; every window's step ends before the next
+// window closes, the short ones included. From the case-4 prior errors with the same firings, the
+// five early steps leave J closer at 60 s than the two of 20 s windows.
+TEST(Identifier, EarlyWindowsAreShorterOnlyOverTheirSpan) {
+  TruthSetup s;
+  s.j = study_j();
+  s.r = study_true_mass_properties().r_so_bcm;
+  s.k = spread_strengths();
+  IdentifierConfig c = config_with_priors(s.j - 1e7 * Mat3(Vec3(-1, 1, 0.5).asDiagonal()),
+                                          s.r - Vec3(1, 1, 1).normalized());
+  c.second_order_noise = true;
+  c.guard_halvings = 3;
+  IdentifierConfig early = c;
+  early.early_window_s = 12.0;
+  early.early_span_s = 60.0;
+  ASSERT_TRUE(validate(early).ok);
+  Identifier plain, id;
+  plain.configure(c);
+  id.configure(early);
+  TruthRun truth(s);
+  RandomFiring fire(12);
+  std::vector<double> lengths;
+  double sum = 0.0;
+  int overrun = 0;
+  bool stepping_before = false;
+  double j60_plain = 0.0, j60_early = 0.0;
+  int tick = 0;
+  truth.run(static_cast<int>(200.0 / kDt), fire, [&](double, const test::V3& w, const test::V8& f) {
+    const std::uint32_t before = id.counters().windows;
+    stepping_before = id.stepping();
+    plain.update(id_input(w, f));
+    id.update(id_input(w, f));
+    ++tick;
+    if (id.counters().windows != before) {
+      if (stepping_before && before > 0) ++overrun;
+      lengths.push_back(id.latched_window_s());
+      sum += id.latched_window_s();
+      EXPECT_NEAR(id.identified_s(), sum, 1e-9);
+    }
+    if (tick == 600) {
+      j60_plain = j_error(plain, s.j);
+      j60_early = j_error(id, s.j);
+    }
+  });
+  ASSERT_GE(lengths.size(), 8u);
+  for (std::size_t i = 0; i < lengths.size(); ++i) {
+    EXPECT_NEAR(lengths[i], i < 5 ? 12.0 : 20.0, 1e-9) << i;
+  }
+  EXPECT_EQ(overrun, 0);
+  std::printf("J at 60 s: %.3g with 20 s windows, %.3g with five early 12 s windows\n", j60_plain,
+              j60_early);
+  EXPECT_LT(j60_early, j60_plain);
+  EXPECT_LT(j_error(id, s.j), 1e-3);
 }
 
 // (I18) A thruster that stops delivering (an unmodelled fault) after the model is identified: the
