@@ -247,7 +247,7 @@ void Identifier::configure(const IdentifierConfig& c) {
   dist_factor_ = held_disturbance_factor(c.window_s, c.disturbance_corr_s);
   dist_factor_early_ =
       n_early_ > 0 ? held_disturbance_factor(c.early_window_s, c.disturbance_corr_s) : 0.0;
-  const int n_min = n_early_ > 0 ? std::min(n_early_, n_full_) : n_full_;
+  const int n_min = n_early_ > 0 ? n_early_ : n_full_;  // validate: early_window_s <= window_s
   // Ticks of one joint step: linearisation, the second-order term (3), the information gate
   // (I26), gain rows, gain, a gate re-inflation (4), apply, covariance rows, finish, strengths
   // and report. Smallest blocks that let the step end well before the next window closes.
@@ -1466,19 +1466,14 @@ void Identifier::report() {
   // var(a_i) + var(eps) a_i^2, var(k_i) + var(eps) k_i^2.
   est_.thrust_scale_sigma = thrust_scale_sigma();
   const double ve = est_.thrust_scale_sigma * est_.thrust_scale_sigma;
+  const Mat6 j_marginal = p_j_ + ve * (a_ * a_.transpose());
   est_.j = inertia_matrix(a_);
-  est_.j_sigma = (p_j_.diagonal() + ve * a_.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+  est_.j_sigma = j_marginal.diagonal().cwiseMax(0.0).cwiseSqrt();
+  est_.j_cov = pack_upper<6>(j_marginal);
   est_.r = r_;
   est_.r_sigma = p_r_.diagonal().cwiseMax(0.0).cwiseSqrt();
   est_.k = k_;
   est_.k_sigma = (p_k_.diagonal() + ve * k_.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
-  est_.j_cov = pack_upper<6>(p_j_);
-  {
-    int n = 0;
-    for (int i = 0; i < 6; ++i) {
-      for (int j = i; j < 6; ++j) est_.j_cov(n++) += ve * a_(i) * a_(j);
-    }
-  }
   est_.r_cov = pack_upper<3>(p_r_);
   est_.gyro_bias = b_;
   est_.gyro_bias_sigma = p_b_.diagonal().cwiseMax(0.0).cwiseSqrt();
