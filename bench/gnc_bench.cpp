@@ -194,6 +194,9 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.survey_hold_only = true;              // (F43) the survey in HOLD only
   p.fdi.survey_max_kick_rad_s = 5.0e-5;       // (F44) ... and no survey check that may kick the rate
   p.fdi.survey_noise_kick = true;             // (F48) ... nor where the gyro is too noisy for one
+  p.fdi.check_long_ticks = 1000;  // (F49) ... where it is, every check in HOLD one long window
+  p.fdi.check_long_energy = 80.0;
+  p.fdi.check_long_evidence_energy = 320.0;
   p.fdi.centred_gyro_noise = true;            // (F28) the gyro's variance sigma_g^2, as flown
   p.fdi.suspect_chi2 = 30.66;                 // ... and the suspicion at 1 - 1e-6, as flown
   p.fdi.detect_early_ticks = fdi ? 3 : 0;     // (F33) early detection, as flown

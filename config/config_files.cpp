@@ -324,6 +324,16 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("survey_hold_only")) fd.survey_hold_only = r.boolean("survey_hold_only");  // (F43)
     if (r.has("survey_max_kick_rad_s")) fd.survey_max_kick_rad_s = r.non_negative("survey_max_kick_rad_s");  // (F44)
     if (r.has("survey_noise_kick")) fd.survey_noise_kick = r.boolean("survey_noise_kick");  // (F48)
+    if (r.has("check_long_ticks")) {  // (F49), off when absent
+      fd.check_long_ticks = r.integer("check_long_ticks");
+      if (fd.check_long_ticks != 0 && (fd.check_long_ticks < 4 || fd.check_long_ticks > 1000)) {
+        r.fail("check_long_ticks", "must be 0 or in [4, 1000]");
+      }
+    }
+    if (r.has("check_long_energy")) fd.check_long_energy = r.positive("check_long_energy");
+    if (r.has("check_long_evidence_energy")) {
+      fd.check_long_evidence_energy = r.positive("check_long_evidence_energy");
+    }
     if (r.has("episode_restart_leader")) fd.episode_restart_leader = r.boolean("episode_restart_leader");  // (F41)
     if (r.has("episode_restart_stale")) {  // (F38)
       fd.episode_restart_stale = r.boolean("episode_restart_stale");

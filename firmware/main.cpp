@@ -229,6 +229,9 @@ int firmware_main() {
     g_params.fdi.survey_hold_only = true;  // (F43) the survey in HOLD only
     g_params.fdi.survey_max_kick_rad_s = 5.0e-5;  // (F44) ... and no survey check that may kick the rate
     g_params.fdi.survey_noise_kick = true;  // (F48) ... nor where the gyro is too noisy for one
+    g_params.fdi.check_long_ticks = 1000;  // (F49) ... where it is, every check in HOLD one long window
+    g_params.fdi.check_long_energy = 80.0;
+    g_params.fdi.check_long_evidence_energy = 320.0;
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown

@@ -97,6 +97,15 @@ Check validate(const FaultDetectorParams& p) {
   if (p.survey_max_windows < 1 || p.survey_max_windows > 1000) {
     return bad("fdi.survey_max_windows", "must be in [1, 1000]");
   }
+  if (p.check_long_ticks != 0 && (p.check_long_ticks < 4 || p.check_long_ticks > 1000)) {
+    return bad("fdi.check_long_ticks", "must be 0 or in [4, 1000]");
+  }
+  if (!finite_positive(p.check_long_energy)) {
+    return bad("fdi.check_long_energy", "must be positive");
+  }
+  if (!finite_positive(p.check_long_evidence_energy)) {
+    return bad("fdi.check_long_evidence_energy", "must be positive");
+  }
   return Check{};
 }
 
@@ -122,6 +131,7 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
   }
   st_ = FaultDetectorStatus{};
   factor_.fill(1.0);
+  check_force_ = p_.check_force_n;
   // (F48) The least kick by which one window shows a total loss at survey_energy (F6's ramp
   // energy over n samples, the gyro's noise sigma_g).
   const double nw = static_cast<double>(p_.window_ticks);
@@ -415,9 +425,16 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
     // (F27) At a pod's closure the window restarts on this sample: every interval of the new
     // window is flown with the valve as the test set it. (F46) That window is the test's length.
     const bool test_start = restart_window_ && probe_left_ > 0 && !sweeping();
+    // (F49) A long check's window starts here; a long check whose window a gap or a declaration
+    // broke ends (the rest of it would be flown unscored).
+    const bool long_start = restart_window_ && long_start_;
+    if (check_long_n_ > 0 && !long_start) end_check();
     restart_window_ = false;
+    long_start_ = false;
     start_window(in.omega);
-    if (test_start && p_.probe_window_ticks > 0 && probe_short_) {
+    if (long_start) {
+      window_len_ = check_long_n_;
+    } else if (test_start && p_.probe_window_ticks > 0 && probe_short_) {
       window_len_ = p_.probe_window_ticks;
     }
     return pending_;
@@ -490,13 +507,43 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
       return pending_;
     }
   }
+  // (F49) A long check's window showing motion off the checked jet's signature: another fault
+  // (a jet stuck on) started within it. The check ends and its window is dropped, as (F45) drops
+  // an onset window, so that the bank decides the fault on windows of its own length. Tested on
+  // every update of the window past the early test's level (its first crossing can come while the
+  // part off the signature is still small).
+  if (check_long_n_ > 0 && st_.check_jet >= 0 && p_.detect_early_ticks > 0 &&
+      n_ >= p_.detect_early_ticks && n_ < window_len_) {
+    const double nn = static_cast<double>(n_);
+    const double var = window_var(acc, nn);
+    const double stt = acc.sum_tt - acc.sum_t * acc.sum_t / nn;
+    const Vec3 str = acc.sum_tr - acc.sum_t * (acc.sum_r / nn);
+    const Vec3 slope = stt > 0.0 ? Vec3(str / stt) : Vec3::Zero();
+    if (stt > 0.0 && slope.squaredNorm() * stt / var > p_.detect_early_chi2 &&
+        check_normal_chi2(b_[static_cast<std::size_t>(st_.check_jet)], slope, stt, var) >
+            p_.check_fit_chi2) {
+      ++st_.long_checks_dropped;
+      end_check();
+      last_suspicious_ = true;  // the next window, filled by the fault, is scored (F21)
+      check_prev_ = -1;         // the thrust commanded after this update carries no check
+      start_window(in.omega);
+      return pending_;
+    }
+  }
   // (F19) The thrust of this update was commanded while the check of the previous one ran.
   if (check_prev_ >= 0) acc.check_jet = check_prev_;
   check_prev_ = st_.check_jet;
   omega_prev_ = in.omega;
   if (n_ >= window_len_) {
+    // (F49) A long check ends with its window: the thrust commanded after this update is the
+    // next window's, without the check.
+    const bool long_end = check_long_n_ > 0 && st_.check_jet >= 0;
     close_window();
     start_window(in.omega);  // the window's last sample starts the next one
+    if (long_end) {
+      end_check();
+      check_prev_ = -1;
+    }
   }
   return pending_;
 }
@@ -1621,6 +1668,13 @@ void FaultDetector::update_check() {
       static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s));
   int jet = -1;
   double evidence = p_.check_llr;
+  // (F49) Long checks: the evidence scan gates on the model's error only; the chosen jet's force
+  // is then sized (one null-space move a decision).
+  const bool long_checks = long_mode();
+  const auto gated = [&](int g) {
+    return signature_rel_error(g) <= p_.check_max_model_error &&
+           (long_checks || !(p_.check_min_llr > 0.0) || expected_check_llr(g) >= p_.check_min_llr);
+  };
   if (p_.check_blocker && st_.best >= kThrusters && st_.best_llr > p_.confirm_llr &&
       st_.ambiguous_with >= kThrusters) {
     // (F37) The stuck-off jet that blocks a stuck-off leader is checked, evidence or not.
@@ -1629,8 +1683,7 @@ void FaultDetector::update_check() {
     if (((latched >> g) & 1u) == 0 &&
         (last_check_[k] == 0 ||
          st_.windows + 1 - last_check_[k] >= (interval << check_backoff_[k])) &&
-        signature_rel_error(g) <= p_.check_max_model_error &&
-        (!(p_.check_min_llr > 0.0) || expected_check_llr(g) >= p_.check_min_llr)) {
+        gated(g)) {
       jet = g;
       evidence = 1e300;  // no evidence outranks it
     }
@@ -1653,16 +1706,25 @@ void FaultDetector::update_check() {
         check_normal_chi2(b_[k], eval_slope_, eval_stt_, eval_var_) > p_.check_fit_chi2) {
       continue;
     }
-    if (signature_rel_error(i) <= p_.check_max_model_error &&
-        (!(p_.check_min_llr > 0.0) || expected_check_llr(i) >= p_.check_min_llr)) {
+    if (gated(i)) {
       evidence = e;
       jet = i;
     }
   }
   int windows = p_.check_windows;
+  double force = p_.check_force_n;
+  if (jet >= 0 && long_checks) {
+    force = long_check_force(jet, p_.check_long_evidence_energy, false);
+    if (!(force > 0.0)) {
+      // No long check of it within the gates: due again one interval from now (not a check).
+      last_check_[static_cast<std::size_t>(jet)] = st_.windows + 1;
+      jet = -1;
+    }
+  }
   if (jet < 0) {
     jet = survey_candidate(windows);
     if (jet < 0) return;
+    if (long_checks) force = candidate_force_;
     ++st_.surveys;
     const auto ks = static_cast<std::size_t>(jet);
     survey_e_[ks] = 0.0;  // its survey clock restarts with the check (verified or not)
@@ -1671,6 +1733,16 @@ void FaultDetector::update_check() {
   }
   st_.check_jet = jet;
   check_left_ = windows;
+  check_force_ = force;
+  if (long_checks) {
+    // (F49) One window of check_long_ticks samples, from the next one on: the window under way
+    // is dropped, as an aligned test's (F27).
+    check_left_ = 1;
+    check_long_n_ = p_.check_long_ticks;
+    long_start_ = true;
+    restart_window_ = true;
+    ++st_.long_checks;
+  }
   const auto kj = static_cast<std::size_t>(jet);
   if (last_check_[kj] != 0 && check_backoff_[kj] < 2) ++check_backoff_[kj];
   last_check_[kj] = st_.windows + 1;
@@ -1736,6 +1808,22 @@ int FaultDetector::survey_candidate(int& windows) {
   }
   if (jet < 0) return -1;
   ++st_.survey_ratings;
+  if (long_mode()) {
+    // (F49) A long check, where (F48) would refuse: its force sized to check_long_energy.
+    candidate_force_ =
+        signature_rel_error(jet) > p_.check_max_model_error
+            ? 0.0
+            : long_check_force(jet, p_.check_long_energy, true);
+    if (candidate_force_ > 0.0) {
+      windows = 1;
+      return jet;
+    }
+    ++st_.survey_kick_refusals;
+    const auto retry = std::min(
+        interval, static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s)));
+    survey_from_[static_cast<std::size_t>(jet)] = st_.windows - (interval - retry);
+    return -1;
+  }
   const bool noisy = survey_noisy_;  // (F48)
   if (noisy) ++st_.survey_noise_refusals;
   double kick_rate = 0.0;
@@ -1793,28 +1881,65 @@ double FaultDetector::expected_check_energy(int i, double* kick_rate) const {
   const double n = static_cast<double>(p_.window_ticks);
   const double f = p_.check_force_n;
   const double offset = r_sigma_ * j_inv_.norm() * f * (sum / own) * n * dt_;
-  if (kick_rate != nullptr) {
-    // (F44) The torque the model's error leaves of the move, per unit of du: the centre of mass's
-    // covariance against the net force F (tau = dr x F: S(F) R S(F)^T) and each fired jet's
-    // strength 1 sigma against its torque (independent); through J^-1, the rate's covariance
-    // per second of the check, and its root-mean-square magnitude.
-    Vec3 force = Vec3::Zero();
-    Mat3 torque_cov = Mat3::Zero();
-    for (int q = 0; q < kChannels; ++q) {
-      const auto kq = static_cast<std::size_t>(2 * q);
-      force += du(q) * dir_[kq];
-      const Vec3 tq = (m_.k_sigma * du(q)) * (pos_[kq] + m_.r).cross(dir_[kq]);
-      torque_cov += tq * tq.transpose();
-    }
-    Mat3 sf;
-    sf << 0.0, -force.z(), force.y(), force.z(), 0.0, -force.x(), -force.y(), force.x(), 0.0;
-    torque_cov += sf * m_.r_cov * sf.transpose();
-    const Mat3 rate_cov = j_inv_ * torque_cov * j_inv_.transpose();
-    *kick_rate = (f / own) * std::sqrt(std::fmax(rate_cov.trace(), 0.0));
-  }
+  if (kick_rate != nullptr) *kick_rate = (f / own) * move_kick_rate(du);
   const double var = quiet_var_ + offset * offset + 1e-30;
   const double step = b_[k].norm() * f * dt_;
   return step * step * n * (n * n - 1.0) / 12.0 / var;
+}
+
+double FaultDetector::move_kick_rate(const Vec8& du) const {
+  // (F44) The torque the model's error leaves of the move, per unit of du: the centre of mass's
+  // covariance against the net force F (tau = dr x F: S(F) R S(F)^T) and each fired jet's
+  // strength 1 sigma against its torque (independent); through J^-1, the rate's covariance
+  // per second of the check, and its root-mean-square magnitude, per unit of du.
+  Vec3 force = Vec3::Zero();
+  Mat3 torque_cov = Mat3::Zero();
+  for (int q = 0; q < kChannels; ++q) {
+    const auto kq = static_cast<std::size_t>(2 * q);
+    force += du(q) * dir_[kq];
+    const Vec3 tq = (m_.k_sigma * du(q)) * (pos_[kq] + m_.r).cross(dir_[kq]);
+    torque_cov += tq * tq.transpose();
+  }
+  Mat3 sf;
+  sf << 0.0, -force.z(), force.y(), force.z(), 0.0, -force.x(), -force.y(), force.x(), 0.0;
+  torque_cov += sf * m_.r_cov * sf.transpose();
+  const Mat3 rate_cov = j_inv_ * torque_cov * j_inv_.transpose();
+  return std::sqrt(std::fmax(rate_cov.trace(), 0.0));
+}
+
+double FaultDetector::long_check_force(int i, double energy, bool kick_gates) const {
+  // (F49) One window of N samples through which "i stuck off" ramps the residual by b_i f dt a
+  // sample has the energy s^2 f^2 g / (q + a^2 f^2): s = |b_i| dt, g = N (N^2 - 1) / 12 (F24's
+  // ramp), q the noise of a quiet window of N samples (the gyro's share as is, the rest of the
+  // last quiet window's grown with the window's length, as F5's terms grow) and a f the centre
+  // of mass's 1 sigma against the check's force over the window (F24). The least f with the
+  // energy asked, 0 when none reaches it, or when that f exceeds check_force_n, or (kick_gates) a
+  // dead jet's kick (b_i f N dt) or 3 sigma of the model's (F44) exceeds survey_max_kick_rad_s.
+  const auto k = static_cast<std::size_t>(i);
+  const int c = i / 2;
+  Vec8 du;
+  if (!check_move(c, du)) return 0.0;
+  const double own = du(c);
+  if (!(own > 0.0)) return 0.0;
+  const double nn = static_cast<double>(p_.check_long_ticks);
+  const double nw = static_cast<double>(p_.window_ticks);
+  const double t = nn * dt_;
+  const double gyro_var = (p_.centred_gyro_noise ? 1.0 : 2.0) * p_.gyro_sigma * p_.gyro_sigma;
+  const double grow = nn / nw;
+  const double q = gyro_var + std::fmax(0.0, quiet_var_ - gyro_var) * grow * grow + 1e-30;
+  const double a = r_sigma_ * j_inv_.norm() * (du.cwiseAbs().sum() / own) * t;
+  const double s = b_[k].norm() * dt_;
+  const double g = nn * (nn * nn - 1.0) / 12.0;
+  const double et = energy;
+  const double den = s * s * g - et * a * a;
+  if (!(den > 0.0)) return 0.0;
+  const double f = std::sqrt(et * q / den);
+  if (!(f <= p_.check_force_n)) return 0.0;
+  if (kick_gates && p_.survey_max_kick_rad_s > 0.0) {
+    if (b_[k].norm() * f * t > p_.survey_max_kick_rad_s) return 0.0;
+    if (3.0 * (f / own) * move_kick_rate(du) * t > p_.survey_max_kick_rad_s) return 0.0;
+  }
+  return f;
 }
 
 double FaultDetector::degraded_llr(int g) const {

@@ -226,6 +226,22 @@ struct FaultDetectorParams {
   // bound before it is confirmed, and a half-strength jet, not confirmed by one check, at every
   // survey interval. false: the survey checks whatever the gyro's noise.
   bool survey_noise_kick{false};
+  // (F49) Where (F48) refuses the survey (the gyro too noisy for a check of the bank's windows
+  // within the kick bound) and a survey may fly (HOLD, F43), every check, evidence or survey, is
+  // flown as one window of check_long_ticks samples that starts with it, at the least force
+  // whose expected stuck-off energy is check_long_energy (a dead jet gains half of it, a healthy
+  // one loses half). A ramp's energy grows with the cube of its samples: at a fixed kick K,
+  // E = K^2 (N^2 - 1) / (12 N sigma_g^2) for one window of N samples, against 1/W of that spread
+  // over W windows. The check is flown only when a dead jet's kick and 3 sigma of the model's
+  // (F44) stay within survey_max_kick_rad_s and the force within check_force_n. An early
+  // suspicion (F33) off the checked jet's signature ends it (the window dropped, as F45). 0: off.
+  // An evidence check (a jet whose stuck-off or partial-loss evidence reached check_llr) is sized
+  // to check_long_evidence_energy and gated on the force only, as an evidence check of the bank's
+  // windows is not gated on its kick (F44): it answers evidence of a fault, and a partial loss
+  // needs the energy to be told from a total one (F23) and confirmed (F18).
+  int check_long_ticks{0};
+  double check_long_energy{80.0};
+  double check_long_evidence_energy{320.0};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -313,6 +329,8 @@ struct FaultDetectorStatus {
   std::uint32_t survey_ratings{0};  // (F36) due jets rated against the check gates (<= 1 a decision)
   std::uint32_t survey_kick_refusals{0};  // (F44) due jets not surveyed: the check would kick the rate
   std::uint32_t survey_noise_refusals{0};  // (F48) due jets not surveyed: the gyro too noisy
+  std::uint32_t long_checks{0};  // (F49) of the checks, those flown as one long window
+  std::uint32_t long_checks_dropped{0};  // (F49) ended by an early suspicion off their jet
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
   std::uint32_t onset_restarts{0};  // (F45) onset windows ended at their early suspicion
@@ -381,7 +399,7 @@ class FaultDetector {
   // (F19) The thruster the detector asks to be fired for a jet check (-1 none), and at what
   // force (N, produced).
   int check_jet() const { return st_.check_jet; }
-  double check_force() const { return p_.check_force_n; }
+  double check_force() const { return check_force_; }  // (F49: the long check's own)
   // (F19, F42) The check's move of the channel forces for channel c, unscaled (du(c) in (0, 1]):
   // the minimum-norm move with no torque on the detector's model, whose channel torques are
   // (p + r_hat) x d with the identified centre of mass. False when channel c has no such move.
@@ -451,7 +469,23 @@ class FaultDetector {
   void end_check() {
     st_.check_jet = -1;
     check_left_ = 0;
+    check_long_n_ = 0;
+    long_start_ = false;
   }
+  // (F49) Long checks: whether they fly now, and the force of one of thruster i (0: none within
+  // the gates).
+  bool long_mode() const {
+    return p_.check_long_ticks > 0 && survey_noisy_ && survey_allowed_;
+  }
+  // energy: the check's expected stuck-off energy; kick_gates: F44's and F48's bounds apply.
+  double long_check_force(int i, double energy, bool kick_gates) const;
+  // (F44) The rms rate per second that the model's error leaves of the check's move du, per unit
+  // of du.
+  double move_kick_rate(const Vec8& du) const;
+  double check_force_{100.0};  // the force of the check under way (check_force_n, or F49's)
+  int check_long_n_{0};        // (F49) the samples of the long check under way, 0 none
+  bool long_start_{false};     // (F49) its window starts on the next valid sample
+  double candidate_force_{0.0};  // (F49) the survey candidate's long-check force
   int check_left_{0};
   double quiet_var_{0.0};   // (F24) the residual variance of the last window flown without a check
   int check_prev_{-1};      // the jet checked on the previous update (its thrust is this one's)

@@ -406,6 +406,32 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOnInGncYaml) {
                           });
 }
 
+// (F49) Long checks where the gyro is too noisy for the survey's: gnc.yaml's 1 000 samples at
+// energies 80 (survey) and 320 (evidence), off (0) when the key is absent (the struct's energies),
+// bad values named by file and key.
+TEST(ConfigShipped, TheLongChecksAreReadOptionalAndOnInGncYaml) {
+  const auto fd = load_run(kMission, kGnc, case_file(7)).flight.fdi;
+  EXPECT_EQ(fd.check_long_ticks, 1000);
+  EXPECT_EQ(fd.check_long_energy, 80.0);
+  EXPECT_EQ(fd.check_long_evidence_energy, 320.0);
+  expect_optional_fdi_key("  check_long_ticks: 1000", "check_long_ticks",
+                          "  check_long_ticks: 2", "must be 0 or in [4, 1000]",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(7)).flight.fdi.check_long_ticks, 0);
+                          });
+  expect_optional_fdi_key("  check_long_energy: 80.0", "check_long_energy",
+                          "  check_long_energy: 0", "", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(7)).flight.fdi.check_long_energy,
+                                      gnc::FaultDetectorParams{}.check_long_energy);
+                          });
+  expect_optional_fdi_key("  check_long_evidence_energy: 320.0", "check_long_evidence_energy",
+                          "  check_long_evidence_energy: -1", "", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(7))
+                                          .flight.fdi.check_long_evidence_energy,
+                                      gnc::FaultDetectorParams{}.check_long_evidence_energy);
+                          });
+}
+
 // (F33) Early detection: gnc.yaml's 3 samples at chi-square(3) 1 - 1e-7, off (0) when the key is
 // absent, and a bad value named by file and key.
 TEST(ConfigShipped, EarlyDetectionIsReadAndOptional) {

@@ -2120,6 +2120,209 @@ TEST(FaultDetector, NoSurveyCheckWhereTheGyroIsTooNoisyToSeeALossWithinTheKickBo
   }
 }
 
+// (F49) With case 7's gyro (3.2e-5 rad/s a sample) and 2.5 s windows, no check of the bank's
+// windows can show a jet's loss within a 5e-5 rad/s kick (F48 refuses the survey). Flown as one
+// window of 1 000 samples, a check whose expected stuck-off energy is 80 needs a kick of about
+// 3e-5 rad/s: a dead jet is surveyed, confirmed stuck off (the right jet), and the kick its
+// missing thrust put on the body over each of its long checks, b_i f T from the truth's geometry,
+// stays within the bound; the force is the least that reaches the energy against the gyro's noise
+// (computed here from the truth: at least 80, and not twice it). A healthy flight surveys its jets
+// the same way and confirms nothing; with the long checks off, nothing is surveyed at all.
+TEST(FaultDetector, WhereTheGyroIsTooNoisyTheSurveyFliesOneLongWindowWithinTheKickBound) {
+  constexpr double kBound = 5e-5;
+  constexpr int kLong = 1000;
+  constexpr double kEnergy = 80.0;
+  const auto params = [&](const Truth& t, int long_ticks) {
+    FaultDetectorParams p = survey_params(t, 300.0);
+    p.window_ticks = 25;
+    p.centred_gyro_noise = true;
+    p.survey_max_kick_rad_s = kBound;
+    p.survey_noise_kick = true;
+    p.check_long_ticks = long_ticks;
+    p.check_long_energy = kEnergy;
+    return p;
+  };
+  for (const int dead : {-1, 3, 6, 13}) {
+    for (const int long_ticks : {0, kLong}) {
+      const std::string what = "dead jet " + std::to_string(dead) + ", long window " +
+                               std::to_string(long_ticks);
+      Truth t;
+      t.gyro_sigma = 3.1623e-5;  // case 7: sqrt(1e-10 / 0.1)
+      t.stuck_off = dead;
+      t.body.omega = V3(1e-6, -2e-6, 1e-6);  // HOLD: the gyroscopic term's error is negligible
+      FaultDetector d = make_detector(t, params(t, long_ticks));
+      const Mat3 j_inv = t.body.j.inverse();
+      // HOLD's firing: every channel's one half at milli-newtons (HoldFiring without its firm jet
+      // 0, which would spin the body up over the hour flown here).
+      struct {
+        std::mt19937_64 rng;
+        Vec16 phase{Vec16::Zero()};
+        Vec16 next(int tick) {
+          std::uniform_real_distribution<double> u(0.0, 1.0);
+          if (tick % 200 == 0) {
+            phase.setZero();
+            for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
+          }
+          return phase;
+        }
+      } firing{std::mt19937_64(60 + static_cast<std::uint64_t>(dead + 1))};
+      Vec16 prev = Vec16::Zero();
+      RunResult first;
+      int long_started = 0;
+      int check_start = -1;
+      double impulse = 0.0;  // the checked jet's check impulse over the check under way, N s
+      double worst_kick = 0.0;
+      double least_energy = 1e300;
+      double most_energy = 0.0;
+      for (int k = 0; k < 60000 && first.confirmed_at < 0; ++k) {
+        FaultDetectorInput in;
+        in.omega = t.gyro();
+        in.omega_valid = true;
+        in.thrust = prev;
+        in.valve_open = t.valve;
+        const int before = d.check_jet();
+        const std::uint32_t dropped = d.status().long_checks_dropped;
+        const FaultEvents e = d.update(in);
+        if (e.confirmed) {
+          first.confirmed_at = k;
+          first.thruster = e.thruster;
+          first.kind = e.kind;
+        }
+        const int now = d.check_jet();
+        if (before >= 0 && now != before && check_start >= 0) {
+          // A check of `before` ended: its length and the dead jet's kick.
+          const int ticks = k - check_start;
+          // A long check lasts its window, unless an early suspicion off its jet ended it.
+          if (long_ticks > 0 && d.status().long_checks_dropped == dropped) {
+            EXPECT_EQ(ticks, kLong) << what;
+          }
+          EXPECT_LE(ticks, long_ticks > 0 ? kLong : 3 * 25 + 5) << what;
+          if (before == dead) {
+            const auto b = static_cast<std::size_t>(before);
+            const V3 rate = j_inv * (t.pos[b] + t.r).cross(t.dir[b]);
+            worst_kick = std::max(worst_kick, rate.norm() * impulse);
+          }
+          check_start = -1;
+        }
+        if (now >= 0 && now != before) {
+          check_start = k;
+          impulse = 0.0;
+          if (d.status().long_checks > static_cast<std::uint32_t>(long_started)) {
+            ++long_started;
+            const auto b = static_cast<std::size_t>(now);
+            const V3 rate = j_inv * (t.pos[b] + t.r).cross(t.dir[b]);
+            const double step = rate.norm() * d.check_force() * kDt;
+            const double n = kLong;
+            const double energy =
+                step * step * n * (n * n - 1.0) / 12.0 / (t.gyro_sigma * t.gyro_sigma);
+            least_energy = std::min(least_energy, energy);
+            most_energy = std::max(most_energy, energy);
+            EXPECT_LE(d.check_force(), 100.0) << what;
+          }
+        }
+        Vec16 cmd = firing.next(k);
+        if (now >= 0) {
+          cmd(now) += d.check_force();
+          impulse += d.check_force() * kDt;
+        }
+        t.advance(cmd);
+        prev = cmd;
+      }
+      if (long_ticks == 0) {
+        EXPECT_EQ(d.status().surveys, 0u) << what;
+        EXPECT_GT(d.status().survey_noise_refusals, 0u) << what;
+        EXPECT_EQ(d.status().long_checks, 0u) << what;
+        EXPECT_LT(first.confirmed_at, 0) << what;
+        continue;
+      }
+      EXPECT_GT(long_started, 0) << what;
+      EXPECT_EQ(d.status().long_checks, static_cast<std::uint32_t>(long_started)) << what;
+      EXPECT_EQ(d.status().checks, d.status().long_checks) << what << ": every check long";
+      EXPECT_GE(least_energy, 0.9 * kEnergy) << what;
+      EXPECT_LE(most_energy, 2.0 * kEnergy) << what;
+      if (dead < 0) {
+        EXPECT_LT(first.confirmed_at, 0) << what << ": false alarm, thruster " << first.thruster;
+        EXPECT_GE(d.status().surveys, 10u) << what;
+      } else {
+        ASSERT_GE(first.confirmed_at, 0) << what;
+        EXPECT_EQ(first.thruster, dead) << what;
+        EXPECT_EQ(first.kind, FaultKind::kStuckOff) << what;
+        EXPECT_GT(worst_kick, 0.2 * kBound) << what << ": the dead jet's check kicked nothing";
+        EXPECT_EQ(d.status().long_checks_dropped, 0u) << what;
+        EXPECT_LE(worst_kick, kBound) << what;
+      }
+    }
+  }
+}
+
+// (F49) A jet stuck on 30 s into a long check of another jet: the early test (F33) shows motion
+// off the checked jet's signature, and the check ends within seconds of the onset, its window
+// dropped (not after the 70 s left of it), so that the bank's windows of their own length follow.
+// (A dead checked jet's motion lies along its signature: WhereTheGyroIsTooNoisy... above flies its
+// checks whole.)
+TEST(FaultDetector, AJetStuckOnDuringALongCheckEndsIt) {
+  for (const int stuck : {2, 5, 11}) {
+    const std::string what = "thruster " + std::to_string(stuck) + " stuck on";
+    Truth t;
+    t.gyro_sigma = 3.1623e-5;
+    t.body.omega = V3(1e-6, -2e-6, 1e-6);
+    FaultDetectorParams p = survey_params(t, 300.0);
+    p.window_ticks = 25;
+    p.centred_gyro_noise = true;
+    p.survey_max_kick_rad_s = 5e-5;
+    p.survey_noise_kick = true;
+    p.check_long_ticks = 1000;
+    p.detect_early_ticks = 3;
+    p.skip_onset_window = true;
+    p.onset_restart = true;
+    FaultDetector d = make_detector(t, p);
+    std::mt19937_64 rng(80 + static_cast<std::uint64_t>(stuck));
+    Vec16 phase = Vec16::Zero();
+    Vec16 prev = Vec16::Zero();
+    int onset = -1;
+    int checked = -1;
+    int ended = -1;
+    for (int k = 0; k < 20000 && ended < 0; ++k) {
+      if (k % 200 == 0) {
+        std::uniform_real_distribution<double> u(0.0, 1.0);
+        phase.setZero();
+        for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
+      }
+      FaultDetectorInput in;
+      in.omega = t.gyro();
+      in.omega_valid = true;
+      in.thrust = prev;
+      in.valve_open = t.valve;
+      d.update(in);
+      if (onset >= 0 && d.check_jet() < 0) ended = k;
+      // 300 ticks into the first long check of a jet other than the one to stick.
+      // (A checked jet whose torque is nearly parallel to the stuck one's, its channel partner or
+      // another pod's mirror, cannot tell the two apart: not that check.)
+      const auto torque = [&t](int i) {
+        const auto b = static_cast<std::size_t>(i);
+        return V3((t.pos[b] + t.r).cross(t.dir[b]).normalized());
+      };
+      if (onset < 0 && d.check_jet() >= 0 && d.check_jet() != stuck &&
+          d.status().long_checks > 0 && std::fabs(torque(d.check_jet()).dot(torque(stuck))) < 0.8) {
+        if (checked < 0) checked = k;
+        if (k - checked == 300) {
+          onset = k;
+          t.stuck_on = stuck;
+        }
+      }
+      Vec16 cmd = phase;
+      if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
+      t.advance(cmd);
+      prev = cmd;
+    }
+    ASSERT_GE(onset, 0) << what << ": no long check flown";
+    ASSERT_GE(ended, 0) << what;
+    EXPECT_EQ(d.status().long_checks_dropped, 1u) << what;
+    EXPECT_LE(ended - onset, 50) << what << ": the check ran on";
+    EXPECT_GE(ended - onset, 3) << what << ": ended before the early test could see it";
+  }
+}
+
 TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNothingWhenHealthy) {
   for (std::uint64_t seed : {21u, 22u}) {
     Truth t;
@@ -2364,6 +2567,22 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
   p = FaultDetectorParams{};
   p.survey_max_windows = 0;
   EXPECT_STREQ(validate(p).field, "fdi.survey_max_windows");
+  for (const int ticks : {-1, 3, 1001}) {  // (F49)
+    p = FaultDetectorParams{};
+    p.check_long_ticks = ticks;
+    EXPECT_STREQ(validate(p).field, "fdi.check_long_ticks") << ticks;
+  }
+  for (const int ticks : {0, 4, 1000}) {
+    p = FaultDetectorParams{};
+    p.check_long_ticks = ticks;
+    EXPECT_TRUE(validate(p).ok) << ticks;
+  }
+  p = FaultDetectorParams{};
+  p.check_long_energy = 0.0;
+  EXPECT_STREQ(validate(p).field, "fdi.check_long_energy");
+  p = FaultDetectorParams{};
+  p.check_long_evidence_energy = std::nan("");
+  EXPECT_STREQ(validate(p).field, "fdi.check_long_evidence_energy");
   EXPECT_TRUE(validate(FaultDetectorParams{}).ok);
 }
 
