@@ -173,6 +173,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.enabled = fdi;
   p.fdi.identified_isolation = fdi;  // (F14) the identifier's fault torque, as flown
   p.fdi.degraded_min_loss = fdi ? 0.1 : 0.0;  // (F18) partial losses of thrust, as flown
+  p.fdi.degraded_loss_projection = true;  // (F51) the loss beyond the signature's error along itself
   p.fdi.check_llr = fdi ? 5.0 : 0.0;          // (F19) jet checks, as flown
   p.fdi.check_max_model_error = 0.5;          // ... against the model's stated 1 sigma, as flown
   p.fdi.check_min_llr = 5.0;                  // (F24) ... when the check can move the evidence
@@ -197,6 +198,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.check_long_ticks = 1000;  // (F49) ... where it is, every check in HOLD one long window
   p.fdi.check_long_energy = 80.0;
   p.fdi.check_long_evidence_energy = 320.0;
+  p.fdi.check_long_reach = 0.8;  // (F50) ... or this fraction of the energy the centre of mass caps
   p.fdi.centred_gyro_noise = true;            // (F28) the gyro's variance sigma_g^2, as flown
   p.fdi.suspect_chi2 = 30.66;                 // ... and the suspicion at 1 - 1e-6, as flown
   p.fdi.detect_early_ticks = fdi ? 3 : 0;     // (F33) early detection, as flown

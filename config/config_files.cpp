@@ -334,6 +334,13 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("check_long_evidence_energy")) {
       fd.check_long_evidence_energy = r.positive("check_long_evidence_energy");
     }
+    if (r.has("degraded_loss_projection")) {  // (F51), off when absent
+      fd.degraded_loss_projection = r.boolean("degraded_loss_projection");
+    }
+    if (r.has("check_long_reach")) {  // (F50), off when absent
+      fd.check_long_reach = r.non_negative("check_long_reach");
+      if (fd.check_long_reach > 0.95) r.fail("check_long_reach", "must be in [0, 0.95]");
+    }
     if (r.has("episode_restart_leader")) fd.episode_restart_leader = r.boolean("episode_restart_leader");  // (F41)
     if (r.has("episode_restart_stale")) {  // (F38)
       fd.episode_restart_stale = r.boolean("episode_restart_stale");

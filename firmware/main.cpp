@@ -208,6 +208,7 @@ int firmware_main() {
     g_params.fdi.enabled = true;
     g_params.fdi.identified_isolation = true;  // (F14) the identifier's fault torque, as flown
     g_params.fdi.degraded_min_loss = 0.1;      // (F18) partial losses of thrust, as flown
+    g_params.fdi.degraded_loss_projection = true;  // (F51) the loss beyond the signature's error along itself
     g_params.fdi.check_llr = 5.0;              // (F19) jet checks, as flown
     g_params.fdi.check_max_model_error = 0.5;  // ... against the model's stated 1 sigma, as flown
     g_params.fdi.check_min_llr = 5.0;          // (F24) ... when the check can move the evidence
@@ -232,6 +233,7 @@ int firmware_main() {
     g_params.fdi.check_long_ticks = 1000;  // (F49) ... where it is, every check in HOLD one long window
     g_params.fdi.check_long_energy = 80.0;
     g_params.fdi.check_long_evidence_energy = 320.0;
+    g_params.fdi.check_long_reach = 0.8;  // (F50) ... or this fraction of the energy the centre of mass caps
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
     g_params.fdi.detect_early_ticks = 3;       // (F33) early detection, as flown

@@ -106,6 +106,9 @@ Check validate(const FaultDetectorParams& p) {
   if (!finite_positive(p.check_long_evidence_energy)) {
     return bad("fdi.check_long_evidence_energy", "must be positive");
   }
+  if (!(p.check_long_reach >= 0.0 && p.check_long_reach <= 0.95)) {
+    return bad("fdi.check_long_reach", "must be in [0, 0.95]");
+  }
   return Check{};
 }
 
@@ -1713,9 +1716,11 @@ void FaultDetector::update_check() {
   }
   int windows = p_.check_windows;
   double force = p_.check_force_n;
+  bool capped = false;
   if (jet >= 0 && long_checks) {
-    force = long_check_force(jet, p_.check_long_evidence_energy, false);
+    force = long_check_force(jet, p_.check_long_evidence_energy, false, &capped);
     if (!(force > 0.0)) {
+      capped = false;
       // No long check of it within the gates: due again one interval from now (not a check).
       last_check_[static_cast<std::size_t>(jet)] = st_.windows + 1;
       jet = -1;
@@ -1742,6 +1747,7 @@ void FaultDetector::update_check() {
     long_start_ = true;
     restart_window_ = true;
     ++st_.long_checks;
+    if (capped) ++st_.long_checks_capped;
   }
   const auto kj = static_cast<std::size_t>(jet);
   if (last_check_[kj] != 0 && check_backoff_[kj] < 2) ++check_backoff_[kj];
@@ -1907,7 +1913,34 @@ double FaultDetector::move_kick_rate(const Vec8& du) const {
   return std::sqrt(std::fmax(rate_cov.trace(), 0.0));
 }
 
-double FaultDetector::long_check_force(int i, double energy, bool kick_gates) const {
+double FaultDetector::loss_rel_error(int i) const {
+  // (F51) A loss a of thruster i is fitted along its signature b_i = J^-1 k_i (p_i + r) x e_i: a
+  // model error db biases it by db . b_i / |b_i|^2. Strength: k_sigma / |k_i|; inertia:
+  // j_rel_sigma (|J^-1 dJ| bounds it, as in signature_rel_error). The centre of mass: the jet
+  // alone errs by J^-1 k_i (dr x e_i), whose share along b_i is dr . (k_i e_i x J^-T b_i) / |b_i|^2;
+  // its check (F19) fires the move du, of net force F = sum du_q e_q per unit of du_c, whose error
+  // J^-1 (dr x F) / du_c along b_i is dr . (F x J^-T b_i) / (du_c |b_i|^2). Each 1 sigma is
+  // sqrt(v^T R_r v); the larger of the two.
+  const auto k = static_cast<std::size_t>(i);
+  const double bb = b_[k].squaredNorm();
+  const double kk = std::fabs(m_.k(i));
+  if (!(bb > 0.0) || !(kk > 0.0)) return 1.0;
+  const Vec3 jb = j_inv_.transpose() * b_[k];
+  const Vec3 alone = (m_.k(i) / bb) * dir_[k].cross(jb);
+  double r_var = alone.dot(m_.r_cov * alone);
+  Vec8 du;
+  const int c = i / 2;
+  if (check_move(c, du) && du(c) > 0.0) {
+    Vec3 force = Vec3::Zero();
+    for (int q = 0; q < kChannels; ++q) force += du(q) * dir_[static_cast<std::size_t>(2 * q)];
+    const Vec3 move = force.cross(jb) / (du(c) * bb);
+    r_var = std::fmax(r_var, move.dot(m_.r_cov * move));
+  }
+  return m_.k_sigma / kk + m_.j_rel_sigma + std::sqrt(std::fmax(r_var, 0.0));
+}
+
+double FaultDetector::long_check_force(int i, double energy, bool kick_gates,
+                                       bool* capped) const {
   // (F49) One window of N samples through which "i stuck off" ramps the residual by b_i f dt a
   // sample has the energy s^2 f^2 g / (q + a^2 f^2): s = |b_i| dt, g = N (N^2 - 1) / 12 (F24's
   // ramp), q the noise of a quiet window of N samples (the gyro's share as is, the rest of the
@@ -1930,6 +1963,24 @@ double FaultDetector::long_check_force(int i, double energy, bool kick_gates) co
   const double a = r_sigma_ * j_inv_.norm() * (du.cwiseAbs().sum() / own) * t;
   const double s = b_[k].norm() * dt_;
   const double g = nn * (nn * nn - 1.0) / 12.0;
+  // (F50) The energy no force exceeds is s^2 g / a^2. An energy beyond check_long_reach of it is
+  // flown at that fraction, at a force within the kick bounds of a survey check (F44): the check
+  // then answers evidence with less than its energy, and is flown again; when that energy is
+  // below check_long_energy it is not flown.
+  if (capped != nullptr && p_.check_long_reach > 0.0 && a > 0.0 &&
+      energy > p_.check_long_reach * s * s * g / (a * a)) {
+    const double et = p_.check_long_reach * s * s * g / (a * a);
+    double f = std::sqrt(et * q / (s * s * g - et * a * a));
+    if (p_.survey_max_kick_rad_s > 0.0) {
+      f = std::fmin(f, p_.survey_max_kick_rad_s / (b_[k].norm() * t));
+      const double model_kick = 3.0 * move_kick_rate(du) / own * t;
+      if (model_kick > 0.0) f = std::fmin(f, p_.survey_max_kick_rad_s / model_kick);
+    }
+    if (!(f <= p_.check_force_n)) return 0.0;
+    if (!(s * s * f * f * g / (q + a * a * f * f) >= p_.check_long_energy)) return 0.0;
+    *capped = true;
+    return f;
+  }
   const double et = energy;
   const double den = s * s * g - et * a * a;
   if (!(den > 0.0)) return 0.0;
@@ -1992,7 +2043,8 @@ int FaultDetector::degraded_candidate(double& loss) const {
   const auto kg = static_cast<std::size_t>(g);
   const double a = deg_sr_[kg] / deg_e_[kg];
   const double eps = signature_rel_error(g);
-  if (a >= 1.0 || a < p_.degraded_min_loss + p_.model_sigmas * eps) return -1;
+  const double loss_eps = p_.degraded_loss_projection ? loss_rel_error(g) : eps;  // (F51)
+  if (a >= 1.0 || a < p_.degraded_min_loss + p_.model_sigmas * loss_eps) return -1;
   // Twin jets: the runner-up explains the data to cos^2 theta = Gamma_h / Gamma_g of what g
   // does. Each signature's direction is known to its relative error, so the model's error can
   // turn either one by up to model_sigmas eps: g is decided only when theta exceeds both turns.

@@ -126,6 +126,13 @@ struct FaultDetectorParams {
   // partial loss (not a stuck-off: its own a = 1 trails by margin_llr), and it leads every other
   // hypothesis by margin_llr plus model_sigmas of the model's error. 0: off.
   double degraded_min_loss{0.0};
+  // (F51) The model's error that a fitted loss must exceed (degraded_min_loss + model_sigmas eps)
+  // is that of the jet's signature along itself: the centre of mass's share from its covariance,
+  // projected on the signature, for the jet alone and for its check's move (the larger), not
+  // r_sigma over the jet's arm (a bound on the whole signature's error, which in cases 6-7,
+  // r known to 0.56 m, put eps above 0.13 and so every half loss below the gate).
+  // false: signature_rel_error as before.
+  bool degraded_loss_projection{false};
   // (F19) Jet check: when a jet's stuck-off score or partial-loss CUSUM (F18) reaches check_llr
   // (the evidence of a jet the despin asks for only a few newtons), the flight fires that jet at
   // check_force_n for check_windows windows in the null space of the channels' torques (no torque
@@ -242,6 +249,13 @@ struct FaultDetectorParams {
   int check_long_ticks{0};
   double check_long_energy{80.0};
   double check_long_evidence_energy{320.0};
+  // (F50) A long check's energy is capped by the centre of mass's 1 sigma: the force's own error
+  // grows with it, so E(f) = s^2 f^2 g / (q + a^2 f^2) < s^2 g / a^2 = E_cap whatever the force.
+  // Where E_cap is below check_long_evidence_energy (cases 6-7: E_cap 200-500 for r known to
+  // 0.56 m), the evidence check flies at check_long_reach E_cap instead, when that reaches
+  // check_long_energy; the evidence of successive checks adds up in the jet's sums (F18, F23).
+  // 0: such a jet is not checked (F49).
+  double check_long_reach{0.0};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -331,6 +345,7 @@ struct FaultDetectorStatus {
   std::uint32_t survey_noise_refusals{0};  // (F48) due jets not surveyed: the gyro too noisy
   std::uint32_t long_checks{0};  // (F49) of the checks, those flown as one long window
   std::uint32_t long_checks_dropped{0};  // (F49) ended by an early suspicion off their jet
+  std::uint32_t long_checks_capped{0};  // (F50) evidence checks flown at check_long_reach E_cap
   std::uint16_t unverified{0};  // (F36) bit i: thruster i commanded since it was last verified
   std::uint32_t early_detections{0};  // (F33) suspicions raised before their window closed
   std::uint32_t onset_restarts{0};  // (F45) onset windows ended at their early suspicion
@@ -400,6 +415,10 @@ class FaultDetector {
   // force (N, produced).
   int check_jet() const { return st_.check_jet; }
   double check_force() const { return check_force_; }  // (F49: the long check's own)
+  // (F51) The model's relative 1 sigma of thruster i's fitted loss: its signature's error along
+  // itself (strength, inertia, and the centre of mass's covariance for the jet alone and for its
+  // check's move, the larger).
+  double loss_rel_error(int i) const;
   // (F19, F42) The check's move of the channel forces for channel c, unscaled (du(c) in (0, 1]):
   // the minimum-norm move with no torque on the detector's model, whose channel torques are
   // (p + r_hat) x d with the identified centre of mass. False when channel c has no such move.
@@ -477,8 +496,10 @@ class FaultDetector {
   bool long_mode() const {
     return p_.check_long_ticks > 0 && survey_noisy_ && survey_allowed_;
   }
-  // energy: the check's expected stuck-off energy; kick_gates: F44's and F48's bounds apply.
-  double long_check_force(int i, double energy, bool kick_gates) const;
+  // energy: the check's expected stuck-off energy; kick_gates: F44's and F48's bounds apply;
+  // capped (F50, may be null): an energy above check_long_reach of its cap is flown at that
+  // fraction of the cap, when that is at least check_long_energy, and *capped is set.
+  double long_check_force(int i, double energy, bool kick_gates, bool* capped = nullptr) const;
   // (F44) The rms rate per second that the model's error leaves of the check's move du, per unit
   // of du.
   double move_kick_rate(const Vec8& du) const;

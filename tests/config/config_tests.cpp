@@ -408,12 +408,14 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOnInGncYaml) {
 
 // (F49) Long checks where the gyro is too noisy for the survey's: gnc.yaml's 1 000 samples at
 // energies 80 (survey) and 320 (evidence), off (0) when the key is absent (the struct's energies),
-// bad values named by file and key.
+// bad values named by file and key; (F50) evidence checks at 0.8 of the energy the centre of mass
+// caps, off (0) when absent.
 TEST(ConfigShipped, TheLongChecksAreReadOptionalAndOnInGncYaml) {
   const auto fd = load_run(kMission, kGnc, case_file(7)).flight.fdi;
   EXPECT_EQ(fd.check_long_ticks, 1000);
   EXPECT_EQ(fd.check_long_energy, 80.0);
   EXPECT_EQ(fd.check_long_evidence_energy, 320.0);
+  EXPECT_EQ(fd.check_long_reach, 0.8);  // (F50)
   expect_optional_fdi_key("  check_long_ticks: 1000", "check_long_ticks",
                           "  check_long_ticks: 2", "must be 0 or in [4, 1000]",
                           [](const std::string& gnc) {
@@ -429,6 +431,10 @@ TEST(ConfigShipped, TheLongChecksAreReadOptionalAndOnInGncYaml) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(7))
                                           .flight.fdi.check_long_evidence_energy,
                                       gnc::FaultDetectorParams{}.check_long_evidence_energy);
+                          });
+  expect_optional_fdi_key("  check_long_reach: 0.8", "check_long_reach",  // (F50), off when absent
+                          "  check_long_reach: 1.5", "must be in [0, 0.95]", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(7)).flight.fdi.check_long_reach, 0.0);
                           });
 }
 
@@ -547,7 +553,7 @@ TEST(ConfigShipped, TheShortIsolationTestsEvidenceGateIsReadAndOptional) {
 // another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader,
 // (F21) the onset window not scored, (F45) ended at its early suspicion, (F42) checks in the
 // identified model's null space, (F43) the survey in HOLD only and (F48) not where the gyro is
-// too noisy:
+// too noisy, (F51) the loss gate on the signature's error along itself:
 // gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is not a
 // boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
@@ -556,7 +562,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
                           "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
                           "episode_restart_leader", "skip_onset_window",
                           "check_model_null_space", "survey_hold_only", "onset_restart",
-                          "survey_noise_kick"}) {
+                          "survey_noise_kick", "degraded_loss_projection"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -574,6 +580,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "skip_onset_window"     ? f.skip_onset_window
              : k == "onset_restart"         ? f.onset_restart
              : k == "survey_noise_kick"     ? f.survey_noise_kick
+             : k == "degraded_loss_projection" ? f.degraded_loss_projection
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;

@@ -583,6 +583,83 @@ TEST(ZeroAllocation, NoHeapInLongJetChecks) {
   EXPECT_EQ(d.confirmed_off(), 1u << kDead);
 }
 
+// gnc/fdi/README.md (F50), (F51): case 6's HOLD (the centre of mass known to 0.56 m along one
+// direction), a half-strength jet: long evidence checks at their cap within the kick bound and the
+// loss gate on the signature's error along itself, up to the jet's confirmation as degraded, all
+// under the counter.
+TEST(ZeroAllocation, NoHeapInCappedLongChecksAndTheLossGate) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  constexpr int kHalf = 3;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(0.3, -0.2, 0.1);
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 25;
+  p.gyro_sigma = 3.1623e-5;
+  p.centred_gyro_noise = true;
+  p.degraded_min_loss = 0.1;
+  p.degraded_loss_projection = true;
+  p.check_llr = 5.0;
+  p.check_min_llr = 5.0;
+  p.check_max_model_error = 0.5;
+  p.survey_interval_s = 3000.0;
+  p.survey_max_kick_rad_s = 5e-5;
+  p.survey_noise_kick = true;
+  p.check_long_ticks = 1000;
+  p.check_long_reach = 0.8;
+  p.episode_restart = true;
+  p.episode_restart_stale = true;
+  FaultDetector d;
+  d.configure(p, rcs, kUmax, kDt);
+  FaultModel m;
+  m.j = j;
+  m.r = r;
+  m.j_rel_sigma = 0.0064;
+  m.r_cov << 0.3108, -0.0504, 0.0041, -0.0504, 0.0176, -0.0001, 0.0041, -0.0001, 0.0059;
+  m.k_sigma = 0.0097;
+  d.set_model(m);
+  Vec3 w(1e-6, -2e-6, 1e-6);
+  Vec16 phase = Vec16::Zero();
+  Vec16 prev = Vec16::Zero();
+  std::mt19937_64 rng(504);
+  std::normal_distribution<double> noise(0.0, p.gyro_sigma);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  long counted = -1;
+  {
+    Armed armed;
+    for (int k = 0; k < 300000 && d.confirmed_degraded() == 0; ++k) {
+      if (k % 200 == 0) {
+        phase.setZero();
+        for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
+      }
+      FaultDetectorInput in;
+      in.omega = w + Vec3(noise(rng), noise(rng), noise(rng));
+      in.omega_valid = true;
+      in.thrust = prev;
+      d.update(in);
+      Vec16 cmd = phase;
+      if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
+      Vec3 tau = Vec3::Zero();
+      for (int i = 0; i < 16; ++i) {
+        const int c = i / 2;
+        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
+                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
+        const double f = i == kHalf ? 0.5 * cmd(i) : cmd(i);
+        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
+      }
+      w += kDt * j.inverse() * (tau - w.cross(j * w));
+      prev = cmd;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(d.status().long_checks_capped, 1u);
+  EXPECT_EQ(d.confirmed_degraded(), 1u << kHalf);
+  EXPECT_EQ(d.confirmed_off() | d.confirmed_on(), 0u);
+}
+
 // gnc/fdi/README.md (F36)-(F38), (F44): the jet survey's bookkeeping, its kick rating and its
 // checks, with the stale episode's restart and the blocker's check on; no evidence check (check_llr out of reach), a
 // survey every 20 s and a verification level no firing reaches: no heap.

@@ -4,7 +4,10 @@
 // noisy gyro. Every thruster and kind is isolated to the right one; healthy runs never confirm.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <array>
@@ -2323,6 +2326,174 @@ TEST(FaultDetector, AJetStuckOnDuringALongCheckEndsIt) {
   }
 }
 
+// (F51) The model's error of a fitted loss, against a Monte-Carlo of the truth's geometry: draws of
+// the centre of mass from an anisotropic covariance, each jet's signature b_i = J^-1 (p_i + r + dr)
+// x e_i recomputed, its change along b_i as a fraction of |b_i|^2, alone and for its check's move
+// (the kernel of the channels' torque matrix, here from an SVD pseudo-inverse); the larger 1 sigma
+// of the two, plus the strength and inertia terms.
+TEST(FaultDetector, TheLossGatesModelErrorIsTheSignaturesErrorAlongItself) {
+  Truth t;
+  FaultDetectorParams p = check_rig_params(t);
+  p.degraded_loss_projection = true;
+  FaultDetector d;
+  ASSERT_TRUE(validate(p).ok);
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  const Mat3 rot = Eigen::AngleAxisd(0.7, V3(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+  m.r_cov = rot * V3(0.04, 0.01, 0.25).asDiagonal() * rot.transpose();
+  m.k_sigma = 0.01;
+  m.j_rel_sigma = 0.002;
+  d.set_model(m);
+  const Mat3 j_inv = t.body.j.inverse();
+  const Eigen::LLT<Mat3> chol(m.r_cov);
+  const Mat3 l = chol.matrixL();
+  // The channels' torque matrix (each channel's "+" jet, 2c) and the kernel projector.
+  Eigen::Matrix<double, 3, 8> b;
+  for (int c = 0; c < 8; ++c) {
+    const auto k = static_cast<std::size_t>(2 * c);
+    b.col(c) = (t.pos[k] + t.r).cross(t.dir[k]);
+  }
+  const Eigen::Matrix<double, 8, 3> b_pinv =
+      b.jacobiSvd(Eigen::ComputeFullU | Eigen::ComputeFullV).solve(Mat3::Identity());
+  const Eigen::Matrix<double, 8, 8> kernel = Eigen::Matrix<double, 8, 8>::Identity() - b_pinv * b;
+  std::mt19937_64 rng(51);
+  std::normal_distribution<double> n(0.0, 1.0);
+  constexpr int kDraws = 40000;
+  for (int i = 0; i < 16; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const int c = i / 2;
+    const V3 bi = j_inv * (t.pos[k] + t.r).cross(t.dir[k]);
+    const Eigen::Matrix<double, 8, 1> du = kernel.col(c);
+    V3 force = V3::Zero();
+    for (int q = 0; q < 8; ++q) force += du(q) * t.dir[static_cast<std::size_t>(2 * q)];
+    double alone2 = 0.0;
+    double move2 = 0.0;
+    for (int s = 0; s < kDraws; ++s) {
+      const V3 dr = l * V3(n(rng), n(rng), n(rng));
+      const V3 db = j_inv * (t.pos[k] + t.r + dr).cross(t.dir[k]) - bi;
+      const double alone = db.dot(bi) / bi.squaredNorm();
+      // The move's torque error per unit of the checked jet's force, its share along b_i (the
+      // "-" jet is checked with the move reversed and its signature reversed: the same share).
+      const double move = (j_inv * dr.cross(force)).dot(bi) / (du(c) * bi.squaredNorm());
+      alone2 += alone * alone;
+      move2 += move * move;
+    }
+    const double r_share = std::sqrt(std::max(alone2, move2) / kDraws);
+    const double expected = m.k_sigma + m.j_rel_sigma + r_share;
+    EXPECT_NEAR(d.loss_rel_error(i), expected, 0.02 * expected) << "thruster " << i;
+  }
+}
+
+// (F50, F51) Case 6's HOLD: the gyro too noisy for the bank's windows, the centre of mass known to
+// 0.56 m along one direction (the identified model's covariance there). A half-strength jet of
+// those the survey checks (jets 0, 1, 8, 9 are verified by the other checks' moves here). A long evidence check's
+// energy cannot reach check_long_evidence_energy (320) for the jets whose cap s^2 g / a^2 is
+// below it, and the former loss gate (degraded_min_loss + 3 r_sigma / arm) lies above 0.5 for
+// them: the half loss is never confirmed. With the checks at 0.8 of their cap within the kick
+// bound, and the gate on the signature's error along itself, it is confirmed degraded, to
+// itself, at 0.5 within 3 of its reported 1 sigma; each capped check's dead-jet kick stays within
+// the bound; healthy, nothing is confirmed.
+TEST(FaultDetector, AHalfLossWhereTheCentreOfMassCapsTheCheckIsConfirmedDegraded) {
+  constexpr double kBound = 5e-5;
+  const double kRSigma = std::sqrt(0.3108);
+  for (const int half : {-1, 3, 6, 11, 14}) {
+    for (const bool on : {false, true}) {
+      const std::string what = "half-strength jet " + std::to_string(half) +
+                               (on ? ", F50 and F51" : ", without them");
+      Truth t;
+      t.gyro_sigma = 3.1623e-5;  // cases 6-7: sqrt(1e-10 / 0.1)
+      t.degraded = half;
+      t.degraded_factor = 0.5;
+      t.body.omega = V3(1e-6, -2e-6, 1e-6);
+      FaultDetectorParams p = survey_params(t, 3000.0);
+      p.window_ticks = 25;
+      p.centred_gyro_noise = true;
+      p.survey_max_kick_rad_s = kBound;
+      p.survey_noise_kick = true;
+      p.check_long_ticks = 1000;
+      p.check_long_energy = 80.0;
+      p.check_long_evidence_energy = 320.0;
+      p.check_interval_s = 600.0;
+      p.check_max_model_error = 0.5;
+      p.model_sigmas = 3.0;
+      p.margin_llr = 10.0;
+      p.confirm_llr = 25.0;
+      p.check_long_reach = on ? 0.8 : 0.0;
+      p.degraded_loss_projection = on;
+      FaultDetector d;
+      ASSERT_TRUE(validate(p).ok) << what << ": " << validate(p).field;
+      d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+      // The identified model's 1 sigma in case 6's HOLD (the degraded dispersion's draw 0): the
+      // centre of mass known to 0.56 m along one direction, 0.08-0.13 m across it.
+      FaultModel m = identified_model(t);
+      m.r_cov << 0.3108, -0.0504, 0.0041, -0.0504, 0.0176, -0.0001, 0.0041, -0.0001, 0.0059;
+      m.k_sigma = 0.0097;
+      m.j_rel_sigma = 0.0064;
+      d.set_model(m);
+      const Mat3 j_inv = t.body.j.inverse();
+      if (half >= 0) {
+        // The former gate refuses a half loss of this jet.
+        const auto b = static_cast<std::size_t>(half);
+        const double arm = (t.pos[b] + t.r).cross(t.dir[b]).norm();
+        ASSERT_GT(0.1 + 3.0 * (m.k_sigma + m.j_rel_sigma + kRSigma / arm), 0.5) << what;
+      }
+      std::mt19937_64 rng(500 + static_cast<std::uint64_t>(half + 1));
+      Vec16 phase = Vec16::Zero();
+      Vec16 prev = Vec16::Zero();
+      RunResult first;
+      double factor = 0.0;
+      double factor_sigma = 0.0;
+      std::uint32_t capped = 0;
+      double worst_capped_kick = 0.0;
+      for (int k = 0; k < 400000 && first.confirmed_at < 0; ++k) {  // 40 000 s
+        if (k % 200 == 0) {
+          std::uniform_real_distribution<double> u(0.0, 1.0);
+          phase.setZero();
+          for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
+        }
+        FaultDetectorInput in;
+        in.omega = t.gyro();
+        in.omega_valid = true;
+        in.thrust = prev;
+        in.valve_open = t.valve;
+        const FaultEvents e = d.update(in);
+        if (e.confirmed) {
+          first.confirmed_at = k;
+          first.thruster = e.thruster;
+          first.kind = e.kind;
+          factor = e.factor;
+          factor_sigma = e.factor_sigma;
+        }
+        if (d.status().long_checks_capped > capped) {
+          capped = d.status().long_checks_capped;
+          // The dead-jet kick of this check over its 1 000 samples, from the truth's geometry.
+          const auto b = static_cast<std::size_t>(d.check_jet());
+          const V3 rate = j_inv * (t.pos[b] + t.r).cross(t.dir[b]);
+          worst_capped_kick = std::max(worst_capped_kick, rate.norm() * d.check_force() * 100.0);
+        }
+        Vec16 cmd = phase;
+        if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
+        t.advance(cmd);
+        prev = cmd;
+      }
+      EXPECT_LE(worst_capped_kick, kBound * (1.0 + 1e-9)) << what;
+      if (!on) {
+        EXPECT_EQ(capped, 0u) << what;
+      }
+      if (half < 0 || !on) {
+        EXPECT_LT(first.confirmed_at, 0) << what << ": confirmed thruster " << first.thruster;
+        continue;
+      }
+      EXPECT_GT(capped, 0u) << what << ": no evidence check at its cap";
+      ASSERT_GE(first.confirmed_at, 0) << what;
+      EXPECT_EQ(first.thruster, half) << what;
+      EXPECT_EQ(first.kind, FaultKind::kDegraded) << what;
+      EXPECT_NEAR(factor, 0.5, 3.0 * factor_sigma) << what;
+      EXPECT_LT(factor_sigma, 0.1) << what;
+    }
+  }
+}
+
 TEST(FaultDetector, TheSurveyChecksEachUnverifiedJetOncePerIntervalAndConfirmsNothingWhenHealthy) {
   for (std::uint64_t seed : {21u, 22u}) {
     Truth t;
@@ -2583,6 +2754,13 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
   p = FaultDetectorParams{};
   p.check_long_evidence_energy = std::nan("");
   EXPECT_STREQ(validate(p).field, "fdi.check_long_evidence_energy");
+  for (const double reach : {-0.1, 0.96, std::nan("")}) {  // (F50)
+    p = FaultDetectorParams{};
+    p.check_long_reach = reach;
+    EXPECT_STREQ(validate(p).field, "fdi.check_long_reach") << reach;
+  }
+  p.check_long_reach = 0.95;
+  EXPECT_TRUE(validate(p).ok);
   EXPECT_TRUE(validate(FaultDetectorParams{}).ok);
 }
 
