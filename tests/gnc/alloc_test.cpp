@@ -514,6 +514,48 @@ TEST(ZeroAllocation, NoHeapInAJetCheck) {
 // and the off-signature test on every update of it; thruster 6 dead, so its check confirms it:
 // no heap. A rigid body with the study's inertia at rest, every channel's one half at
 // milli-newtons.
+// HOLD's firing for the long-check rigs: every channel's one half at milli-newtons (a fresh draw
+// every 200 ticks), a check's force added to its jet, the rigid body driven by what the thrusters
+// produce (thruster i at strength(i) of its command), a noisy gyro; flown under the heap counter
+// until `done` or max_ticks. Returns the allocations counted.
+template <class Done>
+long fly_hold_counted(FaultDetector& d, const RcsLayout& rcs, const Mat3& j, const Vec3& r,
+                      double gyro_sigma, const Vec16& strength, std::uint64_t seed, int max_ticks,
+                      Done done) {
+  constexpr double kDt = 0.1;
+  Vec3 w(1e-6, -2e-6, 1e-6);
+  Vec16 phase = Vec16::Zero();
+  Vec16 prev = Vec16::Zero();
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, gyro_sigma);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Armed armed;
+  for (int k = 0; k < max_ticks && !done(); ++k) {
+    if (k % 200 == 0) {
+      phase.setZero();
+      for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
+    }
+    FaultDetectorInput in;
+    in.omega = w + Vec3(noise(rng), noise(rng), noise(rng));
+    in.omega_valid = true;
+    in.thrust = prev;
+    d.update(in);
+    Vec16 cmd = phase;
+    if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
+    Vec3 tau = Vec3::Zero();
+    for (int i = 0; i < 16; ++i) {
+      const int c = i / 2;
+      const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
+                                : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
+      tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r)
+                 .cross(strength(i) * cmd(i) * e);
+    }
+    w += kDt * j.inverse() * (tau - w.cross(j * w));
+    prev = cmd;
+  }
+  return rocksteady::test::heap_allocations();
+}
+
 TEST(ZeroAllocation, NoHeapInLongJetChecks) {
   constexpr double kUmax = 200.0;
   constexpr double kDt = 0.1;
@@ -543,40 +585,10 @@ TEST(ZeroAllocation, NoHeapInLongJetChecks) {
   m.r_cov = Mat3::Identity() * 1e-6;
   m.k_sigma = 1e-3;
   d.set_model(m);
-  Vec3 w(1e-6, -2e-6, 1e-6);
-  Vec16 phase = Vec16::Zero();
-  Vec16 prev = Vec16::Zero();
-  std::mt19937_64 rng(9);
-  std::normal_distribution<double> noise(0.0, p.gyro_sigma);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  long counted = -1;
-  {
-    Armed armed;
-    for (int k = 0; k < 30000 && d.confirmed_off() == 0; ++k) {
-      if (k % 200 == 0) {
-        phase.setZero();
-        for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
-      }
-      FaultDetectorInput in;
-      in.omega = w + Vec3(noise(rng), noise(rng), noise(rng));
-      in.omega_valid = true;
-      in.thrust = prev;
-      d.update(in);
-      Vec16 cmd = phase;
-      if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
-      Vec3 tau = Vec3::Zero();
-      for (int i = 0; i < 16; ++i) {
-        const int c = i / 2;
-        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
-                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
-        const double f = i == kDead ? 0.0 : cmd(i);
-        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
-      }
-      w += kDt * j.inverse() * (tau - w.cross(j * w));
-      prev = cmd;
-    }
-    counted = rocksteady::test::heap_allocations();
-  }
+  Vec16 strength = Vec16::Ones();
+  strength(kDead) = 0.0;
+  const long counted = fly_hold_counted(d, rcs, j, r, p.gyro_sigma, strength, 9, 30000,
+                                        [&] { return d.confirmed_off() != 0; });
   EXPECT_EQ(counted, 0);
   EXPECT_GE(d.status().long_checks, 2u);
   EXPECT_EQ(d.status().long_checks, d.status().checks);
@@ -620,40 +632,10 @@ TEST(ZeroAllocation, NoHeapInCappedLongChecksAndTheLossGate) {
   m.r_cov << 0.3108, -0.0504, 0.0041, -0.0504, 0.0176, -0.0001, 0.0041, -0.0001, 0.0059;
   m.k_sigma = 0.0097;
   d.set_model(m);
-  Vec3 w(1e-6, -2e-6, 1e-6);
-  Vec16 phase = Vec16::Zero();
-  Vec16 prev = Vec16::Zero();
-  std::mt19937_64 rng(504);
-  std::normal_distribution<double> noise(0.0, p.gyro_sigma);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  long counted = -1;
-  {
-    Armed armed;
-    for (int k = 0; k < 300000 && d.confirmed_degraded() == 0; ++k) {
-      if (k % 200 == 0) {
-        phase.setZero();
-        for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
-      }
-      FaultDetectorInput in;
-      in.omega = w + Vec3(noise(rng), noise(rng), noise(rng));
-      in.omega_valid = true;
-      in.thrust = prev;
-      d.update(in);
-      Vec16 cmd = phase;
-      if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
-      Vec3 tau = Vec3::Zero();
-      for (int i = 0; i < 16; ++i) {
-        const int c = i / 2;
-        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
-                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
-        const double f = i == kHalf ? 0.5 * cmd(i) : cmd(i);
-        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
-      }
-      w += kDt * j.inverse() * (tau - w.cross(j * w));
-      prev = cmd;
-    }
-    counted = rocksteady::test::heap_allocations();
-  }
+  Vec16 strength = Vec16::Ones();
+  strength(kHalf) = 0.5;
+  const long counted = fly_hold_counted(d, rcs, j, r, p.gyro_sigma, strength, 504, 300000,
+                                        [&] { return d.confirmed_degraded() != 0; });
   EXPECT_EQ(counted, 0);
   EXPECT_GE(d.status().long_checks_capped, 1u);
   EXPECT_EQ(d.confirmed_degraded(), 1u << kHalf);

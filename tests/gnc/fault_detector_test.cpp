@@ -1977,6 +1977,22 @@ struct HoldFiring {
   }
 };
 
+// HOLD's firing without HoldFiring's firm jet 0 (which would spin the body up over the hours the
+// long-check tests fly): every channel's one half at milli-newtons, a fresh draw every 200 ticks.
+struct MilliNewtonHold {
+  std::mt19937_64 rng;
+  Vec16 phase{Vec16::Zero()};
+  explicit MilliNewtonHold(std::uint64_t seed) : rng(seed) {}
+  Vec16 next(int tick) {
+    if (tick % 200 == 0) {
+      std::uniform_real_distribution<double> u(0.0, 1.0);
+      phase.setZero();
+      for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
+    }
+    return phase;
+  }
+};
+
 using SurveyRun = CheckRun;
 
 SurveyRun fly_hold(Truth& t, FaultDetector& d, int ticks, int onset, int stuck_off,
@@ -2155,20 +2171,7 @@ TEST(FaultDetector, WhereTheGyroIsTooNoisyTheSurveyFliesOneLongWindowWithinTheKi
       t.body.omega = V3(1e-6, -2e-6, 1e-6);  // HOLD: the gyroscopic term's error is negligible
       FaultDetector d = make_detector(t, params(t, long_ticks));
       const Mat3 j_inv = t.body.j.inverse();
-      // HOLD's firing: every channel's one half at milli-newtons (HoldFiring without its firm jet
-      // 0, which would spin the body up over the hour flown here).
-      struct {
-        std::mt19937_64 rng;
-        Vec16 phase{Vec16::Zero()};
-        Vec16 next(int tick) {
-          std::uniform_real_distribution<double> u(0.0, 1.0);
-          if (tick % 200 == 0) {
-            phase.setZero();
-            for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
-          }
-          return phase;
-        }
-      } firing{std::mt19937_64(60 + static_cast<std::uint64_t>(dead + 1))};
+      MilliNewtonHold firing(60 + static_cast<std::uint64_t>(dead + 1));
       Vec16 prev = Vec16::Zero();
       RunResult first;
       int long_started = 0;
@@ -2279,18 +2282,13 @@ TEST(FaultDetector, AJetStuckOnDuringALongCheckEndsIt) {
     p.skip_onset_window = true;
     p.onset_restart = true;
     FaultDetector d = make_detector(t, p);
-    std::mt19937_64 rng(80 + static_cast<std::uint64_t>(stuck));
-    Vec16 phase = Vec16::Zero();
+    MilliNewtonHold firing(80 + static_cast<std::uint64_t>(stuck));
     Vec16 prev = Vec16::Zero();
     int onset = -1;
     int checked = -1;
     int ended = -1;
     for (int k = 0; k < 20000 && ended < 0; ++k) {
-      if (k % 200 == 0) {
-        std::uniform_real_distribution<double> u(0.0, 1.0);
-        phase.setZero();
-        for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
-      }
+      const Vec16 phase = firing.next(k);
       FaultDetectorInput in;
       in.omega = t.gyro();
       in.omega_valid = true;
@@ -2437,8 +2435,7 @@ TEST(FaultDetector, AHalfLossWhereTheCentreOfMassCapsTheCheckIsConfirmedDegraded
         const double arm = (t.pos[b] + t.r).cross(t.dir[b]).norm();
         ASSERT_GT(0.1 + 3.0 * (m.k_sigma + m.j_rel_sigma + kRSigma / arm), 0.5) << what;
       }
-      std::mt19937_64 rng(500 + static_cast<std::uint64_t>(half + 1));
-      Vec16 phase = Vec16::Zero();
+      MilliNewtonHold firing(500 + static_cast<std::uint64_t>(half + 1));
       Vec16 prev = Vec16::Zero();
       RunResult first;
       double factor = 0.0;
@@ -2446,11 +2443,7 @@ TEST(FaultDetector, AHalfLossWhereTheCentreOfMassCapsTheCheckIsConfirmedDegraded
       std::uint32_t capped = 0;
       double worst_capped_kick = 0.0;
       for (int k = 0; k < 400000 && first.confirmed_at < 0; ++k) {  // 40 000 s
-        if (k % 200 == 0) {
-          std::uniform_real_distribution<double> u(0.0, 1.0);
-          phase.setZero();
-          for (int c = 0; c < 8; ++c) phase(2 * c + (u(rng) < 0.5 ? 0 : 1)) = 0.002 + 0.018 * u(rng);
-        }
+        const Vec16 phase = firing.next(k);
         FaultDetectorInput in;
         in.omega = t.gyro();
         in.omega_valid = true;
