@@ -190,6 +190,7 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.probe_partial_rival = true;           // (F29) ... read against partial losses
   p.fdi.probe_read_closed = true;             // (F32) ... and first on the closed window
   p.fdi.probe_read_elsewhere = true;          // (F40) ... which may name another pod's jet
+  p.fdi.probe_start_llr = 8.0;                // (F52) ... and may start below confirm_llr
   p.fdi.check_model_null_space = true;        // (F42) checks in the identified model's null space
   p.fdi.survey_interval_s = fdi ? 20000.0 : 0.0;  // (F36) the survey as flown: its bookkeeping
   p.fdi.survey_hold_only = true;              // (F43) the survey in HOLD only

@@ -290,6 +290,12 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("probe_short_min_llr")) {  // (F47)
       fd.probe_short_min_llr = r.non_negative("probe_short_min_llr");
     }
+    if (r.has("probe_start_llr")) {  // (F52)
+      fd.probe_start_llr = r.non_negative("probe_start_llr");
+      if (fd.probe_start_llr > 0.0 && !(fd.probe_start_llr < fd.confirm_llr)) {
+        r.fail("probe_start_llr", "must be 0 or below confirm_llr");
+      }
+    }
     // (F14) stuck-on isolation inside identification; optional keys (off when absent).
     if (r.has("identified_isolation")) fd.identified_isolation = r.boolean("identified_isolation");
     if (r.has("identified_zero_chi2")) fd.identified_zero_chi2 = r.positive("identified_zero_chi2");

@@ -226,6 +226,7 @@ int firmware_main() {
     g_params.fdi.probe_partial_rival = true;   // (F29) ... read against partial losses
     g_params.fdi.probe_read_closed = true;     // (F32) ... and first on the closed window
     g_params.fdi.probe_read_elsewhere = true;  // (F40) ... which may name another pod's jet
+    g_params.fdi.probe_start_llr = 8.0;        // (F52) ... and may start below confirm_llr
     g_params.fdi.check_model_null_space = true;  // (F42) checks in the identified model's null space
     g_params.fdi.survey_hold_only = true;  // (F43) the survey in HOLD only
     g_params.fdi.survey_max_kick_rad_s = 5.0e-5;  // (F44) ... and no survey check that may kick the rate

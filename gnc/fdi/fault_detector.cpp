@@ -57,6 +57,10 @@ Check validate(const FaultDetectorParams& p) {
   if (!(p.probe_short_min_llr >= 0.0) || !std::isfinite(p.probe_short_min_llr)) {
     return bad("fdi.probe_short_min_llr", "must be finite and >= 0");
   }
+  if (!(p.probe_start_llr >= 0.0) || !std::isfinite(p.probe_start_llr) ||
+      (p.probe_start_llr > 0.0 && !(p.probe_start_llr < p.confirm_llr))) {
+    return bad("fdi.probe_start_llr", "must be 0 or in (0, confirm_llr)");  // (F52)
+  }
   if (!finite_positive(p.identified_zero_chi2)) {
     return bad("fdi.identified_zero_chi2", "must be positive");
   }
@@ -988,7 +992,8 @@ void FaultDetector::decide() {
       verdict_pending_ = true;
       // (F32) The verdict on the window before the closure and the closed ones; the confirmation
       // closes the valve on this same update, so the tested pod stays closed.
-      const int h = p_.probe_read_closed ? closed_probe_verdict() : -1;
+      int h = p_.probe_read_closed ? closed_probe_verdict() : -1;
+      if (!verdict_allowed(h)) h = -1;  // (F52) read again on the reopened window
       if (h >= 0) {
         end_probe_verdict();
         declare(h, FaultKind::kStuckOn);
@@ -999,7 +1004,8 @@ void FaultDetector::decide() {
       }
       // (F40) ... or on the stuck-on jet of another pod that the motion behind the closed valve
       // shows; its pod is closed by the confirmation, the tested one reopens.
-      const int e = p_.probe_read_elsewhere ? closed_verdict_elsewhere() : -1;
+      int e = p_.probe_read_elsewhere ? closed_verdict_elsewhere() : -1;
+      if (!verdict_allowed(e)) e = -1;  // (F52)
       if (e >= 0) {
         end_probe_verdict();
         ++st_.elsewhere_verdicts;
@@ -1019,7 +1025,8 @@ void FaultDetector::decide() {
     }
   } else if (verdict_pending_ && eval_open_fraction_ >= 0.5) {
     // (F15) The first window flown mostly with the tested pod open again.
-    const int h = probe_verdict();
+    int h = probe_verdict();
+    if (!verdict_allowed(h)) h = -1;  // (F52) the bank goes on, and may test again
     end_probe_verdict();
     if (h >= 0) {
       declare(h, FaultKind::kStuckOn);
@@ -1033,21 +1040,25 @@ void FaultDetector::decide() {
     reset_episode();  // every hypothesis exonerated: the next episode starts afresh
     return;
   }
-  if (best_s <= p_.confirm_llr) {
+  // (F52) A stuck-on leader past probe_start_llr but not yet past confirm_llr: tested against its
+  // runner-up; nothing is confirmed here.
+  const bool early_test = best_s <= p_.confirm_llr && p_.probe_start_llr > 0.0 &&
+                          best_s > p_.probe_start_llr && best < kThrusters && runner_up >= 0;
+  if (best_s <= p_.confirm_llr && !early_test) {
     ambiguous_windows_ = 0;
     st_.ambiguous_with = -1;
     return;
   }
   // (F6) clearly ahead of the runner-up, and (F8) of every alternative beyond the model's error.
   int blocking = runner_up;
-  if (best_s - second > p_.margin_llr) {
+  if (!early_test && best_s - second > p_.margin_llr) {
     if (block_scan_.h == best) {  // the scan of steps 2 and 3
       blocking = block_scan_.worst;
     } else {
       blocking = blocking_alternative(best);
     }
   }
-  if (blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
+  if (!early_test && blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
   if (blocking < 0 && best < kThrusters && p_.episode_restart) blocking = partial_loss_rival(best);
   if (blocking < 0) {
     const int thruster = best % kThrusters;
@@ -1099,6 +1110,7 @@ void FaultDetector::decide() {
     ambiguous_windows_ = 0;
     end_probe_verdict();
     probe_tested_pod_ = pod;
+    probe_early_ = early_test;
     trigger_llr_ = window_llr_;  // (F32)
     if (p_.probe_window_ticks > 0) {  // (F47)
       const double ratio =

@@ -82,6 +82,12 @@ struct FaultDetectorParams {
   // test started on weaker evidence (a model still far from the truth) flies a whole window.
   // 0: every test short.
   double probe_short_min_llr{0.0};
+  // (F52) An isolation test may start on a stuck-on leader whose score is past this, below
+  // confirm_llr, so that the closed valve's evidence (E / 2 against every stuck-on jet behind an
+  // open valve) comes a window or two sooner. Such a test's verdict names a jet only once that
+  // jet's own score is past confirm_llr: a verdict on a test's windows alone (margin_llr over
+  // them) is safe only on a leader the bank has already found. 0: tests only past confirm_llr.
+  double probe_start_llr{0.0};
   // (F27) The pod's closure (a test of F9, or a sweep's of F17) starts a new window, so the test's
   // first window is flown closed throughout (the decision comes kEvaluationSteps updates into the
   // window that follows the one it read: without this, that window is flown partly open and a
@@ -650,6 +656,12 @@ class FaultDetector {
   // (F15) The isolation test's outcome: the tested pod, how many windows were flown with it closed
   // throughout, and the verdict awaited from the first window after it reopens.
   int probe_tested_pod_{-1};
+  bool probe_early_{false};  // (F52) the test under way started below confirm_llr
+  // (F52) Whether a test's verdict may name stuck-on thruster h (its score past confirm_llr after
+  // an early test).
+  bool verdict_allowed(int h) const {
+    return !probe_early_ || (h >= 0 && score_[static_cast<std::size_t>(h)] > p_.confirm_llr);
+  }
   int probe_closed_{0};
   bool verdict_pending_{false};
   int window_len_{5};  // (F46) the samples of the window under way (window_ticks or a test's)

@@ -547,6 +547,21 @@ TEST(ConfigShipped, TheShortIsolationTestsEvidenceGateIsReadAndOptional) {
                           });
 }
 
+// (F52) Isolation tests started on a stuck-on leader past 8, below confirm_llr: gnc.yaml's 8, off
+// (0) when the key is absent, and a level at or past confirm_llr names the file and key.
+TEST(ConfigShipped, TheEarlyIsolationTestsLevelIsReadAndOptional) {
+  for (int c = 1; c <= 7; ++c) {
+    EXPECT_EQ(load_run(kMission, kGnc, case_file(c)).flight.fdi.probe_start_llr, 8.0)
+        << "case " << c;
+  }
+  expect_optional_fdi_key("  probe_start_llr: 8.0", "probe_start_llr",
+                          "  probe_start_llr: 30.0", "below confirm_llr",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.probe_start_llr,
+                                      0.0);
+                          });
+}
+
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
 // (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)

@@ -396,6 +396,89 @@ TEST(ZeroAllocation, NoHeapInAPodSweep) {
   EXPECT_EQ(d.confirmed_on(), 1u << kStuck);
 }
 
+// gnc/fdi/README.md (F52): the mirror trap of the detector's tests (jet 2 stuck on, the model's
+// centre of mass with its xy part mirrored), isolation tests that may start below confirm_llr and
+// whose verdict waits for it, under the counter up to the confirmation.
+TEST(ZeroAllocation, NoHeapInAnEarlyIsolationTest) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(-0.3, 0.2, 3.5456);
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = 1e-6;
+  p.disturbance_sigma = 0.0;
+  p.probe_windows = 1;
+  p.probe_aligned = true;
+  p.probe_read_closed = true;
+  p.probe_partial_rival = true;
+  p.centred_gyro_noise = true;
+  p.probe_start_llr = 8.0;
+  FaultDetector d;
+  d.configure(p, rcs, kUmax, kDt);
+  FaultModel m;
+  m.j = j;
+  m.r = Vec3(-r.x(), -r.y(), r.z());
+  m.j_rel_sigma = 1e-4;
+  m.r_cov = Mat3::Identity() * 0.13;
+  m.k_sigma = 1e-3;
+  d.set_model(m);
+  constexpr int kStuck = 2;
+  Vec3 w = Vec3::Zero();
+  std::array<bool, kPods> valves{{true, true, true, true}};
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, p.gyro_sigma);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Vec16 prev = Vec16::Zero();
+  std::array<bool, kPods> prev_valves = valves;
+  double first_test_score = -1.0;
+  long counted = -1;
+  {
+    Armed armed;
+    for (int k = 0; k < 2000 && d.confirmed_on() == 0; ++k) {
+      FaultDetectorInput in;
+      in.omega = w + Vec3(noise(rng), noise(rng), noise(rng));
+      in.omega_valid = true;
+      in.thrust = prev;
+      in.valve_open = prev_valves;
+      d.update(in);
+      if (d.probe_pod() >= 0 && first_test_score < 0.0) first_test_score = d.status().best_llr;
+      for (int q = 0; q < kPods; ++q) valves[static_cast<std::size_t>(q)] = true;
+      if (d.probe_pod() >= 0) valves[static_cast<std::size_t>(d.probe_pod())] = false;
+      // Every channel but 1 and 5 fired at random, one half at a time; jet 2 stuck on from tick 50.
+      Vec16 cmd = Vec16::Zero();
+      for (int c = 0; c < 8; ++c) {
+        const double x = u(rng);
+        const double f = kUmax * u(rng);
+        if (c == 1 || c == 5) continue;
+        if (x < 0.25) cmd(2 * c) = f;
+        else if (x < 0.5) cmd(2 * c + 1) = f;
+      }
+      Vec3 tau = Vec3::Zero();
+      for (int i = 0; i < 16; ++i) {
+        const int c = i / 2;
+        const int pod = rcs.channel_pod[c];
+        if (!valves[static_cast<std::size_t>(pod)]) continue;
+        const double f = (i == kStuck && k >= 50) ? kUmax : cmd(i);
+        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
+                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
+        tau += (rcs.pod_position[static_cast<std::size_t>(pod)] + r).cross(f * e);
+      }
+      w += kDt * j.inverse() * (tau - w.cross(j * w));
+      prev = cmd;
+      prev_valves = valves;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(d.status().probes, 1u);
+  EXPECT_GT(first_test_score, p.probe_start_llr);
+  EXPECT_LE(first_test_score, p.confirm_llr) << "the first test did not start early";
+  EXPECT_EQ(d.confirmed_on(), 1u << kStuck);
+}
+
 // gnc/fdi/README.md (F18): the partial-loss CUSUMs and their step, the confirmation of a
 // half-strength jet, and the flight after it with the factor latched (the detector's input scaled
 // by it): no heap. A rigid body with the study's inertia, every jet commanded at random, jet 9 at

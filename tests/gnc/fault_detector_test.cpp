@@ -1094,6 +1094,8 @@ struct AmbiguousRun {
   std::vector<int> probe_ends;  // ticks at which an isolation test reopened its pod
   std::vector<int> probe_pods;  // the pod of each test
   std::vector<int> probe_starts;  // the tick each test closed its pod
+  std::vector<double> probe_start_scores;  // the leader's score on the update each test started
+  double score_before_confirmation{0.0};   // the leader's score on the update before it
 };
 
 // The trap's truth r and the detector flying against its mirror: the model's r has its xy part
@@ -1130,11 +1132,13 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p, double firing_scale = 1.0) {
     in.omega_valid = true;
     in.thrust = prev;
     in.valve_open = prev_valve;
+    const double score_before = d.status().best_llr;
     const FaultEvents e = d.update(in);
     if (e.confirmed && out.r.confirmed_at < 0) {
       out.r.confirmed_at = k;
       out.r.thruster = e.thruster;
       out.r.kind = e.kind;
+      out.score_before_confirmation = score_before;
     }
     // The flight's reaction: a confirmed stuck-on closes its pod; the test closes the pod asked.
     t.valve = {{true, true, true, true}};
@@ -1150,6 +1154,7 @@ AmbiguousRun fly_ambiguous(FaultDetectorParams p, double firing_scale = 1.0) {
       if (pp >= 0) {
         out.probe_pods.push_back(pp);
         out.probe_starts.push_back(k);
+        out.probe_start_scores.push_back(d.status().best_llr);
       }
       last_pod = pp;
     }
@@ -1226,6 +1231,56 @@ TEST(FaultDetector, ATestWhoseClosedWindowShowsTheMotionIsFollowedAtOnceByTheNex
   // Not asserted: that the confirmation comes sooner. It does on x86-64 (tick 272 against 282);
   // on the aarch64 build the test of pod 0 started a window sooner is read differently and jet 2
   // is confirmed later (272 against 234), as 9 of the 33 stuck-on runs the dispersion moved.
+}
+
+// (F52) A test may start on a stuck-on leader whose score is past probe_start_llr, below
+// confirm_llr. In the mirror trap the first test then starts sooner, on a score below the
+// confirmation level (without F52 every test starts past it), and jet 2 is confirmed stuck on
+// either way; the early test's verdict names it only once its own score is past confirm_llr.
+TEST(FaultDetector, AnIsolationTestMayStartOnAStuckOnLeaderBelowTheConfirmationLevel) {
+  FaultDetectorParams p;  // gnc.yaml's isolation tests
+  p.probe_windows = 1;
+  p.probe_aligned = true;
+  p.probe_read_closed = true;
+  p.probe_partial_rival = true;
+  p.centred_gyro_noise = true;
+  ASSERT_TRUE(validate(p).ok);
+  const AmbiguousRun late = fly_ambiguous(p);
+  p.probe_start_llr = 8.0;
+  ASSERT_TRUE(validate(p).ok);
+  const AmbiguousRun early = fly_ambiguous(p);
+  for (const AmbiguousRun* run : {&late, &early}) {
+    ASSERT_GE(run->r.confirmed_at, 0) << "not isolated";
+    EXPECT_EQ(run->r.thruster, 2);
+    EXPECT_EQ(run->r.kind, FaultKind::kStuckOn);
+    ASSERT_FALSE(run->probe_starts.empty());
+    EXPECT_GT(run->score_before_confirmation, p.confirm_llr);
+  }
+  for (double s : late.probe_start_scores) EXPECT_GT(s, p.confirm_llr);
+  EXPECT_GT(early.probe_start_scores[0], p.probe_start_llr);
+  EXPECT_LE(early.probe_start_scores[0], p.confirm_llr);
+  EXPECT_LT(early.probe_starts[0], late.probe_starts[0]);
+  EXPECT_GT(early.probe_starts[0], 50) << "a test before the fault";
+}
+
+// (F52) Healthy firing at both gyro noise levels with early tests from 8: whatever tests start,
+// none names a jet, as no healthy score reaches confirm_llr.
+TEST(FaultDetector, HealthyFiringConfirmsNothingWithEarlyIsolationTests) {
+  for (double sigma : {3.1623e-6, 3.1623e-5}) {
+    Truth t;
+    t.gyro_sigma = sigma;
+    FaultDetectorParams p = bank_params(sigma);
+    p.probe_windows = 1;
+    p.probe_aligned = true;
+    p.probe_read_closed = true;
+    p.probe_read_elsewhere = true;
+    p.probe_start_llr = 8.0;
+    FaultDetector d = make_detector(t, p);
+    const RunResult r = fly(t, d, 20000, -1, -1, -1);  // 2000 s
+    EXPECT_LT(r.confirmed_at, 0) << "false alarm: thruster " << r.thruster << " after "
+                                 << d.status().probes << " tests";
+    EXPECT_EQ(d.confirmed_on() | d.confirmed_off(), 0);
+  }
 }
 
 // (F16) The tests are read on the likelihood of all their windows. In a reopened window alone the
@@ -2754,6 +2809,16 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
   }
   p.check_long_reach = 0.95;
   EXPECT_TRUE(validate(p).ok);
+  for (double level : {-1.0, 25.0, 30.0, std::nan("")}) {  // (F52) below confirm_llr
+    FaultDetectorParams q;
+    q.probe_start_llr = level;
+    EXPECT_STREQ(validate(q).field, "fdi.probe_start_llr") << level;
+  }
+  {
+    FaultDetectorParams q;
+    q.probe_start_llr = 8.0;
+    EXPECT_TRUE(validate(q).ok);
+  }
   EXPECT_TRUE(validate(FaultDetectorParams{}).ok);
 }
 
