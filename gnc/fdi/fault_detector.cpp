@@ -1058,7 +1058,7 @@ void FaultDetector::decide() {
       blocking = blocking_alternative(best);
     }
   }
-  if (!early_test && blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
+  if (blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
   if (blocking < 0 && best < kThrusters && p_.episode_restart) blocking = partial_loss_rival(best);
   if (blocking < 0) {
     const int thruster = best % kThrusters;

@@ -673,6 +673,7 @@ class FaultDetector {
     probe_tested_pod_ = -1;
     probe_closed_ = 0;
     verdict_pending_ = false;
+    probe_early_ = false;
   }
   // (F15) The stuck-on hypothesis confirmed by a test's outcome, or -1.
   int probe_verdict() const;
