@@ -330,6 +330,7 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("survey_hold_only")) fd.survey_hold_only = r.boolean("survey_hold_only");  // (F43)
     if (r.has("survey_max_kick_rad_s")) fd.survey_max_kick_rad_s = r.non_negative("survey_max_kick_rad_s");  // (F44)
     if (r.has("survey_noise_kick")) fd.survey_noise_kick = r.boolean("survey_noise_kick");  // (F48)
+    if (r.has("check_kick_after_fault")) fd.check_kick_after_fault = r.boolean("check_kick_after_fault");  // (F56)
     if (r.has("check_long_ticks")) {  // (F49), off when absent
       fd.check_long_ticks = r.integer("check_long_ticks");
       if (fd.check_long_ticks != 0 && (fd.check_long_ticks < 4 || fd.check_long_ticks > 1000)) {

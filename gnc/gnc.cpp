@@ -102,7 +102,9 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
   params_ = params;
   configure_components();
   {
-    // The detector takes the table now active; what it has confirmed stays latched.
+    // The detector takes the table now active; what it has confirmed stays latched, and its
+    // counts go on (telemetry counts the flight's suspicions, checks, tests).
+    const FaultDetectorStatus before = fdi_.status();
     const std::uint16_t on = fdi_.confirmed_on();
     const std::uint16_t off = fdi_.confirmed_off();
     const std::uint16_t degraded = fdi_.confirmed_degraded();
@@ -114,6 +116,7 @@ ParamCheck Gnc::apply_params(const GncParams& params, bool declared_change) {
       if ((off >> i) & 1u) fdi_.declare(i, FaultKind::kStuckOff);
       if ((degraded >> i) & 1u) fdi_.declare(i, FaultKind::kDegraded, factor(i));
     }
+    fdi_.carry_counts(before);
   }
   if (estimator_changed) {
     filter_.reset();
@@ -302,7 +305,8 @@ void Gnc::apply_jet_check(const AllocatorLimits& lim, Vec8& u) {
   // the minimum-norm change with B du = 0 that moves channel c by s f (the projection of e_c on
   // the kernel of B), then scales it by the largest gamma in [0, 1] that keeps every channel
   // in [lo, hi] (as the excitation's X5). A channel in the row space of B (no kernel
-  // component) or a jet whose half is unusable (valve closed, latched) is not checked.
+  // component) or a jet whose half is unusable (valve closed, latched) is not checked, and a
+  // channel that cannot move both ways is held still by the move (F55).
   // B is the detector's model, with the identified centre of mass (F42), latched for the whole
   // check when it starts; or, without F42, the active table's B_hat.
   const int i = fdi_.check_jet();
@@ -310,8 +314,14 @@ void Gnc::apply_jet_check(const AllocatorLimits& lim, Vec8& u) {
   const double s = (i % 2 == 0) ? 1.0 : -1.0;
   if ((s > 0.0 && !(lim.hi(c) > 0.0)) || (s < 0.0 && !(lim.lo(c) < 0.0))) return;
   if (check_move_jet_ != i) {
+    // (F55) A channel that cannot move both ways is held (the detector's model: its latches and
+    // the valves; the table's: the bounds).
+    std::uint8_t held = 0;
+    for (int j = 0; j < kChannels; ++j) {
+      if (!(lim.hi(j) > 0.0) || !(lim.lo(j) < 0.0)) held = static_cast<std::uint8_t>(held | (1u << j));
+    }
     check_move_ok_ = fdi_.check_on_model() ? fdi_.check_move(c, check_move_)
-                                           : jet_check_move(alloc_.b_hat(), c, check_move_);
+                                           : jet_check_move(alloc_.b_hat(), c, check_move_, held);
     check_move_jet_ = i;
   }
   if (!check_move_ok_) return;

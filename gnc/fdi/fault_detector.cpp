@@ -198,6 +198,7 @@ void FaultDetector::cancel_evaluation() {
 }
 
 void FaultDetector::reset() {
+  valve_open_ = {{true, true, true, true}};
   have_start_ = false;
   last_suspicious_ = false;
   n_ = 0;
@@ -296,6 +297,31 @@ void FaultDetector::declare(int thruster, FaultKind kind, double factor) {
   end_check();
 }
 
+void FaultDetector::carry_counts(const FaultDetectorStatus& b) {
+  st_.suspicions += b.suspicions;
+  st_.models_held += b.models_held;
+  st_.probes += b.probes;
+  st_.episode_restarts += b.episode_restarts;
+  st_.identified_confirmations += b.identified_confirmations;
+  st_.sweeps += b.sweeps;
+  st_.sweep_confirmations += b.sweep_confirmations;
+  st_.degraded_confirmations += b.degraded_confirmations;
+  st_.checks += b.checks;
+  st_.checks_unfit += b.checks_unfit;
+  st_.surveys += b.surveys;
+  st_.survey_ratings += b.survey_ratings;
+  st_.survey_kick_refusals += b.survey_kick_refusals;
+  st_.evidence_kick_refusals += b.evidence_kick_refusals;
+  st_.survey_noise_refusals += b.survey_noise_refusals;
+  st_.long_checks += b.long_checks;
+  st_.long_checks_dropped += b.long_checks_dropped;
+  st_.long_checks_capped += b.long_checks_capped;
+  st_.early_detections += b.early_detections;
+  st_.onset_restarts += b.onset_restarts;
+  st_.probe_whole_windows += b.probe_whole_windows;
+  st_.elsewhere_verdicts += b.elsewhere_verdicts;
+}
+
 void FaultDetector::clear(int thruster) {
   identified_confirm_ = -1;
   st_.identified_best = -1;
@@ -390,6 +416,7 @@ FaultEvents FaultDetector::update(const FaultDetectorInput& in) {
   pending_ = FaultEvents{};
   if (!p_.enabled) return pending_;
   survey_allowed_ = in.survey_allowed;
+  valve_open_ = in.valve_open;
   // (F18) A jet latched degraded delivers its factor of what is commanded: everything (the
   // prediction, the hypotheses' ramps, the sweep's delivered thrust) sees the delivered thrust.
   if (st_.confirmed_degraded == 0) return step(in);
@@ -1729,9 +1756,23 @@ void FaultDetector::update_check() {
   int windows = p_.check_windows;
   double force = p_.check_force_n;
   bool capped = false;
+  // (F56) After a confirmed fault, an evidence check within the kick bound of a survey's only.
+  const bool kick_gated = p_.check_kick_after_fault && p_.survey_max_kick_rad_s > 0.0 &&
+                          (latched | st_.confirmed_degraded) != 0;
+  if (jet >= 0 && !long_checks && kick_gated) {
+    double kick_rate = 0.0;
+    const double e = expected_check_energy(jet, &kick_rate);
+    if (!(e > 0.0) || 3.0 * kick_rate * static_cast<double>(windows) * window_s >
+                          p_.survey_max_kick_rad_s) {
+      ++st_.evidence_kick_refusals;
+      last_check_[static_cast<std::size_t>(jet)] = st_.windows + 1;  // due one interval from now
+      jet = -1;
+    }
+  }
   if (jet >= 0 && long_checks) {
-    force = long_check_force(jet, p_.check_long_evidence_energy, false, &capped);
+    force = long_check_force(jet, p_.check_long_evidence_energy, kick_gated, &capped);
     if (!(force > 0.0)) {
+      if (kick_gated) ++st_.evidence_kick_refusals;
       capped = false;
       // No long check of it within the gates: due again one interval from now (not a check).
       last_check_[static_cast<std::size_t>(jet)] = st_.windows + 1;
@@ -1874,7 +1915,17 @@ bool FaultDetector::check_move(int c, Vec8& du) const {
     const auto kq = static_cast<std::size_t>(2 * q);
     b.col(q) = (pos_[kq] + m_.r).cross(dir_[kq]);
   }
-  return jet_check_move(b, c, du);
+  return jet_check_move(b, c, du, held_channels());
+}
+
+std::uint8_t FaultDetector::held_channels() const {
+  const auto latched = static_cast<unsigned>(st_.confirmed_on | st_.confirmed_off);
+  std::uint8_t held = 0;
+  for (int q = 0; q < kChannels; ++q) {
+    const bool open = valve_open_[static_cast<std::size_t>(pod_[static_cast<std::size_t>(2 * q)])];
+    if (!open || ((latched >> (2 * q)) & 3u) != 0) held = static_cast<std::uint8_t>(held | (1u << q));
+  }
+  return held;
 }
 
 double FaultDetector::expected_check_llr(int i) const {

@@ -262,6 +262,15 @@ struct FaultDetectorParams {
   // check_long_energy; the evidence of successive checks adds up in the jet's sums (F18, F23).
   // 0: such a jet is not checked (F49).
   double check_long_reach{0.0};
+  // (F56) After a confirmed fault (any jet latched on, off or degraded), an evidence check too is
+  // flown only within the kick bound of a survey check (F44: 3 sigma of the rate the model's
+  // error may put on the body over the check, survey_max_kick_rad_s; a long check's, F49, with a
+  // dead jet's kick as well). The confirmation restarts the identifier from its prior (I27 off):
+  // a check of the evidence that the re-inflated model builds up would be flown on that model,
+  // and a despin flown beside its repeated checks misses its goals. A refused jet is due again
+  // one check interval later, not counted as a check. false: evidence checks are never gated on
+  // their kick.
+  bool check_kick_after_fault{false};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
@@ -348,6 +357,7 @@ struct FaultDetectorStatus {
   std::uint32_t surveys{0};                   // (F36) of the checks, those started by the survey
   std::uint32_t survey_ratings{0};  // (F36) due jets rated against the check gates (<= 1 a decision)
   std::uint32_t survey_kick_refusals{0};  // (F44) due jets not surveyed: the check would kick the rate
+  std::uint32_t evidence_kick_refusals{0};  // (F56) evidence checks not flown after a fault: kick
   std::uint32_t survey_noise_refusals{0};  // (F48) due jets not surveyed: the gyro too noisy
   std::uint32_t long_checks{0};  // (F49) of the checks, those flown as one long window
   std::uint32_t long_checks_dropped{0};  // (F49) ended by an early suspicion off their jet
@@ -398,6 +408,11 @@ class FaultDetector {
   // model's thrust from now on (a factor of 1 or out of range leaves it healthy).
   void declare(int thruster, FaultKind kind, double factor = 1.0);
   void clear(int thruster);                    // -1: every thruster
+  // Adds the counters of `before` (a status of this detector before it was configured again) to
+  // this one's: the flight reconfigures the detector with every table it takes (a model adoption,
+  // an uplink), and its counts in telemetry are the flight's, not the configuration's. The window
+  // count, to which the checks' intervals are kept, and the state start afresh.
+  void carry_counts(const FaultDetectorStatus& before);
   // (F14) Evidence from the identifier's fault torque, after each of its windows. A stuck-on it
   // isolates is confirmed on the next update (the same event and latch as (F6)).
   void identified_evidence(const StuckOnEvidence& e);
@@ -429,6 +444,9 @@ class FaultDetector {
   // the minimum-norm move with no torque on the detector's model, whose channel torques are
   // (p + r_hat) x d with the identified centre of mass. False when channel c has no such move.
   bool check_move(int c, Vec8& du) const;
+  // (F55) The channels a check's move holds (bit j: channel j): a half latched stuck on or off,
+  // or its pod's valve closed in this update's input.
+  std::uint8_t held_channels() const;
   bool check_on_model() const { return p_.check_model_null_space; }
 
   // Rate change signature of hypothesis h over the last window (exposed for tests): 0..15
@@ -525,6 +543,8 @@ class FaultDetector {
   std::array<std::uint8_t, kThrusters> check_backoff_{};  // doublings of each jet's interval (0..2)
   std::array<double, kThrusters> survey_e_{};  // (F36) stuck-off energy since last verified
   bool survey_allowed_{true};  // (F43) this update's FaultDetectorInput::survey_allowed
+  // (F55) The pods' latch valves of this update's input: a check's move holds their channels.
+  std::array<bool, kPods> valve_open_{{true, true, true, true}};
   bool survey_noisy_{false};  // (F48) the gyro too noisy for a survey check within its kick bound
   std::array<std::uint32_t, kThrusters> survey_from_{};  // (F36) window count when last verified
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust

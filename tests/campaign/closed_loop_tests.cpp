@@ -459,6 +459,42 @@ TEST(ClosedLoop, AJetStuckOnJustBeforeAWindowClosesIsIsolatedWithinThreeSeconds)
       << "the trap: the episode kept, the confirmation comes a window later";
 }
 
+// The detector's counts are the whole flight's. The flight reconfigures the detector at every
+// model adoption, which restarts its state; its counters go on (Gnc::apply_params carries them;
+// before, they started again from zero and a run reported only its last adoption's share, here
+// 10 of the 12 checks). Case 4, jet 1 stuck on from 60 s (its pod closed at 250 s), flown to
+// 45 000 s and logged every second: the jet checks reported are the checks the log shows
+// starting (a change of fdi_check_jet to a jet; a check lasts at least three 1 s windows, so
+// every one is seen), across the run's model adoptions.
+TEST(ClosedLoop, TheDetectorCountsEveryJetCheckOfTheFlightAcrossModelAdoptions) {
+  config::RunSetup s = load(4);
+  plant::ThrusterFault f;
+  f.thruster = 1;
+  f.kind = plant::FaultKind::kStuckOn;
+  f.onset_s = 60.0;
+  s.truth.faults.push_back(f);
+  const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", 1.0, 45000.0);
+  ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
+  ASSERT_EQ(r.fdi.thruster, 1);
+  std::uint32_t starts = 0;
+  double last_start = 0.0;
+  int prev = -1;
+  for (const TimeRow& row : r.series) {
+    if (row.fdi_check_jet >= 0 && row.fdi_check_jet != prev) {
+      ++starts;
+      last_start = row.t;
+    }
+    prev = row.fdi_check_jet;
+  }
+  ASSERT_GE(starts, 2u) << "the premise: checks flown after the confirmation";
+  EXPECT_GT(r.estimation.model_adoptions, 0u) << "the premise: the detector reconfigured";
+  EXPECT_EQ(r.fdi.checks, starts) << "last check started at " << last_start << " s";
+  EXPECT_LE(r.fdi.surveys, r.fdi.checks);
+  std::printf("case 4, jet 1 stuck on from 60 s, 45 000 s: %u checks (%u surveys), %u model "
+              "adoptions\n",
+              r.fdi.checks, r.fdi.surveys, r.estimation.model_adoptions);
+}
+
 // (F42) Case 7 (the a-priori centre of mass 1 m off) in HOLD with the jet survey every 20 000 s
 // (F36, in HOLD only, F43), flown to 45 000 s: its second round of survey checks, at about
 // 40 000 s, fires jets at 100 N with a net force of up to 107 N (the axial jets) in the null space
@@ -513,8 +549,10 @@ TEST(ClosedLoop, SurveyChecksInTheIdentifiedModelsNullSpaceDoNotKickTheRate) {
 // is confirmed in the despin, and the identifier restarts from its prior (I27 off): in HOLD its
 // centre of mass is metres off. A survey check in that model's null space then puts its error
 // times the check's net force on the body: the rate leaves the SPEC §7 bound late in the flight
-// and the attitude goal is missed. With the check held back while 3 sigma of its kick exceeds
-// half the rate bound (gnc.yaml: 5e-5 rad/s), both goals are met as without a survey.
+// and converges again only after 80 000 s (before F55, whose move holds the latched channel
+// still, never: the attitude goal was missed too). With the check held back while 3 sigma of its
+// kick exceeds half the rate bound (gnc.yaml: 5e-5 rad/s), both goals are met as without a
+// survey, t_omega,conv before 30 000 s.
 TEST(ClosedLoop, NoSurveyCheckKicksTheRateAgainstAModelRestartedByAFault) {
   config::RunSetup s = load(1);
   EXPECT_GT(s.flight.fdi.survey_max_kick_rad_s, 0.0) << "gnc.yaml flies it";
@@ -538,8 +576,7 @@ TEST(ClosedLoop, NoSurveyCheckKicksTheRateAgainstAModelRestartedByAFault) {
   }
   EXPECT_TRUE(gated.t_q_conv_s.has_value());
   EXPECT_LT(*gated.t_omega_conv_s, 30000.0);
-  EXPECT_GT(*open.t_omega_conv_s, 90000.0) << "the trap: a late check kicks the rate out";
-  EXPECT_FALSE(open.t_q_conv_s.has_value()) << "the trap: the attitude goal missed";
+  EXPECT_GT(*open.t_omega_conv_s, 60000.0) << "the trap: a late check kicks the rate out";
 }
 
 // The campaign's measure of how much a stuck-off jet was asked to fire after onset (the issue's

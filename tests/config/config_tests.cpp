@@ -568,7 +568,8 @@ TEST(ConfigShipped, TheEarlyIsolationTestsLevelIsReadAndOptional) {
 // another pod's jet named by a test's closed windows, (F41) the episode restarted for a new leader,
 // (F21) the onset window not scored, (F45) ended at its early suspicion, (F42) checks in the
 // identified model's null space, (F43) the survey in HOLD only and (F48) not where the gyro is
-// too noisy, (F51) the loss gate on the signature's error along itself:
+// too noisy, (F51) the loss gate on the signature's error along itself, (F56) evidence checks
+// after a fault within the kick bound:
 // gnc.yaml true, the former behaviour (false) when a key is absent, and a value that is not a
 // boolean names the file and key.
 TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAndOptional) {
@@ -577,7 +578,8 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
                           "check_blocker", "episode_restart_stale", "probe_read_elsewhere",
                           "episode_restart_leader", "skip_onset_window",
                           "check_model_null_space", "survey_hold_only", "onset_restart",
-                          "survey_noise_kick", "degraded_loss_projection"}) {
+                          "survey_noise_kick", "degraded_loss_projection",
+                          "check_kick_after_fault"}) {
     const std::string line = std::string("  ") + key + ": true";
     const auto get = [&](const auto& f) {
       const std::string k = key;
@@ -596,6 +598,7 @@ TEST(ConfigShipped, TheAlignedTestTheCentredGyroNoiseAndThePartialRivalAreReadAn
              : k == "onset_restart"         ? f.onset_restart
              : k == "survey_noise_kick"     ? f.survey_noise_kick
              : k == "degraded_loss_projection" ? f.degraded_loss_projection
+             : k == "check_kick_after_fault" ? f.check_kick_after_fault
                                           : f.check_score_unfit;
     };
     EXPECT_TRUE(get(load_run(kMission, kGnc, case_file(1)).flight.fdi)) << key;

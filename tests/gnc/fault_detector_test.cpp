@@ -2151,6 +2151,68 @@ TEST(FaultDetector, ASurveyCheckThatMayKickTheRateBeyondItsBoundIsNotFlown) {
   }
 }
 
+// (F56) After a confirmed fault, an evidence check is flown only within the survey's kick bound
+// (F44). Jet 14 is latched stuck off (declared; the firing no longer commands it) and jet 6 dies
+// at the start, under weak firing, so jet 6's evidence reaches check_llr. With the centre of mass
+// known to 1 mm, its check kicks the rate by less than 2e-6 rad/s: it is flown and confirms jet 6
+// stuck off, nothing refused. Known to 5 cm (about 100 N of check force then leaves 5 N m
+// unknown), no check is flown and each refusal is counted. Without the latch, or with the gate
+// off, the 5 cm model checks jet 6 as before: the gate applies only after a fault.
+TEST(FaultDetector, AfterAConfirmedFaultAnEvidenceCheckBeyondTheKickBoundIsNotFlown) {
+  struct WithoutJet {
+    WeakFiring firing;
+    int jet;
+    Vec16 next(int tick) {
+      Vec16 f = firing.next(tick);
+      if (jet >= 0) f(jet) = 0.0;  // a latched jet is not allocated
+      return f;
+    }
+  };
+  constexpr int kDead = 6;
+  constexpr int kLatched = 14;
+  for (const double r_sigma : {1e-3, 0.05}) {
+    for (const bool latch : {true, false}) {
+      for (const bool gate : {true, false}) {
+        if (r_sigma < 0.01 && !(latch && gate)) continue;  // the 1 mm model is never gated
+        Truth t;
+        t.stuck_off = kDead;
+        FaultDetectorParams p = bank_params(t.gyro_sigma);
+        p.degraded_min_loss = 0.1;
+        p.check_llr = 5.0;
+        p.survey_max_kick_rad_s = 2e-6;
+        p.check_kick_after_fault = gate;
+        FaultDetector d;
+        d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+        FaultModel m = identified_model(t);
+        m.r_cov = Mat3::Identity() * r_sigma * r_sigma;
+        d.set_model(m);
+        if (latch) d.declare(kLatched, FaultKind::kStuckOff);
+        const CheckRun run =
+            fly_checks(t, d, WithoutJet{WeakFiring(106), latch ? kLatched : -1}, 30000);
+        const std::string what = "r 1 sigma " + std::to_string(r_sigma) + " m, latch " +
+                                 std::to_string(latch) + ", gate " + std::to_string(gate);
+        const bool gated = latch && gate && r_sigma > 0.01;
+        const bool dead_checked =
+            std::find(run.checked.begin(), run.checked.end(), kDead) != run.checked.end();
+        EXPECT_EQ(d.status().checks, run.checked.size()) << what;
+        if (gated) {
+          EXPECT_EQ(d.status().checks, 0u) << what;
+          EXPECT_GT(d.status().evidence_kick_refusals, 0u) << what;
+        } else {
+          EXPECT_TRUE(dead_checked) << what;
+          EXPECT_EQ(d.status().evidence_kick_refusals, 0u) << what;
+        }
+        if (r_sigma < 0.01) {
+          ASSERT_GE(run.r.confirmed_at, 0) << what;
+          EXPECT_EQ(run.r.thruster, kDead) << what;
+          EXPECT_EQ(run.r.kind, FaultKind::kStuckOff) << what;
+        }
+        EXPECT_TRUE(run.r.confirmed_at < 0 || run.r.thruster == kDead) << what;
+      }
+    }
+  }
+}
+
 // (F48) No survey check where the gyro is too noisy for one window to show a dead jet within the
 // kick bound. The least kick K that gives a total loss survey_energy over one window is found here
 // by summing the mean-centred ramp sample by sample (the rate K j / n at sample j), and the

@@ -4,11 +4,15 @@
 // continues; the ground's overrides (declare, clear, valve, inhibit) act at the tick boundary.
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <vector>
 
+#include "gnc/fdi/jet_check.hpp"
 #include "gnc/gnc.hpp"
 #include "gnc/math/rotation.hpp"
 #include "gnc/model/rcs.hpp"
@@ -590,7 +594,10 @@ struct CheckLoopRun {
   int checked_ticks{0};
 };
 
-CheckLoopRun fly_stuck_off_checked(int jet, double check_llr, double seconds) {
+// held: a thruster the ground declares stuck off at the start (-1: none), so that its channel
+// can move one way only; on_model: the check's move on the detector's model (F42).
+CheckLoopRun fly_stuck_off_checked(int jet, double check_llr, double seconds, int held = -1,
+                                   bool on_model = false) {
   // Case 5's gyro (3.2e-6 rad/s per sample) and an inertia known to 0.2 %: the despin's few
   // newtons on the jet take about a minute to show.
   GncParams p = fdi_params();
@@ -599,6 +606,7 @@ CheckLoopRun fly_stuck_off_checked(int jet, double check_llr, double seconds) {
   p.fdi.gyro_sigma = 3.1623e-6;
   p.fdi.window_ticks = 10;  // gnc.yaml's, quiet sensors
   p.fdi_table_rel_sigma = 2e-3;
+  p.fdi.check_model_null_space = on_model;
   std::mt19937_64 rng(17);
   std::normal_distribution<double> noise(0.0, p.fdi.gyro_sigma);
   const Mat38 b_hat = torque_matrix(p.rcs, p.mass_hat.r_so_bcm);
@@ -609,6 +617,13 @@ CheckLoopRun fly_stuck_off_checked(int jet, double check_llr, double seconds) {
   GncCommands c;
   c.has_mode_request = true;
   c.mode_request = Mode::kDetumble;
+  if (held >= 0) {
+    c.has_fault_declaration = true;
+    c.fault_thruster = static_cast<std::int8_t>(held);
+    c.fault_kind = FaultKind::kStuckOff;
+    truth.degraded = held;  // the truth agrees: it delivers nothing
+    truth.degraded_factor = 0.0;
+  }
   double t = 0.0;
   CheckLoopRun run;
   constexpr double kOnset = 300.0;
@@ -669,6 +684,111 @@ TEST(GncFdi, AJetCheckFiresTheSuspectedJetTorqueFreeAndIsolatesItStuckOff) {
   EXPECT_EQ(passive.check_events, 0);
   std::printf("thruster %d stuck off at 300 s: checked at %.1f s, confirmed at %.1f s\n", kJet,
               run.first_check_at, run.confirmed_at);
+}
+
+// (F55) jet_check_move with held channels against an independent construction: the kernel of the
+// free channels' torque matrix from its singular value decomposition, e_c projected on it. For
+// every channel c and every held set of up to two other channels (and each pod's pair): no torque,
+// the held channels still, and the same least move.
+TEST(JetCheckMove, HeldChannelsStayStillAndTheMoveIsTheLeastOnTheOthers) {
+  const GncParams p = fdi_params();
+  const Mat38 b = torque_matrix(p.rcs, p.mass_hat.r_so_bcm + Vec3(0.3, -0.2, 0.1));
+  int cases = 0;
+  for (int c = 0; c < kChannels; ++c) {
+    for (unsigned held = 0; held < 256u; ++held) {
+      if (((held >> c) & 1u) != 0 || __builtin_popcount(held) > 2) continue;
+      Vec8 du;
+      const bool ok = jet_check_move(b, c, du, static_cast<std::uint8_t>(held));
+      // Independent: free columns, their kernel from the SVD, e_c projected on it.
+      std::vector<int> free;
+      for (int j = 0; j < kChannels; ++j) {
+        if (((held >> j) & 1u) == 0) free.push_back(j);
+      }
+      Eigen::MatrixXd bf(3, static_cast<Eigen::Index>(free.size()));
+      for (std::size_t q = 0; q < free.size(); ++q) bf.col(static_cast<Eigen::Index>(q)) = b.col(free[q]);
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(bf, Eigen::ComputeFullV);
+      const Eigen::Index rank = svd.rank();
+      ASSERT_EQ(rank, 3) << "c " << c << " held " << held;
+      const Eigen::MatrixXd n = svd.matrixV().rightCols(bf.cols() - rank);
+      Eigen::VectorXd ec = Eigen::VectorXd::Zero(bf.cols());
+      for (std::size_t q = 0; q < free.size(); ++q) {
+        if (free[q] == c) ec(static_cast<Eigen::Index>(q)) = 1.0;
+      }
+      const Eigen::VectorXd proj = n * (n.transpose() * ec);
+      Vec8 want = Vec8::Zero();
+      for (std::size_t q = 0; q < free.size(); ++q) want(free[q]) = proj(static_cast<Eigen::Index>(q));
+      ASSERT_TRUE(ok) << "c " << c << " held " << held;
+      EXPECT_LT((b * du).norm(), 1e-12 * b.norm()) << "c " << c << " held " << held;
+      for (int j = 0; j < kChannels; ++j) {
+        if (((held >> j) & 1u) != 0) {
+          EXPECT_EQ(du(j), 0.0) << "c " << c << " held " << held;
+        }
+      }
+      EXPECT_LT((du - want).norm(), 1e-9) << "c " << c << " held " << held;
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 8 * (1 + 7 + 21));
+  // A closed pod holds both its channels (pods 0-3: channels 2k, 2k+1): still a move for the others.
+  for (int pod = 0; pod < kPods; ++pod) {
+    const auto held = static_cast<std::uint8_t>(3u << (2 * pod));
+    for (int c = 0; c < kChannels; ++c) {
+      if (c / 2 == pod) continue;
+      Vec8 du;
+      ASSERT_TRUE(jet_check_move(b, c, du, held)) << "pod " << pod << " c " << c;
+      EXPECT_EQ(du(2 * pod), 0.0);
+      EXPECT_EQ(du(2 * pod + 1), 0.0);
+      EXPECT_LT((b * du).norm(), 1e-12 * b.norm());
+    }
+  }
+  // No held channel: the move as before (the plain projection).
+  Vec8 du;
+  ASSERT_TRUE(jet_check_move(b, 3, du));
+  const Mat3 g = b * b.transpose();
+  Vec8 plain = -(b.transpose() * g.inverse() * b.col(3));
+  plain(3) += 1.0;
+  EXPECT_LT((du - plain).norm(), 1e-12);
+}
+
+// (F55) With a half of another channel latched (declared stuck off: that channel may only go
+// negative), the least torque-free move of channel 2 ("+" = jet 4) asks it for some of its dead
+// "+" half; the flight's scaling into the bounds then left the check unflown (gamma 0) while the
+// detector counted it. The move holds such a channel still: jet 4's check fires, on the table's
+// B_hat and on the detector's model, and isolates it.
+TEST(GncFdi, AJetCheckBesideALatchedChannelHoldsItAndFires) {
+  constexpr int kJet = 4;  // channel 2 "+", fired at a few newtons by the despin
+  // The held jet: the "+" half of the channel that the unheld least move of channel 2 asks most
+  // of, declared stuck off (its channel may then only go negative).
+  int held = -1;
+  {
+    const GncParams p = fdi_params();
+    Vec8 du;
+    ASSERT_TRUE(jet_check_move(torque_matrix(p.rcs, p.mass_hat.r_so_bcm), kJet / 2, du));
+    double most = 1e-3;
+    for (int j = 0; j < kChannels; ++j) {
+      if (j != kJet / 2 && du(j) > most) {
+        most = du(j);
+        held = 2 * j;
+      }
+    }
+    ASSERT_GE(held, 0) << "the move asks no channel's + half";
+  }
+  const int kHeld = held;
+  for (const bool on_model : {false, true}) {
+    SCOPED_TRACE(on_model ? "the detector's model" : "the table's B_hat");
+    const CheckLoopRun run = fly_stuck_off_checked(kJet, 5.0, 3000.0, kHeld, on_model);
+    ASSERT_GE(run.check_events, 1) << "the jet was never checked";
+    EXPECT_GT(run.checked_ticks, 0);
+    EXPECT_GE(run.max_checked_force, 50.0) << "the check did not fire";
+    EXPECT_LT(run.max_torque_error, 1e-9);
+    ASSERT_GE(run.confirmed_at, 0.0) << "never confirmed";
+    EXPECT_EQ(run.thruster, kJet);
+    EXPECT_EQ(run.kind, FaultKind::kStuckOff);
+    EXPECT_LE(run.confirmed_at - run.first_check_at, 30.0);
+    std::printf("jet %d stuck off beside jet %d declared (%s): checked at %.1f s, confirmed at %.1f s, "
+                "%.0f N\n", kJet, kHeld, on_model ? "model" : "B_hat", run.first_check_at,
+                run.confirmed_at, run.max_checked_force);
+  }
 }
 
 TEST(GncFdi, InhibitedIsolationConfirmsButKeepsTheValveOpen) {
