@@ -26,6 +26,16 @@ config::RunSetup load(int n) {
                           kConfigs + "/cases/case" + std::to_string(n) + ".yaml");
 }
 
+// Adds a thruster fault to the truth of s (the flight never sees it) and returns it.
+plant::ThrusterFault inject(config::RunSetup& s, int thruster, plant::FaultKind kind, double onset_s) {
+  plant::ThrusterFault f;
+  f.thruster = thruster;
+  f.kind = kind;
+  f.onset_s = onset_s;
+  s.truth.faults.push_back(f);
+  return f;
+}
+
 RunResult run(const config::RunSetup& s, const std::string& strategy, double log_interval = 0.0,
               double duration = -1.0) {
   GncFlightSide flight;
@@ -262,11 +272,7 @@ TEST(ClosedLoop, AStuckOnJetsDetectionIsTheFirstWindowAboveTheBoundAfterOnset) {
     config::RunSetup s = load(1);
     ASSERT_GT(s.flight.fdi.detect_early_ticks, 0) << "gnc.yaml's early detection";
     if (early == 0) s.flight.fdi.detect_early_ticks = 0;
-    plant::ThrusterFault f;
-    f.thruster = 0;
-    f.kind = plant::FaultKind::kStuckOn;
-    f.onset_s = 3000.0;
-    s.truth.faults.push_back(f);
+    const plant::ThrusterFault f = inject(s, 0, plant::FaultKind::kStuckOn, 3000.0);
     const double dt = s.flight.dt;
     const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", dt, 3060.0);
     ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
@@ -383,11 +389,7 @@ TEST(ClosedLoop, AThrusterStuckOnInHoldIsConfirmedByTheIsolationTest) {
   ASSERT_EQ(healthy.status, RunStatus::kOk) << healthy.note;
   EXPECT_EQ(healthy.fdi.confirmations, 0);
   EXPECT_EQ(healthy.final_mode, std::string("HOLD"));
-  plant::ThrusterFault f;
-  f.thruster = 0;
-  f.kind = plant::FaultKind::kStuckOn;
-  f.onset_s = 50000.0;
-  s.truth.faults.push_back(f);
+  const plant::ThrusterFault f = inject(s, 0, plant::FaultKind::kStuckOn, 50000.0);
   const RunResult r = run(s, "ntcl+dpd_ref:id:fdi");
   ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
   ASSERT_TRUE(r.fdi.first_confirmation_s.has_value()) << "never confirmed";
@@ -406,11 +408,7 @@ std::pair<double, double> stuck_on_latency_with_and_without(int case_number, int
   config::RunSetup s = load(case_number);
   EXPECT_TRUE(s.flight.fdi.*sw) << "gnc.yaml flies it";
   s.flight.fdi.skip_onset_window = false;
-  plant::ThrusterFault f;
-  f.thruster = thruster;
-  f.kind = plant::FaultKind::kStuckOn;
-  f.onset_s = 10000.0;
-  s.truth.faults.push_back(f);
+  const plant::ThrusterFault f = inject(s, thruster, plant::FaultKind::kStuckOn, 10000.0);
   s.flight.fdi.*sw = true;
   const RunResult on = run(s, "ntcl+dpd_ref:id:fdi", 0.0, 10020.0);
   s.flight.fdi.*sw = false;
@@ -468,11 +466,7 @@ TEST(ClosedLoop, AJetStuckOnJustBeforeAWindowClosesIsIsolatedWithinThreeSeconds)
 // every one is seen), across the run's model adoptions.
 TEST(ClosedLoop, TheDetectorCountsEveryJetCheckOfTheFlightAcrossModelAdoptions) {
   config::RunSetup s = load(4);
-  plant::ThrusterFault f;
-  f.thruster = 1;
-  f.kind = plant::FaultKind::kStuckOn;
-  f.onset_s = 60.0;
-  s.truth.faults.push_back(f);
+  inject(s, 1, plant::FaultKind::kStuckOn, 60.0);
   const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", 1.0, 45000.0);
   ASSERT_EQ(r.status, RunStatus::kOk) << r.note;
   ASSERT_EQ(r.fdi.thruster, 1);
@@ -556,11 +550,7 @@ TEST(ClosedLoop, SurveyChecksInTheIdentifiedModelsNullSpaceDoNotKickTheRate) {
 TEST(ClosedLoop, NoSurveyCheckKicksTheRateAgainstAModelRestartedByAFault) {
   config::RunSetup s = load(1);
   EXPECT_GT(s.flight.fdi.survey_max_kick_rad_s, 0.0) << "gnc.yaml flies it";
-  plant::ThrusterFault f;
-  f.thruster = 4;
-  f.kind = plant::FaultKind::kStuckOff;
-  f.onset_s = 10000.0;
-  s.truth.faults.push_back(f);
+  inject(s, 4, plant::FaultKind::kStuckOff, 10000.0);
   s.flight.fdi.survey_interval_s = 20000.0;
   const RunResult gated = run(s, "ntcl+dpd_ref:id:fdi");
   s.flight.fdi.survey_max_kick_rad_s = 0.0;
@@ -585,11 +575,7 @@ TEST(ClosedLoop, NoSurveyCheckKicksTheRateAgainstAModelRestartedByAFault) {
 // off at 3000 s in case 1.
 TEST(ClosedLoop, TheFaultyJetsCommandedFiringIsMeasuredFromOnsetToTheConfirmation) {
   config::RunSetup s = load(1);
-  plant::ThrusterFault f;
-  f.thruster = 4;
-  f.kind = plant::FaultKind::kStuckOff;
-  f.onset_s = 3000.0;
-  s.truth.faults.push_back(f);
+  const plant::ThrusterFault f = inject(s, 4, plant::FaultKind::kStuckOff, 3000.0);
   const double dt = s.flight.dt;
   const RunResult r = run(s, "ntcl+dpd_ref:id:fdi", dt, 5000.0);
   ASSERT_EQ(r.status, RunStatus::kOk) << r.note;

@@ -2119,6 +2119,16 @@ TEST(FaultDetector, NoSurveyCheckStartsWhileTheFlightDisallowsIt) {
   EXPECT_EQ(d.status().surveys, static_cast<std::uint32_t>(surveys));
 }
 
+// The detector on the identified model with its centre of mass known to r_sigma (1 sigma, m).
+FaultDetector make_detector_r(const Truth& t, const FaultDetectorParams& p, double r_sigma) {
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m = identified_model(t);
+  m.r_cov = Mat3::Identity() * r_sigma * r_sigma;
+  d.set_model(m);
+  return d;
+}
+
 // (F44) A survey check whose firing, against the model's error, may put more than
 // survey_max_kick_rad_s (3 sigma) of rate on the body is not flown. At a bound of 2e-6 rad/s: with
 // the centre of mass known to 1 mm the jets the firing commands are surveyed as without the gate;
@@ -2130,11 +2140,7 @@ TEST(FaultDetector, ASurveyCheckThatMayKickTheRateBeyondItsBoundIsNotFlown) {
       Truth t;
       FaultDetectorParams p = survey_params(t, 300.0);
       p.survey_max_kick_rad_s = bound;
-      FaultDetector d;
-      d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-      FaultModel m = identified_model(t);
-      m.r_cov = Mat3::Identity() * r_sigma * r_sigma;
-      d.set_model(m);
+      FaultDetector d = make_detector_r(t, p, r_sigma);
       const SurveyRun run = fly_hold(t, d, 12000, -1, -1, 21);
       const std::string what =
           "r 1 sigma " + std::to_string(r_sigma) + " m, bound " + std::to_string(bound);
@@ -2181,11 +2187,7 @@ TEST(FaultDetector, AfterAConfirmedFaultAnEvidenceCheckBeyondTheKickBoundIsNotFl
         p.check_llr = 5.0;
         p.survey_max_kick_rad_s = 2e-6;
         p.check_kick_after_fault = gate;
-        FaultDetector d;
-        d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
-        FaultModel m = identified_model(t);
-        m.r_cov = Mat3::Identity() * r_sigma * r_sigma;
-        d.set_model(m);
+        FaultDetector d = make_detector_r(t, p, r_sigma);
         if (latch) d.declare(kLatched, FaultKind::kStuckOff);
         const CheckRun run =
             fly_checks(t, d, WithoutJet{WeakFiring(106), latch ? kLatched : -1}, 30000);
