@@ -95,6 +95,9 @@ Check validate(const FaultDetectorParams& p) {
     return bad("fdi.survey_interval_s", "must be >= 0 and finite");
   }
   if (!finite_positive(p.survey_energy)) return bad("fdi.survey_energy", "must be positive");
+  if (!finite_non_negative(p.survey_loss_llr)) {
+    return bad("fdi.survey_loss_llr", "must be >= 0 and finite");  // (F57)
+  }
   if (!finite_non_negative(p.survey_max_kick_rad_s)) {
     return bad("fdi.survey_max_kick_rad_s", "must be >= 0 and finite");
   }
@@ -218,6 +221,8 @@ void FaultDetector::reset() {
   check_backoff_.fill(0);
   survey_e_.fill(0.0);
   survey_from_.fill(st_.windows);
+  loss_survey_at_.fill(0);
+  candidate_loss_ = false;
   st_.unverified = 0;
   check_prev_ = -1;
   quiet_var_ = 0.0;
@@ -1787,6 +1792,7 @@ void FaultDetector::update_check() {
     const auto ks = static_cast<std::size_t>(jet);
     survey_e_[ks] = 0.0;  // its survey clock restarts with the check (verified or not)
     survey_from_[ks] = st_.windows;
+    if (candidate_loss_) loss_survey_at_[ks] = st_.windows + 1;  // (F57)
     st_.unverified = static_cast<std::uint16_t>(st_.unverified & ~(1u << jet));
   }
   st_.check_jet = jet;
@@ -1836,7 +1842,10 @@ void FaultDetector::update_survey() {
     const double e = window_energy_[k];
     if (!(e > 0.0)) continue;
     survey_e_[k] += e;
-    if (survey_e_[k] >= p_.survey_energy) {
+    // (F57) ... and whose partial-loss evidence is not between survey_loss_llr and check_llr (past
+    // check_llr the evidence checks, F19, answer it).
+    const bool loss_evidence = survey_loss_evidence(k);
+    if (survey_e_[k] >= p_.survey_energy && !loss_evidence) {
       survey_e_[k] = 0.0;
       survey_from_[k] = st_.windows;
       st_.unverified = static_cast<std::uint16_t>(st_.unverified & ~bit);
@@ -1844,6 +1853,12 @@ void FaultDetector::update_survey() {
       st_.unverified = static_cast<std::uint16_t>(st_.unverified | bit);
     }
   }
+}
+
+bool FaultDetector::survey_loss_evidence(std::size_t k) const {
+  // (F57) Partial-loss evidence that no evidence check answers yet.
+  return p_.survey_loss_llr > 0.0 && deg_cusum_[k] >= p_.survey_loss_llr &&
+         deg_cusum_[k] < p_.check_llr;
 }
 
 int FaultDetector::survey_candidate(int& windows) {
@@ -1856,23 +1871,43 @@ int FaultDetector::survey_candidate(int& windows) {
   if (!(p_.survey_interval_s > 0.0) || st_.unverified == 0 || !survey_allowed_) return -1;
   const double window_s = static_cast<double>(p_.window_ticks) * dt_;
   const auto interval = static_cast<std::uint32_t>(std::ceil(p_.survey_interval_s / window_s));
+  // (F57) A jet unverified for its partial-loss evidence is due after check_interval_s, at most
+  // once per survey interval (a healthy jet whose model is a few percent off keeps some evidence,
+  // and a survey every check interval would build it up).
+  const auto loss_interval = std::min(
+      interval, static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s)));
   int jet = -1;
   std::uint32_t oldest = 0;
   for (int i = 0; i < kThrusters; ++i) {
     if (((st_.unverified >> i) & 1u) == 0) continue;
-    const std::uint32_t age = st_.windows - survey_from_[static_cast<std::size_t>(i)];
-    if (age < interval || (jet >= 0 && age <= oldest)) continue;
+    const auto k = static_cast<std::size_t>(i);
+    const std::uint32_t age = st_.windows - survey_from_[k];
+    const bool loss = survey_loss_evidence(k) &&
+                      (loss_survey_at_[k] == 0 || st_.windows + 1 - loss_survey_at_[k] >= interval);
+    if (age < (loss ? loss_interval : interval) || (jet >= 0 && age <= oldest)) continue;
     jet = i;
     oldest = age;
   }
   if (jet < 0) return -1;
+  candidate_loss_ = st_.windows - survey_from_[static_cast<std::size_t>(jet)] < interval;
   ++st_.survey_ratings;
+  // (F57) A survey due to partial-loss evidence C is sized to resolve it: at the CUSUM's design
+  // loss a_c a healthy jet's C drifts down by a_c^2 E / 2, so the energy E = 2 C / a_c^2 takes it
+  // back to zero, and a jet at half strength gains (a_c / 2 - a_c^2 / 2) E = 4 C at a_c 0.2
+  // (past check_llr from C >= check_llr / 5: its evidence checks follow). Where the check's gates
+  // do not allow that energy, it is sized as any survey.
+  const double ac = std::fmin(1.0, 2.0 * p_.degraded_min_loss);
+  const double loss_energy =
+      candidate_loss_ && ac > 0.0 ? 2.0 * deg_cusum_[static_cast<std::size_t>(jet)] / (ac * ac) : 0.0;
   if (long_mode()) {
     // (F49) A long check, where (F48) would refuse: its force sized to check_long_energy.
-    candidate_force_ =
-        signature_rel_error(jet) > p_.check_max_model_error
-            ? 0.0
-            : long_check_force(jet, p_.check_long_energy, true);
+    const bool fit = signature_rel_error(jet) <= p_.check_max_model_error;
+    candidate_force_ = fit && loss_energy > p_.check_long_energy
+                           ? long_check_force(jet, loss_energy, true)
+                           : 0.0;
+    if (!(candidate_force_ > 0.0) && fit) {
+      candidate_force_ = long_check_force(jet, p_.check_long_energy, true);
+    }
     if (candidate_force_ > 0.0) {
       windows = 1;
       return jet;
@@ -1892,7 +1927,15 @@ int FaultDetector::survey_candidate(int& windows) {
   const int lo = p_.check_windows;
   const int hi = std::max(lo, p_.survey_max_windows);
   const double need = e > 0.0 ? std::ceil(p_.survey_energy / e) : 0.0;
-  const int n = need >= static_cast<double>(hi) ? hi : std::max(lo, static_cast<int>(need));
+  int n = need >= static_cast<double>(hi) ? hi : std::max(lo, static_cast<int>(need));
+  if (loss_energy > p_.survey_energy && e > 0.0) {
+    // (F57) ... in up to survey_max_windows windows, and no more than the kick bound allows.
+    int m = static_cast<int>(std::fmin(std::ceil(loss_energy / e), static_cast<double>(hi)));
+    if (p_.survey_max_kick_rad_s > 0.0 && kick_rate > 0.0) {
+      m = std::min(m, static_cast<int>(p_.survey_max_kick_rad_s / (3.0 * kick_rate * window_s)));
+    }
+    n = std::max(n, m);
+  }
   // (F44) 3 sigma of the rate the check may put on the body, over its n windows.
   const bool kicks = p_.survey_max_kick_rad_s > 0.0 &&
                      3.0 * kick_rate * static_cast<double>(n) * window_s > p_.survey_max_kick_rad_s;

@@ -273,6 +273,13 @@ struct FaultDetectorParams {
   bool check_kick_after_fault{false};
   double survey_energy{10.0};  // a stuck-off jet's expected LLR is E / 2: check_llr 5 at 10
   int survey_max_windows{8};
+  // (F57) A jet whose partial-loss CUSUM (F18) stands at or above this, and below check_llr, is
+  // not verified by its energy (F36): survey_energy shows a total loss, not a partial one (a jet
+  // at half strength gains a quarter of a dead jet's score). Such a jet is surveyed one
+  // check_interval_s after it was last verified, at most once per survey_interval_s, with the
+  // energy that takes its evidence past check_llr or back to zero (F18's drift at its design loss);
+  // past check_llr its evidence checks (F19) answer it, as before. 0: the energy alone verifies.
+  double survey_loss_llr{0.0};
   // (F33) Early detection: from detect_early_ticks samples into a window, each update tests the
   // window flown so far (the no-fault slope statistic with the noise of F5 on those samples)
   // against detect_early_chi2, and the first crossing raises the window's suspicion there and
@@ -547,6 +554,10 @@ class FaultDetector {
   std::array<bool, kPods> valve_open_{{true, true, true, true}};
   bool survey_noisy_{false};  // (F48) the gyro too noisy for a survey check within its kick bound
   std::array<std::uint32_t, kThrusters> survey_from_{};  // (F36) window count when last verified
+  // (F57) Window count + 1 at each jet's last survey due to its partial-loss evidence (0: none).
+  std::array<std::uint32_t, kThrusters> loss_survey_at_{};
+  bool candidate_loss_{false};  // (F57) the survey candidate is due to its loss evidence only
+  bool survey_loss_evidence(std::size_t k) const;  // (F57) CUSUM in [survey_loss_llr, check_llr)
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
   bool deg_suspecting_{false};  // (F18) a partial loss past half the confirmation level

@@ -404,6 +404,14 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOnInGncYaml) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_max_windows,
                                       gnc::FaultDetectorParams{}.survey_max_windows);
                           });
+  // (F57) A jet with partial-loss evidence is not verified by its energy: 2.5 in gnc.yaml, off
+  // (0) when the key is absent.
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(6)).flight.fdi.survey_loss_llr, 2.5);
+  expect_optional_fdi_key("  survey_loss_llr: 2.5", "survey_loss_llr", "  survey_loss_llr: -1", "",
+                          [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.survey_loss_llr,
+                                      0.0);
+                          });
 }
 
 // (F49) Long checks where the gyro is too noisy for the survey's: gnc.yaml's 1 000 samples at

@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -2847,6 +2848,11 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
   p = FaultDetectorParams{};
   p.survey_energy = 0.0;
   EXPECT_STREQ(validate(p).field, "fdi.survey_energy");
+  for (const double llr : {-1.0, std::numeric_limits<double>::infinity(), std::nan("")}) {  // (F57)
+    p = FaultDetectorParams{};
+    p.survey_loss_llr = llr;
+    EXPECT_STREQ(validate(p).field, "fdi.survey_loss_llr") << llr;
+  }
   p = FaultDetectorParams{};
   p.survey_max_windows = 0;
   EXPECT_STREQ(validate(p).field, "fdi.survey_max_windows");
@@ -3326,6 +3332,73 @@ TEST(FaultDetector, TheNoFaultStatisticIsChiSquareThreeUnderWhiteGyroNoise) {
   const double doubled = mean_quiet_chi2(false, &above);
   EXPECT_NEAR(doubled, 1.5, 0.1);
   EXPECT_LT(above, 0.01);  // chi-square(3) > 15.6: 0.14 %
+}
+
+// (F57) HOLD's milli-newton firing and one firm burst of jet 6 (100 N for 6 s, at 100 s) while
+// it is at half strength. The burst's stuck-off energy verifies the jet (F36) and leaves its
+// partial-loss evidence below check_llr: with the survey's 20 000 s interval the jet is neither
+// checked nor surveyed again in the 4 000 s flown, and its loss is never seen. With
+// survey_loss_llr the evidence keeps it unverified, it is surveyed one check interval (600 s)
+// after the burst, and the surveys take it to its evidence checks and its confirmation, degraded
+// at about half strength. The healthy jet, with the same burst, is verified and never surveyed.
+struct BurstHold {
+  MilliNewtonHold base;
+  int jet;
+  double force;
+  int from;
+  int len;
+  Vec16 next(int tick) {
+    Vec16 f = base.next(tick);
+    if (tick >= from && tick < from + len) {
+      f(jet ^ 1) = 0.0;
+      f(jet) = force;
+    }
+    return f;
+  }
+};
+
+TEST(FaultDetector, AJetWithPartialLossEvidenceIsNotVerifiedByItsEnergyAndIsSurveyed) {
+  constexpr int kJet = 6;
+  constexpr int kBurstEnd = 1060;
+  for (const bool degraded : {true, false}) {
+    for (const double loss_llr : {0.0, 2.5}) {
+      const std::string what = std::string(degraded ? "half strength" : "healthy") +
+                               ", survey_loss_llr " + std::to_string(loss_llr);
+      Truth t;
+      t.degraded = degraded ? kJet : -1;
+      FaultDetectorParams p = survey_params(t, 20000.0);
+      p.survey_loss_llr = loss_llr;
+      FaultDetector d = make_detector(t, p);
+      const SurveyRun run =
+          fly_checks(t, d, BurstHold{MilliNewtonHold(5), kJet, 100.0, 1000, 60}, 100000);
+      std::vector<int> own;  // ticks of the checks of jet 6
+      std::vector<bool> own_survey;
+      for (std::size_t a = 0; a < run.checked.size(); ++a) {
+        if (run.checked[a] != kJet) continue;
+        own.push_back(run.check_ticks[a]);
+        own_survey.push_back(run.surveyed[a]);
+      }
+      if (!degraded || loss_llr == 0.0) {
+        EXPECT_LT(run.r.confirmed_at, 0) << what << ": thruster " << run.r.thruster << " "
+                                         << to_string(run.r.kind);
+        EXPECT_TRUE(own.empty()) << what << ": jet 6 checked at tick " << own.front();
+        continue;
+      }
+      ASSERT_FALSE(own.empty()) << what << ": never surveyed";
+      EXPECT_TRUE(own_survey.front()) << what << ": its first check was not the survey's";
+      // One survey for its evidence in the survey interval; the evidence checks do the rest.
+      EXPECT_EQ(std::count(own_survey.begin(), own_survey.end(), true), 1) << what;
+      EXPECT_GE(own.size(), 2u) << what << ": no evidence check after the survey";
+      // 600 s after the burst verified its energy, within a decision round of 16 jets.
+      EXPECT_GE(own.front(), kBurstEnd + 6000 - 100) << what;
+      EXPECT_LE(own.front(), kBurstEnd + 6000 + 16 * 10) << what;
+      ASSERT_GE(run.r.confirmed_at, 0) << what;
+      EXPECT_EQ(run.r.thruster, kJet) << what;
+      EXPECT_EQ(run.r.kind, FaultKind::kDegraded) << what;
+      EXPECT_NEAR(run.factor, 0.5, 0.1) << what;
+      EXPECT_EQ(run.confirmations, 1) << what;
+    }
+  }
 }
 
 }  // namespace
