@@ -222,7 +222,6 @@ void FaultDetector::reset() {
   survey_e_.fill(0.0);
   survey_from_.fill(st_.windows);
   loss_survey_at_.fill(0);
-  candidate_loss_ = false;
   st_.unverified = 0;
   check_prev_ = -1;
   quiet_var_ = 0.0;
@@ -1792,7 +1791,6 @@ void FaultDetector::update_check() {
     const auto ks = static_cast<std::size_t>(jet);
     survey_e_[ks] = 0.0;  // its survey clock restarts with the check (verified or not)
     survey_from_[ks] = st_.windows;
-    if (candidate_loss_) loss_survey_at_[ks] = st_.windows + 1;  // (F57)
     st_.unverified = static_cast<std::uint16_t>(st_.unverified & ~(1u << jet));
   }
   st_.check_jet = jet;
@@ -1889,7 +1887,8 @@ int FaultDetector::survey_candidate(int& windows) {
     oldest = age;
   }
   if (jet < 0) return -1;
-  candidate_loss_ = st_.windows - survey_from_[static_cast<std::size_t>(jet)] < interval;
+  const auto kj = static_cast<std::size_t>(jet);
+  const bool loss_due = st_.windows - survey_from_[kj] < interval;  // (F57) due to its evidence only
   ++st_.survey_ratings;
   // (F57) A survey due to partial-loss evidence C is sized to resolve it: at the CUSUM's design
   // loss a_c a healthy jet's C drifts down by a_c^2 E / 2, so the energy E = 2 C / a_c^2 takes it
@@ -1898,7 +1897,7 @@ int FaultDetector::survey_candidate(int& windows) {
   // do not allow that energy, it is sized as any survey.
   const double ac = std::fmin(1.0, 2.0 * p_.degraded_min_loss);
   const double loss_energy =
-      candidate_loss_ && ac > 0.0 ? 2.0 * deg_cusum_[static_cast<std::size_t>(jet)] / (ac * ac) : 0.0;
+      loss_due && ac > 0.0 ? 2.0 * deg_cusum_[kj] / (ac * ac) : 0.0;
   if (long_mode()) {
     // (F49) A long check, where (F48) would refuse: its force sized to check_long_energy.
     const bool fit = signature_rel_error(jet) <= p_.check_max_model_error;
@@ -1910,12 +1909,13 @@ int FaultDetector::survey_candidate(int& windows) {
     }
     if (candidate_force_ > 0.0) {
       windows = 1;
+      if (loss_due) loss_survey_at_[kj] = st_.windows + 1;  // (F57) the survey starts now
       return jet;
     }
     ++st_.survey_kick_refusals;
     const auto retry = std::min(
         interval, static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s)));
-    survey_from_[static_cast<std::size_t>(jet)] = st_.windows - (interval - retry);
+    survey_from_[kj] = st_.windows - (interval - retry);
     return -1;
   }
   const bool noisy = survey_noisy_;  // (F48)
@@ -1945,10 +1945,11 @@ int FaultDetector::survey_candidate(int& windows) {
     // Not checkable now: due again one check interval from now.
     const auto retry = std::min(
         interval, static_cast<std::uint32_t>(std::ceil(p_.check_interval_s / window_s)));
-    survey_from_[static_cast<std::size_t>(jet)] = st_.windows - (interval - retry);
+    survey_from_[kj] = st_.windows - (interval - retry);
     return -1;
   }
   windows = n;
+  if (loss_due) loss_survey_at_[kj] = st_.windows + 1;  // (F57) the survey starts now
   return jet;
 }
 

@@ -556,7 +556,6 @@ class FaultDetector {
   std::array<std::uint32_t, kThrusters> survey_from_{};  // (F36) window count when last verified
   // (F57) Window count + 1 at each jet's last survey due to its partial-loss evidence (0: none).
   std::array<std::uint32_t, kThrusters> loss_survey_at_{};
-  bool candidate_loss_{false};  // (F57) the survey candidate is due to its loss evidence only
   bool survey_loss_evidence(std::size_t k) const;  // (F57) CUSUM in [survey_loss_llr, check_llr)
   FaultEvents step(const FaultDetectorInput& in);  // update() with the delivered thrust
   std::array<double, kThrusters> window_energy_{};  // (F18) each stuck-off's E of the window
