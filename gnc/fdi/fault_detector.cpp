@@ -95,6 +95,9 @@ Check validate(const FaultDetectorParams& p) {
     return bad("fdi.survey_interval_s", "must be >= 0 and finite");
   }
   if (!finite_positive(p.survey_energy)) return bad("fdi.survey_energy", "must be positive");
+  if (!finite_non_negative(p.total_loss_sigmas)) {
+    return bad("fdi.total_loss_sigmas", "must be >= 0 and finite");  // (F58)
+  }
   if (!finite_non_negative(p.survey_loss_llr)) {
     return bad("fdi.survey_loss_llr", "must be >= 0 and finite");  // (F57)
   }
@@ -1596,6 +1599,13 @@ bool FaultDetector::partial_not_total(int i, double sr, double e) const {
   return a < floor && 0.5 * e * (floor - a) * (floor - a) > p_.margin_llr;
 }
 
+bool FaultDetector::below_total_loss(int i, double sr, double e) const {
+  // (F58) The fitted loss a = SR / E has the fit's own 1 sigma 1 / sqrt(E) (E is the information
+  // of a); a loss more than total_loss_sigmas of that below the floor is not a dead jet's.
+  if (!(p_.total_loss_sigmas > 0.0) || !(e > 0.0)) return false;
+  return sr / e < total_loss_floor(i) - p_.total_loss_sigmas / std::sqrt(e);
+}
+
 double FaultDetector::partial_loss_llr(int g) const {
   // (F13) The episode's LLR of "thruster g lost a fraction a of its thrust", a in (0, 1] fitted:
   // with SR = sum S~.r~ / var = Lambda + E / 2 and E = sum |S~|^2 / var = |b|^2 A, the maximum
@@ -1608,10 +1618,12 @@ int FaultDetector::partial_loss_alternative(int h) const {
   // jet (a degraded jet explains its residual exactly with its own a < 1, and only that much of
   // a smaller, nearly parallel signature of another jet), and its own amplitude must be that of
   // a jet that produces nothing: its fitted a may not gain margin_llr over a loss at the (F23)
-  // total-loss floor (1 when model_sigmas is 0).
+  // total-loss floor (1 when model_sigmas is 0), nor lie (F58) total_loss_sigmas of its own
+  // 1 sigma below that floor.
   const double lh = lambda(static_cast<std::size_t>(h));
   const double eh = partial_loss_energy(h);
   if (partial_not_total(h % kThrusters, lh + 0.5 * eh, eh)) return h;
+  if (below_total_loss(h % kThrusters, lh + 0.5 * eh, eh)) return h;
   return partial_loss_rival(h);
 }
 

@@ -61,6 +61,12 @@ struct FaultDetectorParams {
   // (F8) The lead over each alternative must also exceed what an error of the model could have
   // produced: this many 1 sigma of the signature's model uncertainty.
   double model_sigmas{3.0};
+  // (F58) A stuck-off leader is also held back (a partial loss, F13) when its fitted loss lies
+  // more than this many of the fit's own 1 sigma (1 / sqrt(E)) below the total-loss floor (F23):
+  // a jet that produces nothing fits at or above the floor within its noise, while
+  // partial_not_total's margin_llr asks sqrt(2 margin_llr) of them (4.5 at 10) before it calls the
+  // loss partial. 0: off (margin_llr alone).
+  double total_loss_sigmas{0.0};
   // (F25) The episode of (F8) restarts with the window in which a suspicion starts with a new
   // leader (false: only when every score is zero, which a stale stuck-off score of an idle jet
   // can put off for the rest of the flight); a stuck-on leader must also beat every jet's partial
@@ -447,6 +453,10 @@ class FaultDetector {
   // itself (strength, inertia, and the centre of mass's covariance for the jet alone and for its
   // check's move, the larger).
   double loss_rel_error(int i) const;
+  // (F23) The fitted loss at and above which thruster i's loss is total (stuck off): 1 less
+  // model_sigmas of its signature's relative error, the gap at most kMaxTotalLossGap.
+  static constexpr double kMaxTotalLossGap = 0.25;
+  double total_loss_floor(int i) const;
   // (F19, F42) The check's move of the channel forces for channel c, unscaled (du(c) in (0, 1]):
   // the minimum-norm move with no torque on the detector's model, whose channel torques are
   // (p + r_hat) x d with the identified centre of mass. False when channel c has no such move.
@@ -488,10 +498,9 @@ class FaultDetector {
   double partial_loss_llr(int g) const;
   // (F13) The episode's signature energy E_g = |b_g|^2 A_g of hypothesis g (16..31).
   double partial_loss_energy(int g) const;
-  // (F23) The fitted loss at and above which thruster i's loss is total (stuck off): 1 less
-  // model_sigmas of its signature's relative error, the gap at most kMaxTotalLossGap.
-  static constexpr double kMaxTotalLossGap = 0.25;
-  double total_loss_floor(int i) const;
+  // (F58) Whether sums SR, E of thruster i's fit put its loss total_loss_sigmas of the fit's
+  // 1 sigma below the total-loss floor (false when total_loss_sigmas is 0).
+  bool below_total_loss(int i, double sr, double e) const;
   // (F13, F18, F23) Whether sums SR, E of thruster i's partial-loss fit say a partial loss: the
   // fitted loss below the floor, and the fit margin_llr better than a loss at the floor.
   bool partial_not_total(int i, double sr, double e) const;

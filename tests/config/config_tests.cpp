@@ -414,6 +414,17 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOnInGncYaml) {
                           });
 }
 
+// (F58) A stuck-off leader this many of its fit's 1 sigma below the total-loss floor is a partial
+// loss: 3 in gnc.yaml, off (0) when the key is absent, a negative value named by file and key.
+TEST(ConfigShipped, TheTotalLossSigmasAreReadAndOptional) {
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(7)).flight.fdi.total_loss_sigmas, 3.0);
+  expect_optional_fdi_key("  total_loss_sigmas: 3.0", "total_loss_sigmas", "  total_loss_sigmas: -1",
+                          "", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.total_loss_sigmas,
+                                      0.0);
+                          });
+}
+
 // (F49) Long checks where the gyro is too noisy for the survey's: gnc.yaml's 1 000 samples at
 // energies 80 (survey) and 320 (evidence), off (0) when the key is absent (the struct's energies),
 // bad values named by file and key; (F50) evidence checks at 0.8 of the energy the centre of mass

@@ -494,6 +494,7 @@ TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
   p.window_ticks = 10;
   p.gyro_sigma = 1e-7;
   p.degraded_min_loss = 0.1;
+  p.total_loss_sigmas = 3.0;  // (F58) the stuck-off leader's test against the total-loss floor
   FaultDetector d;
   d.configure(p, rcs, kUmax, kDt);
   FaultModel m;
