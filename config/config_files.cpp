@@ -355,6 +355,9 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("check_blocker")) fd.check_blocker = r.boolean("check_blocker");  // (F37)
     if (r.has("survey_energy")) fd.survey_energy = r.positive("survey_energy");
     if (r.has("survey_loss_llr")) fd.survey_loss_llr = r.non_negative("survey_loss_llr");  // (F57)
+    if (r.has("after_fault_max_j_rel")) {
+      fd.after_fault_max_j_rel = r.non_negative("after_fault_max_j_rel");  // (F59)
+    }
     if (r.has("total_loss_sigmas")) {
       fd.total_loss_sigmas = r.non_negative("total_loss_sigmas");  // (F58)
     }

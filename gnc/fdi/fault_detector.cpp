@@ -95,6 +95,9 @@ Check validate(const FaultDetectorParams& p) {
     return bad("fdi.survey_interval_s", "must be >= 0 and finite");
   }
   if (!finite_positive(p.survey_energy)) return bad("fdi.survey_energy", "must be positive");
+  if (!finite_non_negative(p.after_fault_max_j_rel)) {
+    return bad("fdi.after_fault_max_j_rel", "must be >= 0 and finite");  // (F59)
+  }
   if (!finite_non_negative(p.total_loss_sigmas)) {
     return bad("fdi.total_loss_sigmas", "must be >= 0 and finite");  // (F58)
   }
@@ -1093,6 +1096,9 @@ void FaultDetector::decide() {
     }
   }
   if (blocking < 0 && best >= kThrusters) blocking = partial_loss_alternative(best);
+  // (F59) After a fault, no stuck-off on a model not confident again (held as its own partial
+  // loss: no isolation test).
+  if (blocking < 0 && best >= kThrusters && after_fault_unconfident()) blocking = best;
   if (blocking < 0 && best < kThrusters && p_.episode_restart) blocking = partial_loss_rival(best);
   if (blocking < 0) {
     const int thruster = best % kThrusters;
@@ -1599,6 +1605,12 @@ bool FaultDetector::partial_not_total(int i, double sr, double e) const {
   return a < floor && 0.5 * e * (floor - a) * (floor - a) > p_.margin_llr;
 }
 
+bool FaultDetector::after_fault_unconfident() const {
+  return p_.after_fault_max_j_rel > 0.0 &&
+         (st_.confirmed_on | st_.confirmed_off | st_.confirmed_degraded) != 0 &&
+         !(m_.j_rel_sigma <= p_.after_fault_max_j_rel);
+}
+
 bool FaultDetector::below_total_loss(int i, double sr, double e) const {
   // (F58) The fitted loss a = SR / E has the fit's own 1 sigma 1 / sqrt(E) (E is the information
   // of a); a loss more than total_loss_sigmas of that below the floor is not a dead jet's.
@@ -1677,6 +1689,7 @@ void FaultDetector::evaluate_partial_losses() {
     if (degraded_llr(i) > 0.5 * p_.confirm_llr) deg_suspecting_ = true;
   }
   if (!deg_suspecting_ || probe_left_ > 0 || verdict_pending_ || sweeping()) return;
+  if (after_fault_unconfident()) return;  // (F59)
   double loss = 0.0;
   const int g = degraded_candidate(loss);
   if (g < 0) return;
@@ -1710,7 +1723,7 @@ void FaultDetector::update_check() {
     return;
   }
   if (!(p_.check_llr > 0.0) || pending_.confirmed || probe_left_ > 0 || verdict_pending_ ||
-      sweeping()) {
+      sweeping() || after_fault_unconfident()) {  // (F59) no check whose verdict would wait
     return;
   }
   // (F34) A check is for evidence that builds up over many windows of weak firing; a window above

@@ -67,6 +67,13 @@ struct FaultDetectorParams {
   // partial_not_total's margin_llr asks sqrt(2 margin_llr) of them (4.5 at 10) before it calls the
   // loss partial. 0: off (margin_llr alone).
   double total_loss_sigmas{0.0};
+  // (F59) After a confirmed fault, a further stuck-off or partial-loss confirmation, and any jet
+  // check or survey, only on a model whose inertia is known to this relative 1 sigma
+  // (FaultModel::j_rel_sigma; the identifier's confidence bound). A confirmation re-inflates the
+  // identifier (F12), and one that absorbed the fault before it was isolated (a fault from the
+  // despin's start) may not converge again: the evidence then gathered against that model is the
+  // model's error, not a second fault. A stuck-on jet is confirmed as before. 0: off.
+  double after_fault_max_j_rel{0.0};
   // (F25) The episode of (F8) restarts with the window in which a suspicion starts with a new
   // leader (false: only when every score is zero, which a stale stuck-off score of an idle jet
   // can put off for the rest of the flight); a stuck-on leader must also beat every jet's partial
@@ -501,6 +508,9 @@ class FaultDetector {
   // (F58) Whether sums SR, E of thruster i's fit put its loss total_loss_sigmas of the fit's
   // 1 sigma below the total-loss floor (false when total_loss_sigmas is 0).
   bool below_total_loss(int i, double sr, double e) const;
+  // (F59) A jet is latched (confirmed or declared) and the model's inertia is not known to
+  // after_fault_max_j_rel: no stuck-off or partial-loss confirmation, no check.
+  bool after_fault_unconfident() const;
   // (F13, F18, F23) Whether sums SR, E of thruster i's partial-loss fit say a partial loss: the
   // fitted loss below the floor, and the fit margin_llr better than a loss at the floor.
   bool partial_not_total(int i, double sr, double e) const;

@@ -425,6 +425,18 @@ TEST(ConfigShipped, TheTotalLossSigmasAreReadAndOptional) {
                           });
 }
 
+// (F59) After a fault, no further loss confirmed and no check on a model whose inertia is not
+// known to this: 0.01 in gnc.yaml (the identifier's confidence bound), off (0) when the key is
+// absent, a negative value named by file and key.
+TEST(ConfigShipped, TheAfterFaultModelBoundIsReadAndOptional) {
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(4)).flight.fdi.after_fault_max_j_rel, 0.01);
+  expect_optional_fdi_key("  after_fault_max_j_rel: 0.01", "after_fault_max_j_rel",
+                          "  after_fault_max_j_rel: -1", "", [](const std::string& gnc) {
+                            EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.after_fault_max_j_rel,
+                                      0.0);
+                          });
+}
+
 // (F49) Long checks where the gyro is too noisy for the survey's: gnc.yaml's 1 000 samples at
 // energies 80 (survey) and 320 (evidence), off (0) when the key is absent (the struct's energies),
 // bad values named by file and key; (F50) evidence checks at 0.8 of the energy the centre of mass

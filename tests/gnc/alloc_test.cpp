@@ -495,6 +495,7 @@ TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
   p.gyro_sigma = 1e-7;
   p.degraded_min_loss = 0.1;
   p.total_loss_sigmas = 3.0;  // (F58) the stuck-off leader's test against the total-loss floor
+  p.after_fault_max_j_rel = 0.01;  // (F59) the model's bound read on each decision after a fault
   FaultDetector d;
   d.configure(p, rcs, kUmax, kDt);
   FaultModel m;
@@ -535,6 +536,68 @@ TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
   EXPECT_EQ(d.status().degraded_confirmations, 1u);
   EXPECT_EQ(d.confirmed_degraded(), 1u << kDegraded);
   EXPECT_LT(d.strength_factor(kDegraded), 0.99);
+}
+
+// (F59) The same flight after a declared fault (jet 14 stuck off, not commanded) on a model whose
+// inertia is known to 2 % only: the partial loss is held, unconfirmed, and no check starts
+// (without the bound the same flight confirms jet 9 degraded and checks).
+TEST(ZeroAllocation, NoHeapWhenALossIsHeldAfterAFault) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(0.3, -0.2, 0.1);
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = 1e-7;
+  p.degraded_min_loss = 0.1;
+  p.total_loss_sigmas = 3.0;  // (F58) the stuck-off leader's test against the total-loss floor
+  p.after_fault_max_j_rel = 0.01;  // (F59) the model's bound read on each decision after a fault
+  p.check_llr = 1e-3;  // (F19) without (F59) a check would start on the first evidence
+  FaultDetector d;
+  d.configure(p, rcs, kUmax, kDt);
+  FaultModel m;
+  m.j = j;
+  m.r = r;
+  m.j_rel_sigma = 0.02;
+  m.r_cov = Mat3::Identity() * 1e-6;
+  m.k_sigma = 1e-3;
+  d.set_model(m);
+  d.declare(14, FaultKind::kStuckOff);
+  constexpr int kDegraded = 9;
+  Vec3 w(1e-5, -2e-5, 1e-5);  // HOLD's rate: the gyroscopic share of J's error small
+  Vec16 cmd = Vec16::Zero();
+  std::uint64_t x = 12345;
+  long counted = -1;
+  {
+    Armed armed;
+    for (int k = 0; k < 3000; ++k) {
+      FaultDetectorInput in;
+      in.omega = w;
+      in.omega_valid = true;
+      in.thrust = cmd;
+      d.update(in);
+      Vec3 tau = Vec3::Zero();
+      for (int i = 0; i < kThrusters; ++i) {
+        x = x * 6364136223846793005ULL + 1442695040888963407ULL;  // a fixed pseudo-random firing
+        cmd(i) = (x >> 62) == 0 && i != 14 ? kUmax * static_cast<double>((x >> 11) & 1023U) / 1023.0
+                                           : 0.0;
+        const int c = i / 2;
+        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
+                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
+        const double f = i == kDegraded ? 0.5 * cmd(i) : cmd(i);
+        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
+      }
+      w += kDt * j.inverse() * (tau - w.cross(j * w));
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_EQ(d.status().degraded_confirmations, 0u);
+  EXPECT_EQ(d.confirmed_degraded(), 0u);
+  EXPECT_EQ(d.status().checks, 0u);
+  EXPECT_TRUE(d.suspecting()) << "the loss is held, not unseen";
 }
 
 // gnc/fdi/README.md (F19): jet checks started by the detector and flown by the Gnc (the null

@@ -2858,6 +2858,11 @@ TEST(FaultDetector, JetCheckParametersAreValidated) {
     p.total_loss_sigmas = s;
     EXPECT_STREQ(validate(p).field, "fdi.total_loss_sigmas") << s;
   }
+  for (const double s : {-0.01, std::numeric_limits<double>::infinity(), std::nan("")}) {  // (F59)
+    p = FaultDetectorParams{};
+    p.after_fault_max_j_rel = s;
+    EXPECT_STREQ(validate(p).field, "fdi.after_fault_max_j_rel") << s;
+  }
   p = FaultDetectorParams{};
   p.survey_max_windows = 0;
   EXPECT_STREQ(validate(p).field, "fdi.survey_max_windows");
@@ -3486,6 +3491,92 @@ TEST(FaultDetector, AStuckOffLeaderWellBelowTheTotalLossFloorIsHeldAsAPartialLos
     ASSERT_GE(run.r.confirmed_at, 0) << "dead jet " << jet;
     EXPECT_EQ(run.r.thruster, jet);
     EXPECT_EQ(run.r.kind, FaultKind::kStuckOff) << "dead jet " << jet;
+  }
+}
+
+// (F59) After a confirmed fault, no stuck-off or partial-loss confirmation and no check on a
+// model whose inertia is not known to after_fault_max_j_rel (0.01). Jet 14 is latched stuck off
+// (declared; the firing no longer commands it) and jet 5 fails at 5 s under random firing, the body
+// at HOLD's rate. On a model with J known to 1e-4, jet 5 dead is confirmed stuck off and at half strength degraded,
+// gate or not; on one known to 5 % neither is confirmed with the gate, and no check is flown,
+// while without the gate, or without the latch, the same flight confirms it. A jet stuck on is
+// confirmed with the gate as without it (its isolation test's pod closed by the harness).
+struct RandomWithoutJet {
+  std::mt19937_64 rng;
+  int jet;
+  Vec16 next(int) {
+    Vec16 f = random_firing(rng);
+    if (jet >= 0) f(jet) = 0.0;  // a latched jet is not allocated
+    return f;
+  }
+};
+
+TEST(FaultDetector, AfterAFaultNoFurtherLossIsConfirmedOnAModelNotConfidentAgain) {
+  constexpr int kJet = 5;
+  constexpr int kLatched = 14;
+  for (const FaultKind kind : {FaultKind::kStuckOff, FaultKind::kDegraded, FaultKind::kStuckOn}) {
+    for (const double j_rel : {1e-4, 0.02}) {
+      for (const bool latch : {true, false}) {
+        for (const double gate : {0.0, 0.01}) {
+          if (!latch && gate == 0.0) continue;
+          const std::string what = to_string(kind) + std::string(", J 1 sigma ") +
+                                   std::to_string(j_rel) + (latch ? ", jet 14 latched" : "") +
+                                   ", gate " + std::to_string(gate);
+          Truth t;
+          t.gyro_sigma = 1e-6;
+          t.body.omega = V3(1e-5, -2e-5, 1e-5);  // HOLD: the gyroscopic term's share of J's error small
+          FaultDetectorParams p = bank_params(t.gyro_sigma);
+          p.degraded_min_loss = 0.1;
+          p.check_llr = 5.0;
+          p.after_fault_max_j_rel = gate;
+          p.probe_after_windows = 1;  // (F9) a stuck-on jet's isolation test: its pod closed
+          p.probe_windows = 1;
+          ASSERT_TRUE(validate(p).ok) << what;
+          FaultDetector d;
+          d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+          FaultModel m = identified_model(t);
+          m.j_rel_sigma = j_rel;
+          d.set_model(m);
+          if (latch) d.declare(kLatched, FaultKind::kStuckOff);
+          RandomWithoutJet firing{std::mt19937_64(11), latch ? kLatched : -1};
+          Vec16 prev = Vec16::Zero();
+          DegradedRun run;
+          int checks_started = 0;
+          for (int k = 0; k < 20000; ++k) {  // 2000 s
+            if (k == 50) {
+              if (kind == FaultKind::kStuckOff) t.stuck_off = kJet;
+              if (kind == FaultKind::kStuckOn) t.stuck_on = kJet;
+              if (kind == FaultKind::kDegraded) t.degraded = kJet;
+            }
+            FaultDetectorInput in;
+            in.omega = t.gyro();
+            in.omega_valid = true;
+            in.thrust = prev;
+            in.valve_open = t.valve;
+            const int before = d.check_jet();
+            run.note(d.update(in), k);
+            if (d.check_jet() >= 0 && d.check_jet() != before) ++checks_started;
+            Vec16 cmd = firing.next(k);
+            if (d.check_jet() >= 0) cmd(d.check_jet()) += d.check_force();
+            for (int q = 0; q < 4; ++q) t.valve[static_cast<std::size_t>(q)] = q != d.probe_pod();
+            t.advance(cmd);
+            prev = cmd;
+          }
+          const bool gated = latch && gate > 0.0 && j_rel > gate && kind != FaultKind::kStuckOn;
+          if (gated) {
+            EXPECT_LT(run.r.confirmed_at, 0) << what << ": confirmed " << run.r.thruster << " "
+                                             << to_string(run.r.kind);
+            EXPECT_EQ(checks_started, 0) << what;
+            EXPECT_EQ(d.status().checks, 0u) << what;
+            continue;
+          }
+          ASSERT_GE(run.r.confirmed_at, 0) << what;
+          EXPECT_EQ(run.r.thruster, kJet) << what;
+          EXPECT_EQ(run.r.kind, kind) << what;
+          EXPECT_EQ(run.confirmations, 1) << what;
+        }
+      }
+    }
   }
 }
 
