@@ -479,16 +479,10 @@ TEST(ZeroAllocation, NoHeapInAnEarlyIsolationTest) {
   EXPECT_EQ(d.confirmed_on(), 1u << kStuck);
 }
 
-// gnc/fdi/README.md (F18): the partial-loss CUSUMs and their step, the confirmation of a
-// half-strength jet, and the flight after it with the factor latched (the detector's input scaled
-// by it): no heap. A rigid body with the study's inertia, every jet commanded at random, jet 9 at
-// half its command from the first tick.
-TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
-  constexpr double kUmax = 200.0;
-  constexpr double kDt = 0.1;
-  const RcsLayout rcs = study_rcs_layout(kUmax);
-  const Mat3 j = total_inertia(study_true_mass_properties());
-  const Vec3 r(0.3, -0.2, 0.1);
+// The partial-loss flights below: the detector on the study's inertia and a known centre of
+// mass (J to j_rel_sigma), F58 and F59 on as flown.
+constexpr int kHalfJet = 9;
+FaultDetector half_jet_detector(double j_rel_sigma, double check_llr) {
   FaultDetectorParams p;
   p.enabled = true;
   p.window_ticks = 10;
@@ -496,104 +490,72 @@ TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
   p.degraded_min_loss = 0.1;
   p.total_loss_sigmas = 3.0;  // (F58) the stuck-off leader's test against the total-loss floor
   p.after_fault_max_j_rel = 0.01;  // (F59) the model's bound read on each decision after a fault
+  p.check_llr = check_llr;
   FaultDetector d;
-  d.configure(p, rcs, kUmax, kDt);
+  d.configure(p, study_rcs_layout(200.0), 200.0, 0.1);
   FaultModel m;
-  m.j = j;
-  m.r = r;
-  m.j_rel_sigma = 1e-4;
+  m.j = total_inertia(study_true_mass_properties());
+  m.r = Vec3(0.3, -0.2, 0.1);
+  m.j_rel_sigma = j_rel_sigma;
   m.r_cov = Mat3::Identity() * 1e-6;
   m.k_sigma = 1e-3;
   d.set_model(m);
-  constexpr int kDegraded = 9;
-  Vec3 w(0.01, 0.02, 0.03);
+  return d;
+}
+
+// A rigid body with the study's inertia from rate w, every jet but `silent` commanded at random,
+// jet 9 at half its command from the first tick: the heap allocations of 3 000 detector updates.
+long fly_half_jet(FaultDetector& d, Vec3 w, int silent) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(0.3, -0.2, 0.1);
   Vec16 cmd = Vec16::Zero();
   std::uint64_t x = 12345;
-  long counted = -1;
-  {
-    Armed armed;
-    for (int k = 0; k < 3000; ++k) {
-      FaultDetectorInput in;
-      in.omega = w;
-      in.omega_valid = true;
-      in.thrust = cmd;
-      d.update(in);
-      Vec3 tau = Vec3::Zero();
-      for (int i = 0; i < kThrusters; ++i) {
-        x = x * 6364136223846793005ULL + 1442695040888963407ULL;  // a fixed pseudo-random firing
-        cmd(i) = (x >> 62) == 0 ? kUmax * static_cast<double>((x >> 11) & 1023U) / 1023.0 : 0.0;
-        const int c = i / 2;
-        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
-                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
-        const double f = i == kDegraded ? 0.5 * cmd(i) : cmd(i);
-        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
-      }
-      w += kDt * j.inverse() * (tau - w.cross(j * w));
+  Armed armed;
+  for (int k = 0; k < 3000; ++k) {
+    FaultDetectorInput in;
+    in.omega = w;
+    in.omega_valid = true;
+    in.thrust = cmd;
+    d.update(in);
+    Vec3 tau = Vec3::Zero();
+    for (int i = 0; i < kThrusters; ++i) {
+      x = x * 6364136223846793005ULL + 1442695040888963407ULL;  // a fixed pseudo-random firing
+      cmd(i) = (x >> 62) == 0 && i != silent
+                   ? kUmax * static_cast<double>((x >> 11) & 1023U) / 1023.0
+                   : 0.0;
+      const int c = i / 2;
+      const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
+                                : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
+      const double f = i == kHalfJet ? 0.5 * cmd(i) : cmd(i);
+      tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
     }
-    counted = rocksteady::test::heap_allocations();
+    w += kDt * j.inverse() * (tau - w.cross(j * w));
   }
-  EXPECT_EQ(counted, 0);
+  return rocksteady::test::heap_allocations();
+}
+
+// gnc/fdi/README.md (F18): the partial-loss CUSUMs and their step, the confirmation of a
+// half-strength jet, and the flight after it with the factor latched (the detector's input scaled
+// by it): no heap.
+TEST(ZeroAllocation, NoHeapWhenAPartialLossIsConfirmedAndFlown) {
+  FaultDetector d = half_jet_detector(1e-4, 0.0);
+  EXPECT_EQ(fly_half_jet(d, Vec3(0.01, 0.02, 0.03), -1), 0);
   EXPECT_EQ(d.status().degraded_confirmations, 1u);
-  EXPECT_EQ(d.confirmed_degraded(), 1u << kDegraded);
-  EXPECT_LT(d.strength_factor(kDegraded), 0.99);
+  EXPECT_EQ(d.confirmed_degraded(), 1u << kHalfJet);
+  EXPECT_LT(d.strength_factor(kHalfJet), 0.99);
 }
 
 // (F59) The same flight after a declared fault (jet 14 stuck off, not commanded) on a model whose
-// inertia is known to 2 % only: the partial loss is held, unconfirmed, and no check starts
-// (without the bound the same flight confirms jet 9 degraded and checks).
+// inertia is known to 2 % only, from HOLD's rate (the gyroscopic share of J's error small): the
+// partial loss is held, unconfirmed, and no check starts (check_llr 1e-3 would start one on the
+// first evidence; without the bound the same flight confirms jet 9 degraded and checks).
 TEST(ZeroAllocation, NoHeapWhenALossIsHeldAfterAFault) {
-  constexpr double kUmax = 200.0;
-  constexpr double kDt = 0.1;
-  const RcsLayout rcs = study_rcs_layout(kUmax);
-  const Mat3 j = total_inertia(study_true_mass_properties());
-  const Vec3 r(0.3, -0.2, 0.1);
-  FaultDetectorParams p;
-  p.enabled = true;
-  p.window_ticks = 10;
-  p.gyro_sigma = 1e-7;
-  p.degraded_min_loss = 0.1;
-  p.total_loss_sigmas = 3.0;  // (F58) the stuck-off leader's test against the total-loss floor
-  p.after_fault_max_j_rel = 0.01;  // (F59) the model's bound read on each decision after a fault
-  p.check_llr = 1e-3;  // (F19) without (F59) a check would start on the first evidence
-  FaultDetector d;
-  d.configure(p, rcs, kUmax, kDt);
-  FaultModel m;
-  m.j = j;
-  m.r = r;
-  m.j_rel_sigma = 0.02;
-  m.r_cov = Mat3::Identity() * 1e-6;
-  m.k_sigma = 1e-3;
-  d.set_model(m);
+  FaultDetector d = half_jet_detector(0.02, 1e-3);
   d.declare(14, FaultKind::kStuckOff);
-  constexpr int kDegraded = 9;
-  Vec3 w(1e-5, -2e-5, 1e-5);  // HOLD's rate: the gyroscopic share of J's error small
-  Vec16 cmd = Vec16::Zero();
-  std::uint64_t x = 12345;
-  long counted = -1;
-  {
-    Armed armed;
-    for (int k = 0; k < 3000; ++k) {
-      FaultDetectorInput in;
-      in.omega = w;
-      in.omega_valid = true;
-      in.thrust = cmd;
-      d.update(in);
-      Vec3 tau = Vec3::Zero();
-      for (int i = 0; i < kThrusters; ++i) {
-        x = x * 6364136223846793005ULL + 1442695040888963407ULL;  // a fixed pseudo-random firing
-        cmd(i) = (x >> 62) == 0 && i != 14 ? kUmax * static_cast<double>((x >> 11) & 1023U) / 1023.0
-                                           : 0.0;
-        const int c = i / 2;
-        const Vec3 e = i % 2 == 0 ? Vec3(rcs.channel_direction[static_cast<std::size_t>(c)])
-                                  : Vec3(-rcs.channel_direction[static_cast<std::size_t>(c)]);
-        const double f = i == kDegraded ? 0.5 * cmd(i) : cmd(i);
-        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(f * e);
-      }
-      w += kDt * j.inverse() * (tau - w.cross(j * w));
-    }
-    counted = rocksteady::test::heap_allocations();
-  }
-  EXPECT_EQ(counted, 0);
+  EXPECT_EQ(fly_half_jet(d, Vec3(1e-5, -2e-5, 1e-5), 14), 0);
   EXPECT_EQ(d.status().degraded_confirmations, 0u);
   EXPECT_EQ(d.confirmed_degraded(), 0u);
   EXPECT_EQ(d.status().checks, 0u);
