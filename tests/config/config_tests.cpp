@@ -415,10 +415,10 @@ TEST(ConfigShipped, TheJetSurveyIsReadOptionalAndOnInGncYaml) {
 }
 
 // (F58) A stuck-off leader this many of its fit's 1 sigma below the total-loss floor is a partial
-// loss: 3 in gnc.yaml, off (0) when the key is absent, a negative value named by file and key.
+// loss: 2 in gnc.yaml, off (0) when the key is absent, a negative value named by file and key.
 TEST(ConfigShipped, TheTotalLossSigmasAreReadAndOptional) {
-  EXPECT_EQ(load_run(kMission, kGnc, case_file(7)).flight.fdi.total_loss_sigmas, 3.0);
-  expect_optional_fdi_key("  total_loss_sigmas: 3.0", "total_loss_sigmas", "  total_loss_sigmas: -1",
+  EXPECT_EQ(load_run(kMission, kGnc, case_file(7)).flight.fdi.total_loss_sigmas, 2.0);
+  expect_optional_fdi_key("  total_loss_sigmas: 2.0", "total_loss_sigmas", "  total_loss_sigmas: -1",
                           "", [](const std::string& gnc) {
                             EXPECT_EQ(load_run(kMission, gnc, case_file(1)).flight.fdi.total_loss_sigmas,
                                       0.0);
