@@ -204,6 +204,8 @@ void BM_GncTickAllModules(benchmark::State& state, bool fdi, AllocatorKind alloc
   p.fdi.survey_loss_llr = 2.5;  // (F57) a jet with partial-loss evidence is not verified by its energy
   p.fdi.total_loss_sigmas = 2.0;  // (F58) a loss 2 sigma below the total-loss floor is partial
   p.fdi.after_fault_max_j_rel = 0.01;  // (F59) after a fault, losses and checks on a confident model
+  p.fdi.balance.kick_rad_s = 0.0;  // (F61) channel balance tests off, as gnc.yaml (HOLD only when on)
+  p.fdi.balance.quiet_ticks = 300;
   p.fdi.centred_gyro_noise = true;            // (F28) the gyro's variance sigma_g^2, as flown
   p.fdi.suspect_chi2 = 30.66;                 // ... and the suspicion at 1 - 1e-6, as flown
   p.fdi.detect_early_ticks = fdi ? 3 : 0;     // (F33) early detection, as flown

@@ -358,6 +358,29 @@ GncConfig load_gnc(const std::string& path) {
     if (r.has("after_fault_max_j_rel")) {
       fd.after_fault_max_j_rel = r.non_negative("after_fault_max_j_rel");  // (F59)
     }
+    if (r.has("balance")) {  // (F61) channel balance tests (optional; off when absent)
+      MapReader b = r.map("balance");
+      gnc::BalanceTestParams& bp = fd.balance;
+      bp.kick_rad_s = b.non_negative("kick_rad_s");
+      bp.force_n = b.positive("force_n");
+      bp.quiet_ticks = b.integer("quiet_ticks");
+      if (bp.quiet_ticks < 1 || bp.quiet_ticks > 10000) b.fail("quiet_ticks", "must be in [1, 10000]");
+      bp.max_fire_ticks = b.integer("max_fire_ticks");
+      if (bp.max_fire_ticks < 1 || bp.max_fire_ticks > 10000) {
+        b.fail("max_fire_ticks", "must be in [1, 10000]");
+      }
+      bp.interval_s = b.non_negative("interval_s");
+      bp.chi2_bound = b.positive("chi2_bound");
+      bp.min_snr = b.positive("min_snr");
+      bp.total_sigmas = b.positive("total_sigmas");
+      bp.partial_sigmas = b.positive("partial_sigmas");
+      if (bp.partial_sigmas < bp.total_sigmas) b.fail("partial_sigmas", "must be >= total_sigmas");
+      bp.min_loss = b.non_negative("min_loss");
+      if (bp.min_loss >= 1.0) b.fail("min_loss", "must be below 1");
+      bp.max_tests = b.integer("max_tests");
+      if (bp.max_tests < 1 || bp.max_tests > 1000) b.fail("max_tests", "must be in [1, 1000]");
+      b.finish();
+    }
     if (r.has("total_loss_sigmas")) {
       fd.total_loss_sigmas = r.non_negative("total_loss_sigmas");  // (F58)
     }

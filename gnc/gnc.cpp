@@ -237,6 +237,7 @@ void Gnc::detect_faults(const Vec3& omega, bool omega_valid, ModeEvents& events)
   }
   in.valve_open = last_valve_;
   in.survey_allowed = !params_.fdi.survey_hold_only || modes_.mode() == Mode::kHold;  // (F43)
+  in.balance_allowed = modes_.mode() == Mode::kHold;  // (F61)
   const FaultEvents fe = fdi_.update(in);
   // (F9) The detector's isolation test closes a pod for a few windows; it is an isolation
   // action, so the ground's inhibit and auto_isolate govern it as they govern the confirmation's.
@@ -691,7 +692,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   AllocatorLimits limits;
   if (enabled) {
     limits = allocation_limits();
-    alloc_.allocate(u_c, limits, u, status);
+    // (F61) During a channel balance test the body drifts free (5d): nothing to allocate.
+    const bool drifting = params_.fdi.enabled && fdi_.balance_channel() >= 0;
+    if (!drifting) alloc_.allocate(u_c, limits, u, status);
     if (status.reduced_authority && !reduced_reported_) {
       out.events.push(ModeEvent{EventId::kReducedAuthority, modes_.mode(), modes_.mode(),
                                 TransitionCheck::kOk, static_cast<std::int16_t>(status.rank),
@@ -738,6 +741,14 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   check_jet_ = -1;
   if (fdi_.check_jet() < 0) check_move_jet_ = -1;  // the next check latches its own move
   if (enabled && params_.fdi.enabled && fdi_.check_jet() >= 0) apply_jet_check(limits, u);
+  // 5d. Channel balance test (gnc/fdi/README.md F61): in HOLD, the body drifts free while the
+  // detector fires one half of a channel after the other (within the channel's bounds), so that
+  // nothing but the test moves it.
+  if (enabled && params_.fdi.enabled && fdi_.balance_channel() >= 0) {
+    const int c = fdi_.balance_channel();
+    u.setZero();
+    u(c) = std::fmin(limits.hi(c), std::fmax(limits.lo(c), fdi_.balance_command()));
+  }
   if (fdi_.confirmed_degraded() != 0) {
     // (F18) A thruster latched degraded produces its factor of its strength: commanded that much
     // more (the limits above kept it within u_max).
@@ -806,6 +817,9 @@ void Gnc::step(const SensorSample& sample, const GncCommands& commands, GncOutpu
   f.checks = fs.checks;
   f.checks_unfit = fs.checks_unfit;
   f.surveys = fs.surveys;
+  f.balance_channel = static_cast<std::int8_t>(fs.balance_channel);
+  f.balance_tests = fs.balance_tests;
+  f.balance_confirmations = fs.balance_confirmations;
   f.unverified = fs.unverified;
 }
 

@@ -213,6 +213,9 @@ struct FdiTelemetry {
   std::uint32_t checks_unfit{0};  // check windows not scored: they showed a model error
   std::uint32_t surveys{0};       // (F36) of the checks, those the jet survey started
   std::uint16_t unverified{0};    // (F36) bit i: thruster i commanded and not verified since
+  std::int8_t balance_channel{-1};  // (F61) channel under a balance test this tick, -1 none
+  std::uint32_t balance_tests{0};   // (F61) balance tests flown
+  std::uint32_t balance_confirmations{0};  // (F61) faults a balance test confirmed
 };
 
 struct GncTelemetry {

@@ -54,6 +54,30 @@ Check validate(const FaultDetectorParams& p) {
   if (p.probe_window_ticks != 0 && (p.probe_window_ticks < 4 || p.probe_window_ticks > 1000)) {
     return bad("fdi.probe_window_ticks", "must be 0 or in [4, 1000]");
   }
+  {  // (F61)
+    const BalanceTestParams& b = p.balance;
+    if (!finite_non_negative(b.kick_rad_s)) return bad("fdi.balance.kick_rad_s", "must be >= 0");
+    if (!finite_positive(b.force_n)) return bad("fdi.balance.force_n", "must be positive");
+    if (b.quiet_ticks < 1 || b.quiet_ticks > 10000) {
+      return bad("fdi.balance.quiet_ticks", "must be in [1, 10000]");
+    }
+    if (b.max_fire_ticks < 1 || b.max_fire_ticks > 10000) {
+      return bad("fdi.balance.max_fire_ticks", "must be in [1, 10000]");
+    }
+    if (!finite_non_negative(b.interval_s)) return bad("fdi.balance.interval_s", "must be >= 0");
+    if (!finite_positive(b.chi2_bound)) return bad("fdi.balance.chi2_bound", "must be positive");
+    if (!finite_positive(b.min_snr)) return bad("fdi.balance.min_snr", "must be positive");
+    if (!finite_positive(b.total_sigmas) || !finite_positive(b.partial_sigmas) ||
+        b.partial_sigmas < b.total_sigmas) {
+      return bad("fdi.balance.partial_sigmas", "must be positive and >= total_sigmas");
+    }
+    if (!finite_non_negative(b.min_loss) || !(b.min_loss < 1.0)) {
+      return bad("fdi.balance.min_loss", "must be in [0, 1)");
+    }
+    if (b.max_tests < 1 || b.max_tests > 1000) {
+      return bad("fdi.balance.max_tests", "must be in [1, 1000]");
+    }
+  }
   if (!(p.probe_short_min_llr >= 0.0) || !std::isfinite(p.probe_short_min_llr)) {
     return bad("fdi.probe_short_min_llr", "must be finite and >= 0");
   }
@@ -154,6 +178,8 @@ void FaultDetector::configure(const FaultDetectorParams& p, const RcsLayout& rcs
   survey_noisy_ = p_.survey_noise_kick && p_.survey_max_kick_rad_s > 0.0 &&
                   nw * p_.gyro_sigma * std::sqrt(12.0 * p_.survey_energy / (nw * (nw * nw - 1.0))) >
                       p_.survey_max_kick_rad_s;
+  // (F61) The balance test, with the detector's per-sample gyro noise (F28's centred form).
+  balance_.configure(p_.balance, dt_, u_max_, p_.gyro_sigma, p_.disturbance_sigma);
   reset_scores();
   // Before set_model: nothing suspected, the model is taken (F7).
   suspecting_ = false;
@@ -293,6 +319,11 @@ void FaultDetector::declare(int thruster, FaultKind kind, double factor) {
     factor_[static_cast<std::size_t>(thruster)] = factor;
   }
   cancel_evaluation();  // that window was scored without the fault in the model
+  if (balance_.active()) {  // (F61) a test flown against the model before it
+    balance_.abort();
+    ++st_.balance_aborted;
+  }
+  st_.balance_channel = -1;
   reset_scores();
   suspecting_ = false;
   deg_suspecting_ = false;
@@ -308,6 +339,10 @@ void FaultDetector::declare(int thruster, FaultKind kind, double factor) {
 }
 
 void FaultDetector::carry_counts(const FaultDetectorStatus& b) {
+  st_.balance_tests += b.balance_tests;  // (F61)
+  st_.balance_confirmations += b.balance_confirmations;
+  st_.balance_inconclusive += b.balance_inconclusive;
+  st_.balance_aborted += b.balance_aborted;
   st_.suspicions += b.suspicions;
   st_.models_held += b.models_held;
   st_.probes += b.probes;
@@ -455,13 +490,23 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   if (eval_phase_ != 0) {
     evaluate_step();
   } else {
-    if (partial_loss_pending_) evaluate_partial_losses();  // (F18)
+    if (partial_loss_pending_) {
+      evaluate_partial_losses();  // (F18)
+    } else if (balance_.evaluate_pending()) {
+      balance_verdict(balance_.finish());  // (F61) the fit of a test whose last sample is in
+    }
     if (model_staged_) {
       model_staged_ = false;
       set_model(staged_);
     }
   }
+  balance_clock_s_ += dt_;
   if (!in.omega_valid || !in.thrust_valid || !in.omega.allFinite() || !in.thrust.allFinite()) {
+    if (balance_.active()) {  // (F61) a gap breaks the test too
+      balance_.abort();
+      ++st_.balance_aborted;
+      st_.balance_channel = -1;
+    }
     have_start_ = false;  // a gap breaks the window; the next valid sample starts another
     return pending_;
   }
@@ -475,6 +520,11 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
     if (check_long_n_ > 0 && !long_start) end_check();
     restart_window_ = false;
     long_start_ = false;
+    if (balance_.active()) {  // (F61) an unpredicted sample: the test is dropped
+      balance_.abort();
+      ++st_.balance_aborted;
+      st_.balance_channel = -1;
+    }
     start_window(in.omega);
     if (long_start) {
       window_len_ = check_long_n_;
@@ -500,6 +550,11 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   }
   predicted_ += (thrust_rate - gyro) * dt_;
   WindowSums& acc = win_[static_cast<std::size_t>(acc_)];
+  // (F61) This interval was flown under a balance test: its sample, and the window is the test's.
+  if (balance_.active()) {
+    acc.balance = true;
+    balance_update(in, thrust_rate, gyro);
+  }
   // Model-uncertainty scale (F5): the thrust term, and the gyroscopic term's sensitivity to J,
   // |J^-1 (w x dJ w)| + |dJ^-1 (w x J w)| <= 2 ||J^-1|| ||dJ|| |w|^2 (not |J^-1 (w x J w)|, which
   // vanishes near a principal axis while its error does not).
@@ -532,7 +587,7 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   // (F33) The window so far, from detect_early_ticks samples until its last (which the closed
   // window's evaluation reads), once per window.
   if (p_.detect_early_ticks > 0 && n_ >= p_.detect_early_ticks && n_ < window_len_ &&
-      !acc.early_suspected && early_chi2(acc, static_cast<double>(n_)) > p_.detect_early_chi2) {
+      !acc.early_suspected && !acc.balance && early_chi2(acc, static_cast<double>(n_)) > p_.detect_early_chi2) {
     acc.early_suspected = true;
     ++st_.suspicions;
     ++st_.early_detections;
@@ -574,6 +629,8 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
       return pending_;
     }
   }
+  // (F61) A balance test may start on this sample.
+  if (!balance_.active()) balance_start(in);
   // (F19) The thrust of this update was commanded while the check of the previous one ran.
   if (check_prev_ >= 0) acc.check_jet = check_prev_;
   check_prev_ = st_.check_jet;
@@ -691,6 +748,7 @@ void FaultDetector::start_window(const Vec3& omega) {
   w.live = 0;
   w.check_jet = -1;
   w.early_suspected = false;
+  w.balance = false;
 }
 
 void FaultDetector::close_window() {
@@ -819,6 +877,10 @@ void FaultDetector::evaluate_noise(const WindowSums& w) {
   const Vec3 slope = stt > 0.0 ? Vec3(str / stt) : Vec3::Zero();
   st_.residual = slope * n;  // rate change over the window that the model does not explain
   st_.chi2 = stt > 0.0 ? slope.squaredNorm() * stt / var : 0.0;
+  // (F61) A window flown under a balance test holds the test's firings, which the model predicts
+  // with its own error: the test decides them, the bank neither scores nor suspects it.
+  eval_balance_ = w.balance;
+  if (w.balance) st_.chi2 = 0.0;
   // (F21) A fault that starts inside a window is in it for part of its samples only, whereas every
   // signature (F4) spans the whole window: a jet whose signature matches the truncated ramp (a
   // weaker one of another pod, nearly parallel) can fit it better than the faulty jet and carry
@@ -871,7 +933,7 @@ void FaultDetector::evaluate_scores(const WindowSums& w, int first, int last) {
   const double n = static_cast<double>(w.n);
   const double var = eval_var_;
   const Vec3 r_mean = w.sum_r / n;
-  if (eval_unfit_ || eval_onset_) {  // (F19) a check that exposed a model error; (F21) an onset
+  if (eval_unfit_ || eval_onset_ || eval_balance_) {  // (F19) a check that exposed a model error; (F21) an onset; (F61)
     for (int h = first; h < last; ++h) {
       const auto k = static_cast<std::size_t>(h);
       window_llr_[k] = 0.0;
@@ -1722,6 +1784,7 @@ void FaultDetector::update_check() {
     if (--check_left_ == 0) end_check();
     return;
   }
+  if (balance_.active()) return;  // (F61) no check during a balance test
   if (!(p_.check_llr > 0.0) || pending_.confirmed || probe_left_ > 0 || verdict_pending_ ||
       sweeping() || after_fault_unconfident()) {  // (F59) no check whose verdict would wait
     return;
@@ -2228,6 +2291,99 @@ int FaultDetector::blocking_alternative(int h) const {
   BlockingScan scan;
   blocking_scan(h, 0, kHypotheses, scan);
   return scan.worst;
+}
+
+}  // namespace rocksteady::gnc
+
+namespace rocksteady::gnc {
+
+void FaultDetector::balance_update(const FaultDetectorInput& in, const Vec3& thrust_rate,
+                                   const Vec3& gyro) {
+  // (F61a) The other jets' motion, as the model predicts it: the channel's own halves are the
+  // test's regressors, whatever the model says of them.
+  const int c = balance_.channel();
+  const auto kp = static_cast<std::size_t>(2 * c);
+  const auto km = kp + 1;
+  if (!in.valve_open[static_cast<std::size_t>(pod_[kp])] ||
+      (((st_.confirmed_on | st_.confirmed_off | st_.confirmed_degraded) >> (2 * c)) & 3u) != 0) {
+    balance_.abort();
+    ++st_.balance_aborted;
+    st_.balance_channel = -1;
+    return;
+  }
+  const double fp = in.thrust(static_cast<Eigen::Index>(kp));
+  const double fm = in.thrust(static_cast<Eigen::Index>(km));
+  const Vec3 other_thrust = (thrust_rate - b_[kp] * fp - b_[km] * fm) * dt_;
+  balance_.sample(in.omega, other_thrust - gyro * dt_, other_thrust, fp, fm);
+  if (balance_.dropped_on_motion()) {
+    // (F61d) The body moved beyond the test: the window restarts on the next sample and is scored
+    // (the motion began before it, as F45's onset window).
+    ++st_.balance_aborted;
+    st_.balance_channel = -1;
+    restart_window_ = true;
+    last_suspicious_ = true;
+  }
+}
+
+void FaultDetector::balance_verdict(const BalanceVerdict& v) {
+  st_.balance_channel = balance_.channel();
+  if (v.outcome == BalanceOutcome::kNone) return;
+  st_.balance_chi2 = v.chi2;
+  st_.balance_ratio = v.ratio;
+  if (v.outcome == BalanceOutcome::kInconclusive && balance_.info(v.channel).done) {
+    ++st_.balance_inconclusive;
+  }
+  if (v.outcome != BalanceOutcome::kFault) return;
+  const auto bit = 1u << v.thruster;
+  if (((st_.confirmed_on | st_.confirmed_off | st_.confirmed_degraded) & bit) != 0) return;
+  declare(v.thruster, v.kind, v.factor);
+  ++st_.balance_confirmations;
+  if (v.kind == FaultKind::kDegraded) ++st_.degraded_confirmations;
+  pending_.confirmed = true;
+  pending_.thruster = v.thruster;
+  pending_.kind = v.kind;
+  pending_.factor = v.kind == FaultKind::kDegraded ? v.factor : 0.0;
+  pending_.factor_sigma = v.kind == FaultKind::kDegraded ? v.factor_sigma : 0.0;
+}
+
+void FaultDetector::balance_start(const FaultDetectorInput& in) {
+  // (F61) In HOLD (the GNC's balance_allowed), with nothing else under way: no isolation test,
+  // sweep, check or confirmation. A channel is usable with both halves unlatched and its pod open.
+  // A stuck-on leader is the isolation test's (F9), as for a check; a stuck-off or partial-loss
+  // suspicion that the bank cannot decide (a model that absorbed the fault) is the balance test's.
+  const bool stuck_on_leader =
+      st_.best >= 0 && st_.best < kThrusters && st_.best_llr > 0.5 * p_.confirm_llr;
+  // Nor after a window above the no-fault bound (the bank's evidence first; F61d sets it when a
+  // test is dropped on the body's motion), and only once the bank has scored a window flown
+  // without a test since the last one: between two tests it sees the body under control.
+  const WindowSums& closed = win_[static_cast<std::size_t>(acc_ ^ 1)];
+  if (!balance_.enabled() || !in.balance_allowed || stuck_on_leader || last_suspicious_ ||
+      closed.balance || win_[static_cast<std::size_t>(acc_)].balance ||
+      probe_left_ > 0 ||
+      verdict_pending_ || sweeping() || st_.check_jet >= 0 || check_left_ > 0 ||
+      st_.probe_pod >= 0 || pending_.confirmed || eval_phase_ != 0) {
+    return;
+  }
+  const std::uint16_t latched =
+      static_cast<std::uint16_t>(st_.confirmed_on | st_.confirmed_off | st_.confirmed_degraded);
+  std::uint8_t usable = 0;
+  std::array<double, kChannels> b_plus{};
+  for (int c = 0; c < kChannels; ++c) {
+    const auto k = static_cast<std::size_t>(2 * c);
+    b_plus[static_cast<std::size_t>(c)] = b_norm_[k];
+    if (((latched >> (2 * c)) & 3u) == 0 && in.valve_open[static_cast<std::size_t>(pod_[k])]) {
+      usable = static_cast<std::uint8_t>(usable | (1u << c));
+    }
+  }
+  const double rel = std::fmax(p_.model_rel_floor, m_.j_rel_sigma);
+  // (F61c) Not on a busy flight: the motion of the last window closed, on the model.
+  const WindowSums& last = win_[static_cast<std::size_t>(acc_ ^ 1)];
+  const double rate = last.n > 0 ? last.thrust_motion / (static_cast<double>(last.n) * dt_) : 1e300;
+  if (!balance_.quiet_enough(rate)) return;
+  if (balance_.start(balance_clock_s_, usable, in.omega, b_plus, j_inv_.norm(), rel)) {
+    ++st_.balance_tests;
+    st_.balance_channel = balance_.channel();
+  }
 }
 
 }  // namespace rocksteady::gnc

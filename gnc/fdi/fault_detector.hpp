@@ -17,6 +17,7 @@
 #include <cstdint>
 
 #include "gnc/check.hpp"
+#include "gnc/fdi/balance_test.hpp"
 #include "gnc/io.hpp"  // FaultKind
 #include "gnc/model/rcs.hpp"
 #include "gnc/types.hpp"
@@ -238,6 +239,9 @@ struct FaultDetectorParams {
   // idle at milli-newtons. A despin's tick already carries the identifier's blocks and the
   // excitation. false: in every mode.
   bool survey_hold_only{false};
+  // (F61) Channel balance tests (balance_test.hpp): in HOLD, each channel's two halves fired one
+  // after the other and compared, with no model of the body. balance.kick_rad_s 0: off.
+  BalanceTestParams balance{};
   // (F44) A survey check starts only when the rate it may put on the body stays within this, rad/s
   // (0: off): 3 sigma of the model's error against the check's firing (the centre of mass's 1 sigma
   // against its net force, each fired jet's strength 1 sigma against its torque) times J^-1 and
@@ -330,6 +334,8 @@ struct FaultDetectorInput {
   bool thrust_valid{true};
   // (F43) A jet survey check may start now (the GNC: only in HOLD when survey_hold_only).
   bool survey_allowed{true};
+  // (F61) A channel balance test may start now (the GNC: in HOLD).
+  bool balance_allowed{false};
 };
 
 // The identified model the predictions use (refreshed when the identifier reports).
@@ -387,6 +393,13 @@ struct FaultDetectorStatus {
   std::uint32_t onset_restarts{0};  // (F45) onset windows ended at their early suspicion
   std::uint32_t probe_whole_windows{0};  // (F47) tests flown on a whole window, weak evidence
   std::uint32_t elsewhere_verdicts{0};  // (F40) tests whose closed windows named another pod's jet
+  int balance_channel{-1};            // (F61) the channel under a balance test, -1 none
+  std::uint32_t balance_tests{0};     // (F61) balance tests flown (started)
+  std::uint32_t balance_confirmations{0};  // (F61) faults confirmed by a balance test
+  std::uint32_t balance_inconclusive{0};   // (F61) channels left undecided after balance.max_tests
+  std::uint32_t balance_aborted{0};        // (F61) tests broken by a gap, a valve or a latch
+  double balance_chi2{0.0};           // (F61) the last test's |g+ + g-|^2 / var
+  double balance_ratio{1.0};          // (F61) ... and its weaker half's strength ratio
 };
 
 // Raised by update(); the caller turns them into events.
@@ -416,7 +429,8 @@ class FaultDetector {
   bool heavy_step_next() const {
     return eval_phase_ == 1 || eval_phase_ == 2 || (eval_phase_ == 0 && partial_loss_pending_) ||
            (eval_phase_ == 3 && st_.best_llr > p_.confirm_llr) ||
-           (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping()));
+           (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping())) ||
+           (eval_phase_ == 0 && !partial_loss_pending_ && balance_.evaluate_pending());  // (F61)
   }
   // The steps up to the decision; with the partial-loss confirmation (F18) on, its step follows on
   // the next update that carries none of them.
@@ -472,6 +486,20 @@ class FaultDetector {
   // or its pod's valve closed in this update's input.
   std::uint8_t held_channels() const;
   bool check_on_model() const { return p_.check_model_null_space; }
+  // (F61) The channel under a balance test (-1 none) and the signed force it adds there over the
+  // next interval (N).
+  int balance_channel() const { return balance_.channel(); }
+  double balance_command() const { return balance_.command(); }
+  const ChannelBalanceTest& balance_test() const { return balance_; }
+  // ... the same as physical thruster forces (N): thruster 2c ("+") or 2c + 1 ("-").
+  Vec16 balance_thrust() const {
+    Vec16 f = Vec16::Zero();
+    const int c = balance_.channel();
+    const double u = balance_.command();
+    if (c >= 0 && u > 0.0) f(2 * c) = u;
+    if (c >= 0 && u < 0.0) f(2 * c + 1) = -u;
+    return f;
+  }
 
   // Rate change signature of hypothesis h over the last window (exposed for tests): 0..15
   // stuck-on of thruster h, 16..31 stuck-off of thruster h - 16.
@@ -498,6 +526,14 @@ class FaultDetector {
   void blocking_scan(int h, int g_begin, int g_end, BlockingScan& scan) const;
   int partial_loss_rival(int h) const;  // (F13, F25) the other jet whose partial loss h does not beat
   BlockingScan block_scan_{};
+  // (F61) The balance test: its sample of this update (the other jets' predicted motion), its
+  // start, and a window flown under it (not scored: its firings are the test's).
+  void balance_update(const FaultDetectorInput& in, const Vec3& thrust_rate, const Vec3& gyro);
+  void balance_start(const FaultDetectorInput& in);
+  void balance_verdict(const BalanceVerdict& v);
+  ChannelBalanceTest balance_{};
+  double balance_clock_s_{0.0};  // (F61) flight time since configure, for the rounds' interval
+  bool eval_balance_{false};     // (F61) the window under evaluation flew a balance test
   // (F13) For a stuck-off leader h: the jet whose partial loss of thrust explains the episode
   // as well (within margin_llr), h itself when its amplitude is that of a partial loss, or -1.
   int partial_loss_alternative(int h) const;
@@ -641,6 +677,7 @@ class FaultDetector {
     std::uint32_t live{0};
     int check_jet{-1};  // (F19) the jet checked during the window, -1 none
     bool early_suspected{false};  // (F33) its suspicion was raised before it closed
+    bool balance{false};          // (F61) a balance test flew within it
   };
   template <bool kFirst>
   void accumulate(WindowSums& w, const FaultDetectorInput& in, const Vec3& r);

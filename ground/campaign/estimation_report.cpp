@@ -85,6 +85,8 @@ nlohmann::json fdi_json(const FdiReport& f) {
           {"checks", f.checks},
           {"checks_unfit", f.checks_unfit},
           {"surveys", f.surveys},
+          {"balance_tests", f.balance_tests},
+          {"balance_confirmations", f.balance_confirmations},
           {"fault_detected_s", opt(f.fault_detected_s)},
           {"fault_first_commanded_s", opt(f.fault_first_commanded_s)},
           {"fault_commanded_s", f.fault_commanded_s},
@@ -108,6 +110,10 @@ FdiReport fdi_from_json(const nlohmann::json& j) {
     f.checks_unfit = j.at("checks_unfit").get<std::uint32_t>();
   }
   if (j.contains("surveys")) f.surveys = j.at("surveys").get<std::uint32_t>();  // (F36)
+  if (j.contains("balance_tests")) {  // (F61)
+    f.balance_tests = j.at("balance_tests").get<std::uint32_t>();
+    f.balance_confirmations = j.at("balance_confirmations").get<std::uint32_t>();
+  }
   // Absent from draws written before these were measured.
   if (j.contains("confirmed_degraded")) {
     f.confirmed_degraded = j.at("confirmed_degraded").get<std::uint16_t>();

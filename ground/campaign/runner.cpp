@@ -335,6 +335,8 @@ RunResult run_closed_loop(const config::RunSetup& setup, const Strategy& strateg
       d.checks = f.checks;
       d.checks_unfit = f.checks_unfit;
       d.surveys = f.surveys;
+      d.balance_tests = f.balance_tests;
+      d.balance_confirmations = f.balance_confirmations;
       if (!setup.truth.faults.empty()) {
         // The first injected fault's jet, commanded by the flight this tick (held over it).
         const plant::ThrusterFault& inj = setup.truth.faults.front();

@@ -119,6 +119,8 @@ struct FdiReport {
   std::uint32_t checks{0};  // (F19) jet checks started
   std::uint32_t checks_unfit{0};  // ... check windows not scored (they showed a model error)
   std::uint32_t surveys{0};       // (F36) ... of the checks, those the jet survey started
+  std::uint32_t balance_tests{0};  // (F61) channel balance tests flown
+  std::uint32_t balance_confirmations{0};  // (F61) ... faults they confirmed
   // The injected fault's jet as the flight commanded it after onset (from the truth's fault list
   // and the flight's command; the flight never sees the former): the first tick it was commanded
   // (its half of the channel asked a positive force with the pod's valve open), and the time and

@@ -593,6 +593,54 @@ TEST(ConfigShipped, TheEarlyIsolationTestsLevelIsReadAndOptional) {
                           });
 }
 
+// (F61) The channel balance tests: gnc.yaml's map read into every case's flight parameters, each
+// bad value named by file and key, and no tests when the map is absent.
+TEST(ConfigShipped, TheChannelBalanceTestsAreReadAndOptional) {
+  for (int c = 1; c <= 7; ++c) {
+    const gnc::BalanceTestParams& b = load_run(kMission, kGnc, case_file(c)).flight.fdi.balance;
+    EXPECT_EQ(b.kick_rad_s, 0.0) << "case " << c;  // off in gnc.yaml (README F61)
+    EXPECT_EQ(b.force_n, 100.0);
+    EXPECT_EQ(b.quiet_ticks, 300);
+    EXPECT_EQ(b.max_fire_ticks, 200);
+    EXPECT_EQ(b.interval_s, 20000.0);
+    EXPECT_EQ(b.chi2_bound, 30.66);
+    EXPECT_EQ(b.min_snr, 10.0);
+    EXPECT_EQ(b.total_sigmas, 2.0);
+    EXPECT_EQ(b.partial_sigmas, 3.0);
+    EXPECT_EQ(b.min_loss, 0.1);
+    EXPECT_EQ(b.max_tests, 6);
+  }
+  const std::string text = read(kGnc);
+  const struct {
+    const char* line;
+    const char* bad;
+    const char* key;
+    const char* reason;
+  } bad_values[] = {
+      {"    quiet_ticks: 300", "    quiet_ticks: 0", "fdi.balance.quiet_ticks", "[1, 10000]"},
+      {"    min_loss: 0.1", "    min_loss: 1.5", "fdi.balance.min_loss", "below 1"},
+      {"    partial_sigmas: 3.0", "    partial_sigmas: 1.0", "fdi.balance.partial_sigmas", "total_sigmas"},
+      {"    kick_rad_s: 0.0 ", "    kick_rad_s: -1.0 ", "fdi.balance.kick_rad_s", "negative"},
+      {"    max_tests: 6", "    max_tests: 0", "fdi.balance.max_tests", "[1, 1000]"},
+  };
+  for (const auto& v : bad_values) {
+    ASSERT_NE(text.find(v.line), std::string::npos) << v.line;
+    TempFile bad("gnc.yaml", replaced(text, v.line, v.bad));
+    expect_error([&] { load_gnc(bad.path()); }, bad.path(), v.key, v.reason);
+  }
+  // Absent: every line of the map commented out, no tests.
+  std::string without = text;
+  const std::size_t at = without.find("  balance:");
+  ASSERT_NE(at, std::string::npos);
+  std::size_t pos = at;
+  for (int i = 0; i < 12; ++i) {
+    without.replace(pos, 2, "#");
+    pos = without.find('\n', pos) + 1;
+  }
+  TempFile absent("gnc.yaml", without);
+  EXPECT_EQ(load_run(kMission, absent.path(), case_file(5)).flight.fdi.balance.kick_rad_s, 0.0);
+}
+
 // (F27) aligned isolation tests, (F28) the centred gyro noise, (F29) the test's partial-loss rival,
 // (F32) the test read on its closed windows, (F34) checks started on quiet windows, (F35) unfit
 // check windows scored, (F37) the blocker checked, (F38) the stale episode restarted, (F40)

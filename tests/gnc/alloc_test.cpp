@@ -895,5 +895,61 @@ TEST(ZeroAllocation, NoHeapWithStuckOnIsolationInsideIdentification) {
   delete loop;
 }
 
+// gnc/fdi/README.md (F61): channel balance tests in free drift, round after round, up to the
+// confirmation of a half-strength jet (the evaluation, the verdict and the declaration), counted.
+TEST(ZeroAllocation, NoHeapInChannelBalanceTests) {
+  constexpr double kUmax = 200.0;
+  constexpr double kDt = 0.1;
+  const RcsLayout rcs = study_rcs_layout(kUmax);
+  const Mat3 j = total_inertia(study_true_mass_properties());
+  const Vec3 r(-0.0495, -0.0004, 3.5456);
+  FaultDetectorParams p;
+  p.enabled = true;
+  p.window_ticks = 10;
+  p.gyro_sigma = 3e-6;
+  p.centred_gyro_noise = true;
+  p.balance.kick_rad_s = 5e-5;
+  p.balance.interval_s = 100.0;
+  FaultDetector d;
+  d.configure(p, rcs, kUmax, kDt);
+  FaultModel m;
+  m.j = 1.5 * j;
+  m.r = r + Vec3(2.0, -2.0, 1.0);
+  m.j_rel_sigma = 0.3;
+  d.set_model(m);
+  constexpr int kWeak = 9;  // channel 4's "-" half at half strength
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, p.gyro_sigma);
+  Vec3 w(2e-5, -1e-5, 1e-5);
+  Vec16 prev = Vec16::Zero();
+  long counted = -1;
+  {
+    Armed armed;
+    for (int k = 0; k < 4000; ++k) {
+      FaultDetectorInput in;
+      in.omega = w + Vec3(noise(rng), noise(rng), noise(rng));
+      in.omega_valid = true;
+      in.thrust = prev;
+      in.balance_allowed = true;
+      d.update(in);
+      const Vec16 f = d.balance_thrust();
+      Vec3 tau = Vec3::Zero();
+      for (int i = 0; i < 16; ++i) {
+        const int c = i / 2;
+        const Vec3 d_i = (i % 2 == 0 ? 1.0 : -1.0) * rcs.channel_direction[static_cast<std::size_t>(c)];
+        const double k_i = i == kWeak ? 0.5 : 1.0;
+        tau += (rcs.pod_position[static_cast<std::size_t>(rcs.channel_pod[c])] + r).cross(k_i * f(i) * d_i);
+      }
+      w += kDt * j.inverse() * (tau - w.cross(j * w));
+      prev = f;
+    }
+    counted = rocksteady::test::heap_allocations();
+  }
+  EXPECT_EQ(counted, 0);
+  EXPECT_GE(d.status().balance_tests, 8u);
+  EXPECT_EQ(d.status().balance_confirmations, 1u);
+  EXPECT_EQ(d.confirmed_degraded(), 1u << kWeak);
+}
+
 }  // namespace
 }  // namespace rocksteady::gnc
