@@ -21,7 +21,6 @@ void ChannelBalanceTest::configure(const BalanceTestParams& p, double dt, double
   const double z = p_.kick_rad_s > 0.0 ? 1.5 * p_.min_snr * gyro_sigma / p_.kick_rad_s : 0.0;
   quiet_ = static_cast<int>(std::fmin(std::fmax(std::ceil(2.0 * z * z), 10.0),
                                       static_cast<double>(std::max(p_.quiet_ticks, 1))));
-  counters_ = BalanceCounters{};
   reset();
 }
 
@@ -43,7 +42,6 @@ bool ChannelBalanceTest::start(double now_s, std::uint8_t usable, const Vec3& om
     if (now_s - round_end_s_ < p_.interval_s) return false;
     info_.fill(ChannelInfo{});
     round_open_ = true;
-    ++counters_.rounds;
   }
   int c = -1;
   bool remaining = false;
@@ -84,7 +82,6 @@ bool ChannelBalanceTest::start(double now_s, std::uint8_t usable, const Vec3& om
   s1p_.setZero();
   s2p_.setZero();
   srr_ = 0.0;
-  ++counters_.tests;
   next_command();
   return true;
 }
@@ -115,7 +112,6 @@ void ChannelBalanceTest::abort() {
   channel_ = -1;
   command_ = 0.0;
   pending_ = false;
-  ++counters_.aborted;
 }
 
 BalanceVerdict ChannelBalanceTest::sample(const Vec3& omega, const Vec3& predicted_other,
@@ -252,9 +248,6 @@ BalanceVerdict ChannelBalanceTest::evaluate() {
     return v;  // the channel is tested again, its information kept
   }
   ci.done = true;
-  if (v.outcome == BalanceOutcome::kBalanced) ++counters_.balanced;
-  if (v.outcome == BalanceOutcome::kFault) ++counters_.faults;
-  if (v.outcome == BalanceOutcome::kInconclusive) ++counters_.inconclusive;
   return v;
 }
 

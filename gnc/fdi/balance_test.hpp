@@ -7,11 +7,11 @@
 // cancel from the comparison: g+ + g- = (k+ - k-) J^-1 (p + r) x d, zero for a healthy channel,
 // and along g+ - g- the two halves' responses s+ = g+.u and s- = -g-.u have the ratio k- / k+.
 //
-// One test of channel c flies, from its start sample: q quiet samples (sized by the gyro's noise, at
-// most quiet_ticks), the "+" half at
-// force_n for n_f samples, quiet_ticks, the "-" half at force_n for n_f, quiet_ticks. n_f is
-// sized on the detector's model so that each firing turns the rate by about kick_rad_s; with a
-// healthy channel the second undoes the first. Every sample's residual (the rate less its start
+// One test of channel c flies, from its start sample, while the body drifts free (Gnc): q quiet
+// samples (sized by the gyro's noise, at most quiet_ticks), the "+" half at force_n for n_f
+// samples, q quiet, the "-" half at force_n for n_f, q quiet. n_f is sized so that each firing
+// turns the rate by about kick_rad_s: on the detector's model for a channel's first test, then on
+// its measured response; with a healthy channel the second firing undoes the first. Every sample's residual (the rate less its start
 // and less the motion the model predicts from every other jet's commanded thrust) is fitted with
 // an offset and the two halves' commanded impulses (I+, I-) as regressors, per axis:
 //   r_j = o + g+ I+(j) + g- I-(j) + e_j.                                              (F61a)
@@ -68,15 +68,6 @@ struct BalanceVerdict {
   double ratio{1.0};                    // rho
 };
 
-struct BalanceCounters {
-  std::uint32_t tests{0};
-  std::uint32_t balanced{0};
-  std::uint32_t faults{0};
-  std::uint32_t inconclusive{0};  // a channel left after max_tests
-  std::uint32_t aborted{0};       // a test broken by a gap, a valve or a latch
-  std::uint32_t rounds{0};
-};
-
 class ChannelBalanceTest {
  public:
   static constexpr double kMaxTotalRatio = 0.25;  // a stuck-off half: rho below this too
@@ -93,7 +84,7 @@ class ChannelBalanceTest {
 
   void configure(const BalanceTestParams& p, double dt, double u_max, double gyro_sigma,
                  double disturbance_sigma);
-  void reset();  // tests and rounds; counters kept
+  void reset();  // tests and rounds (the detector's status keeps the counts)
   bool enabled() const { return p_.kick_rad_s > 0.0; }
   bool active() const { return channel_ >= 0; }
   int channel() const { return channel_; }
@@ -119,11 +110,10 @@ class ChannelBalanceTest {
   // carries none of its own heavy steps (the Cortex-M7 tick budget).
   bool evaluate_pending() const { return pending_; }
   BalanceVerdict finish();
-  void abort();  // a gap, a closed valve or a latched fault: the test is dropped
+  void abort();  // a gap, a closed valve, a latched fault or the body's motion: the test is dropped
   // (F61c) A test may start while the other jets move the body at other_rate (rad/s^2, on the
   // model).
   bool quiet_enough(double other_rate) const;
-  const BalanceCounters& counters() const { return counters_; }
   int fire_ticks() const { return n_fire_; }
   int test_ticks() const { return 3 * quiet_ + 2 * n_fire_; }
   int quiet_ticks() const { return quiet_; }
@@ -171,7 +161,6 @@ class ChannelBalanceTest {
   std::array<ChannelInfo, kChannels> info_{};
   bool round_open_{false};
   double round_end_s_{-1e300};
-  BalanceCounters counters_{};
 };
 
 }  // namespace rocksteady::gnc
