@@ -24,6 +24,8 @@
 //   survey=S      with modules=all: the jet survey (gnc/fdi/README.md F36) every S s (default
 //                 20000, gnc.yaml's; 0 off), so that its checks run on the counted ticks (in HOLD
 //                 only, F43; inside the budget: DEVELOPERS.md)
+//   balance=U     with modules=all: the channel balance tests (gnc/fdi/README.md F61) with a kick
+//                 of U micro-rad/s (default 0: off, as gnc.yaml)
 //
 // Every counted Gnc::step is bracketed by rs_probe_begin()/rs_probe_end(), so an emulator trace
 // (qemu -singlestep -d exec,nochain + tests/cross/count_insns.awk) counts its instructions exactly.
@@ -66,6 +68,7 @@ struct Options {
   bool pinv{false};             // modules=all with the pseudoinverse allocator
   std::uint32_t onset_s{1000};  // ... from this simulated time
   std::uint32_t survey_s{20000};  // (F36) jet survey interval, 0 off (gnc.yaml's 20 000 s)
+  std::uint32_t balance_urad_s{0};  // (F61) balance test kick, micro-rad/s (0 off, gnc.yaml's)
 };
 
 // Parses "key=value" tokens of the semihosting command line (unknown tokens are ignored).
@@ -104,6 +107,7 @@ Options parse_options() {
     }
     if (const char* v = value_of("onset=")) o.onset_s = to_u32(v);
     if (const char* v = value_of("survey=")) o.survey_s = to_u32(v);
+    if (const char* v = value_of("balance=")) o.balance_urad_s = to_u32(v);
   }
   return o;
 }
@@ -239,7 +243,7 @@ int firmware_main() {
     g_params.fdi.survey_loss_llr = 2.5;  // (F57) a jet with partial-loss evidence is not verified by its energy
     g_params.fdi.total_loss_sigmas = 2.0;  // (F58) a loss 2 sigma below the total-loss floor is partial
     g_params.fdi.after_fault_max_j_rel = 0.01;  // (F59) after a fault, losses and checks on a confident model
-    g_params.fdi.balance.kick_rad_s = 0.0;  // (F61) channel balance tests off, as gnc.yaml
+    g_params.fdi.balance.kick_rad_s = 1e-6 * static_cast<double>(opt.balance_urad_s);  // (F61) off, as gnc.yaml
     g_params.fdi.balance.quiet_ticks = 300;
     g_params.fdi.centred_gyro_noise = true;    // (F28) the gyro's variance sigma_g^2, as flown
     g_params.fdi.suspect_chi2 = 30.66;         // ... and the suspicion at 1 - 1e-6, as flown
@@ -324,6 +328,7 @@ int firmware_main() {
       cmd.has_mode_request = true;
       cmd.mode_request = first_mode;
     }
+    if (opt.stuck < 0 && opt.degraded < 0 && k == opt.onset_s * 10U) { cmd.has_fault_declaration = true; cmd.fault_thruster = 9; cmd.fault_kind = gnc::FaultKind::kDegraded; cmd.fault_factor = 0.5; }
     const gnc::SensorSample s = sample_of(body, t);
     // The stack is measured on the first tick (mode change), then on every print tick; every other
     // tick is counted for the instruction figures.
@@ -485,6 +490,12 @@ int firmware_main() {
     }
     line.str(", jet checks ").u32(fdi.checks).str(", confirmed on/off/degraded masks ")
         .u32(fdi.confirmed_on).str("/").u32(fdi.confirmed_off).str("/").u32(fdi.confirmed_degraded);
+    line.flush();
+  }
+  if (opt.balance_urad_s > 0) {  // (F61) what the channel balance tests did
+    line.str("balance tests: ").u32(fdi.balance_tests).str(" started, ")
+        .u32(fdi.balance_aborted).str(" dropped, ").u32(fdi.balance_inconclusive)
+        .str(" channels inconclusive, ").u32(fdi.balance_confirmations).str(" faults confirmed");
     line.flush();
   }
   return ok ? 0 : 1;

@@ -1125,9 +1125,11 @@ void Identifier::update(const IdentifierInput& in, bool background) {
     identified_s_ += latched_.length_s;
     n_ = window_ticks_next();
     latched_noise_ = window_noise();
-    latched_r_ = window_noise_matrix();
     ++counters_.windows;
-    phase_ = Phase::kInertia;
+    // The window's noise matrix (I19) is the step's first block, on a tick of its own: on the
+    // closing tick it could meet the fault detector's heavy evaluation steps, which the background
+    // blocks avoid (the Cortex-M7 tick budget: 20.8 k instructions in HOLD when they met).
+    phase_ = Phase::kNoise;
     // This sample also opens the next window (w = 0 here, so it only enters through alpha_0).
     acc_ = Window{};
     sample_ = -1;
@@ -1138,6 +1140,10 @@ void Identifier::update(const IdentifierInput& in, bool background) {
 void Identifier::step_phase() {
   complete_reinflation();
   switch (phase_) {
+    case Phase::kNoise:
+      latched_r_ = window_noise_matrix();
+      phase_ = Phase::kInertia;
+      break;
     case Phase::kInertia:
       if (c_.mode == IdentifierMode::kJoint) {
         joint_gain();

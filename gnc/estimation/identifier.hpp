@@ -353,7 +353,7 @@ class Identifier {
     double dist_factor{0.0};       // (I21) for that length
   };
   enum class Phase : std::uint8_t {
-    kIdle, kInertia, kSecondOrder, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
+    kIdle, kNoise, kInertia, kSecondOrder, kGain, kOffset, kApply, kStrength, kAnchor, kSync, kReport, kFaultScore,
     kSettleFactors, kSettleStart, kSettle
   };
   // (I23) Thrusters scored per tick after the report (the Cortex-M7 tick budget).

@@ -87,6 +87,8 @@ class ChannelBalanceTest {
   void reset();  // tests and rounds (the detector's status keeps the counts)
   bool enabled() const { return p_.kick_rad_s > 0.0; }
   bool active() const { return channel_ >= 0; }
+  // The test's samples are still coming: the body drifts free under it (its fit may wait).
+  bool flying() const { return channel_ >= 0 && !pending_; }
   int channel() const { return channel_; }
   // The signed force the test adds to its channel over the next interval (0 outside firings).
   double command() const { return command_; }

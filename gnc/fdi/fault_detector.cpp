@@ -488,7 +488,12 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   // (F10) One step of the closed window's evaluation per tick, whatever this tick's data; a model
   // that arrived meanwhile is taken once it is done (before this tick's sample, like any other).
   if (eval_phase_ != 0) {
+    // (F61) The third step is idle without a leader past the confirmation level (no blocking
+    // scan): a balance test's fit takes it (heavy_step_next() counts it there).
+    const bool fit_here = eval_phase_ == 3 && !(st_.best_llr > p_.confirm_llr) &&
+                          balance_.evaluate_pending();
     evaluate_step();
+    if (fit_here) balance_verdict(balance_.finish());
   } else {
     if (partial_loss_pending_) {
       evaluate_partial_losses();  // (F18)
@@ -502,7 +507,7 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   }
   balance_clock_s_ += dt_;
   if (!in.omega_valid || !in.thrust_valid || !in.omega.allFinite() || !in.thrust.allFinite()) {
-    if (balance_.active()) {  // (F61) a gap breaks the test too
+    if (balance_.flying()) {  // (F61) a gap breaks the test too (not one whose samples are in)
       balance_.abort();
       ++st_.balance_aborted;
       st_.balance_channel = -1;
@@ -520,7 +525,7 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
     if (check_long_n_ > 0 && !long_start) end_check();
     restart_window_ = false;
     long_start_ = false;
-    if (balance_.active()) {  // (F61) an unpredicted sample: the test is dropped
+    if (balance_.flying()) {  // (F61) an unpredicted sample: the test is dropped
       balance_.abort();
       ++st_.balance_aborted;
       st_.balance_channel = -1;
@@ -551,7 +556,7 @@ FaultEvents FaultDetector::step(const FaultDetectorInput& in) {
   predicted_ += (thrust_rate - gyro) * dt_;
   WindowSums& acc = win_[static_cast<std::size_t>(acc_)];
   // (F61) This interval was flown under a balance test: its sample, and the window is the test's.
-  if (balance_.active()) {
+  if (balance_.flying()) {
     acc.balance = true;
     balance_update(in, thrust_rate, gyro);
   }

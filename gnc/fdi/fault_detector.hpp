@@ -428,9 +428,12 @@ class FaultDetector {
   // work off those ticks.
   bool heavy_step_next() const {
     return eval_phase_ == 1 || eval_phase_ == 2 || (eval_phase_ == 0 && partial_loss_pending_) ||
-           (eval_phase_ == 3 && st_.best_llr > p_.confirm_llr) ||
+           (eval_phase_ == 3 && (st_.best_llr > p_.confirm_llr || balance_.evaluate_pending())) ||
            (eval_phase_ == 4 && (st_.best_llr > p_.confirm_llr || sweeping())) ||
-           (eval_phase_ == 0 && !partial_loss_pending_ && balance_.evaluate_pending());  // (F61)
+           // (F61) the fit of a balance test on a step that carries no other (with windows of
+           // five updates the closed window's evaluation and the partial-loss step take every
+           // update but the third step's when no leader is past the confirmation level)
+           (eval_phase_ == 0 && !partial_loss_pending_ && balance_.evaluate_pending());
   }
   // The steps up to the decision; with the partial-loss confirmation (F18) on, its step follows on
   // the next update that carries none of them.
@@ -487,8 +490,9 @@ class FaultDetector {
   std::uint8_t held_channels() const;
   bool check_on_model() const { return p_.check_model_null_space; }
   // (F61) The channel under a balance test (-1 none) and the signed force it adds there over the
-  // next interval (N).
-  int balance_channel() const { return balance_.channel(); }
+  // next interval (N). A test whose last sample is in is no longer flown: the flight takes control
+  // again on that update, whenever its fit runs.
+  int balance_channel() const { return balance_.flying() ? balance_.channel() : -1; }
   double balance_command() const { return balance_.command(); }
   const ChannelBalanceTest& balance_test() const { return balance_; }
   // ... the same as physical thruster forces (N): thruster 2c ("+") or 2c + 1 ("-").

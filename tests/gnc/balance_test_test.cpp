@@ -6,6 +6,7 @@
 // healthy RCS is never blamed; a flight that moves the body with other jets leaves it undecided.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
@@ -288,6 +289,57 @@ TEST(ChannelBalance, AJetStuckOnDuringATestEndsItAndTheBankIsolatesTheJet) {
 }
 
 // Nothing starts outside HOLD (the GNC's balance_allowed) or with the test off.
+// With windows of five updates and the partial-loss step on (the firmware's table), the closed
+// window's evaluation and the partial-loss step take every update but one: the fit of a test
+// whose last sample is in must still run (it once never did, and the flight drifted free with a
+// jet stuck on), and the flight takes control again as soon as the test's samples are in.
+TEST(ChannelBalance, ATestsFitRunsWithShortWindowsAndTheFlightResumesAtItsLastSample) {
+  Rig t;
+  FaultDetectorParams p = balance_params(t.gyro_sigma);
+  p.window_ticks = 5;
+  p.degraded_min_loss = 0.1;
+  FaultDetector d;
+  d.configure(p, study_rcs_layout(kUmax), kUmax, kDt);
+  FaultModel m;
+  m.j = t.body.j;
+  m.r = t.r;
+  m.j_rel_sigma = 0.01;
+  m.r_cov = Mat3::Identity() * 1e-4;
+  m.k_sigma = 0.01;
+  d.set_model(m);
+  Vec16 prev = Vec16::Zero();
+  int pending_run = 0;
+  int longest_pending = 0;
+  int verdicts = 0;
+  for (int k = 0; k < 3000; ++k) {
+    FaultDetectorInput in;
+    in.omega = t.gyro();
+    in.omega_valid = true;
+    in.thrust = prev;
+    in.balance_allowed = true;
+    const bool was_pending = d.balance_test().evaluate_pending();
+    const FaultEvents e = d.update(in);
+    EXPECT_FALSE(e.confirmed) << "tick " << k;
+    const ChannelBalanceTest& bt = d.balance_test();
+    if (was_pending && !bt.evaluate_pending()) ++verdicts;
+    pending_run = bt.evaluate_pending() ? pending_run + 1 : 0;
+    longest_pending = std::max(longest_pending, pending_run);
+    const Vec16 f = d.balance_thrust();
+    if (bt.evaluate_pending()) {  // the samples are in: no test flown, the flight's own thrust
+      EXPECT_EQ(d.balance_channel(), -1) << "tick " << k;
+      EXPECT_EQ(f.squaredNorm(), 0.0) << "tick " << k;
+    }
+    t.advance(f, k);
+    prev = f;
+  }
+  const FaultDetectorStatus& st = d.status();
+  EXPECT_GE(st.balance_tests, 8u);  // a round of every channel, at least
+  EXPECT_GE(verdicts, 8);
+  EXPECT_EQ(st.balance_aborted, 0u);
+  EXPECT_EQ(st.balance_confirmations, 0u);
+  EXPECT_LE(longest_pending, p.window_ticks);  // the fit waited at most one window
+}
+
 TEST(ChannelBalance, NoTestWithoutTheFlightsLeaveOrWithTheKickAtZero) {
   for (const bool allowed : {false, true}) {
     FaultDetectorParams p = balance_params(3.1623e-6);
