@@ -328,7 +328,6 @@ int firmware_main() {
       cmd.has_mode_request = true;
       cmd.mode_request = first_mode;
     }
-    if (opt.stuck < 0 && opt.degraded < 0 && k == opt.onset_s * 10U) { cmd.has_fault_declaration = true; cmd.fault_thruster = 9; cmd.fault_kind = gnc::FaultKind::kDegraded; cmd.fault_factor = 0.5; }
     const gnc::SensorSample s = sample_of(body, t);
     // The stack is measured on the first tick (mode change), then on every print tick; every other
     // tick is counted for the instruction figures.
